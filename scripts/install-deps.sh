@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs the Debian packages focal needs, only those missing; idempotent.
+#   scripts/install-deps.sh          build and test dependencies
+#   scripts/install-deps.sh demo     also the scanned meshes used by `make demo`
+set -euo pipefail
+
+packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev)
+if [[ "${1:-}" == "demo" ]]; then
+  packages+=(libcgal-demo)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "focal: installing Debian packages: ${missing[*]}"
+sudo=""
+[[ $(id -u) -ne 0 ]] && sudo="sudo"
+export DEBIAN_FRONTEND=noninteractive
+# apt-get update once: only when the package lists are missing or older than a day.
+if [[ -z "$(find /var/lib/apt/lists -maxdepth 1 -name '*Packages*' -mtime -1 2>/dev/null | head -1)" ]]; then
+  $sudo apt-get update -qq
+fi
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

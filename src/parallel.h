@@ -1,0 +1,30 @@
+#pragma once
+// The one place where focal goes parallel. Every parallel loop gathers into per-element output
+// slots (no scatter, no atomics), so results are identical for any thread count.
+
+#include <omp.h>
+
+#include <cstdint>
+#include <cstdlib>
+
+namespace focal::detail {
+
+/// Threads to use: `requested` if > 0, else FOCAL_NUM_THREADS if set, else all hardware threads.
+inline int thread_count(int requested) {
+  if (requested > 0) return requested;
+  if (const char* env = std::getenv("FOCAL_NUM_THREADS")) {
+    const int n = std::atoi(env);
+    if (n > 0) return n;
+  }
+  return omp_get_max_threads();
+}
+
+/// Calls body(i) for i in [0, n) on `threads` threads (see thread_count) in static chunks.
+template <class Body>
+void parallel_for(std::int64_t n, int threads, Body&& body) {
+  const int t = thread_count(threads);
+#pragma omp parallel for schedule(static) num_threads(t) if (t > 1 && n > 1024)
+  for (std::int64_t i = 0; i < n; ++i) body(i);
+}
+
+}  // namespace focal::detail
