@@ -1,1 +1,238 @@
-// TODO: implementation in progress
+#include "focal/two_slit_fit.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace focal {
+namespace {
+
+double weight_at(std::span<const double> weights, std::size_t i) {
+  return weights.empty() ? 1.0 : weights[i];
+}
+
+/// Eigen-decomposition of the symmetric W = [a b; b c] into k1 >= k2, d1 (of k1) and d2 = d1
+/// rotated by +90 degrees.
+SlitFit decompose(double a, double b, double c) {
+  SlitFit fit;
+  const double mean = 0.5 * (a + c);
+  const double half_gap = std::hypot(0.5 * (a - c), b);
+  const double phi = 0.5 * std::atan2(2.0 * b, a - c);  // angle of d1; 0 when W is isotropic
+  fit.k1 = mean + half_gap;
+  fit.k2 = mean - half_gap;
+  fit.d1 = Eigen::Vector2d(std::cos(phi), std::sin(phi));
+  fit.d2 = Eigen::Vector2d(-fit.d1.y(), fit.d1.x());
+  fit.valid = true;
+  return fit;
+}
+
+/// sum_i w_i |W x_i - g_i|^2 for W = [a b; b c]: the paper's E, evaluated directly (no
+/// cancellation as in the expanded quadratic form).
+double energy_of_matrix(std::span<const NormalRay> rays, std::span<const double> weights, double a,
+                        double b, double c) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const NormalRay& r = rays[i];
+    const double ru = a * r.u + b * r.v - r.sigma;
+    const double rv = b * r.u + c * r.v - r.tau;
+    e += weight_at(weights, i) * (ru * ru + rv * rv);
+  }
+  return e;
+}
+
+/// Normal equations of min sum_i w_i |W x_i - g_i|^2 in w = (a, b, c): the rows of one ray are
+/// (u, v, 0) -> sigma and (0, u, v) -> tau.
+struct NormalEquations {
+  Eigen::Matrix3d lhs = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  int rays = 0;
+};
+
+NormalEquations accumulate(std::span<const NormalRay> rays, std::span<const double> weights) {
+  NormalEquations eq;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const double w = weight_at(weights, i);
+    if (!(w > 0.0)) continue;
+    const NormalRay& r = rays[i];
+    const double uu = w * r.u * r.u, uv = w * r.u * r.v, vv = w * r.v * r.v;
+    eq.lhs(0, 0) += uu;
+    eq.lhs(0, 1) += uv;
+    eq.lhs(1, 1) += uu + vv;
+    eq.lhs(1, 2) += uv;
+    eq.lhs(2, 2) += vv;
+    eq.rhs += w * Eigen::Vector3d(r.u * r.sigma, r.v * r.sigma + r.u * r.tau, r.v * r.tau);
+    ++eq.rays;
+  }
+  eq.lhs(1, 0) = eq.lhs(0, 1);
+  eq.lhs(2, 1) = eq.lhs(1, 2);
+  return eq;
+}
+
+/// Solves the 3x3 system when it is well conditioned: det relative to (trace/3)^3, which is
+/// invariant to the scale of the mesh, above 1e-12.
+bool solve_well_conditioned(const NormalEquations& eq, Eigen::Vector3d& w) {
+  if (eq.rays < 2) return false;
+  const double scale = eq.lhs.trace() / 3.0;
+  const double det = eq.lhs.determinant();
+  if (!(scale > 0.0) || !(det > 1e-12 * scale * scale * scale)) return false;
+  w = eq.lhs.inverse() * eq.rhs;  // closed-form cofactor inverse for fixed 3x3 in Eigen
+  return w.allFinite();
+}
+
+SlitFit invalid_fit() {
+  SlitFit fit;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  fit.valid = false;
+  fit.k1 = fit.k2 = fit.energy = nan;
+  fit.d1 = fit.d2 = Eigen::Vector2d::Constant(nan);
+  return fit;
+}
+
+// ---- The paper's Levenberg-Marquardt on (t, k1, k2). d1 = (-sin t, cos t), d2 = (cos t, sin t).
+
+struct Params {
+  double t = 0.0, k1 = 0.0, k2 = 0.0;
+};
+
+/// The closed-form k1, k2 for a fixed t: E separates into two one-dimensional least squares.
+bool curvatures_at_angle(std::span<const NormalRay> rays, std::span<const double> weights, double t,
+                         Params& p) {
+  const double s = std::sin(t), c = std::cos(t);
+  double aa = 0, ab = 0, cc = 0, ce = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const double w = weight_at(weights, i);
+    const NormalRay& r = rays[i];
+    const double a = r.u * s - r.v * c, b = r.sigma * s - r.tau * c;
+    const double cu = r.u * c + r.v * s, e = r.sigma * c + r.tau * s;
+    aa += w * a * a;
+    ab += w * a * b;
+    cc += w * cu * cu;
+    ce += w * cu * e;
+  }
+  if (!(aa > 0.0) || !(cc > 0.0)) return false;
+  p = {t, ab / aa, ce / cc};
+  return true;
+}
+
+double energy_of(std::span<const NormalRay> rays, std::span<const double> weights,
+                 const Params& p) {
+  return two_slit_energy(rays, weights, p.t, p.k1, p.k2);
+}
+
+/// One Levenberg-Marquardt system J^T J, J^T r for the residuals of eq. 14.
+void lm_system(std::span<const NormalRay> rays, std::span<const double> weights, const Params& p,
+               Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr) {
+  const double s = std::sin(p.t), c = std::cos(p.t);
+  jtj.setZero();
+  jtr.setZero();
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const double w = weight_at(weights, i);
+    const NormalRay& r = rays[i];
+    const double p1 = r.u * p.k1 - r.sigma, q1 = r.v * p.k1 - r.tau;
+    const double p2 = r.u * p.k2 - r.sigma, q2 = r.v * p.k2 - r.tau;
+    const double r1 = p1 * s - q1 * c, r2 = p2 * c + q2 * s;
+    const Eigen::Vector3d j1(p1 * c + q1 * s, r.u * s - r.v * c, 0.0);
+    const Eigen::Vector3d j2(-p2 * s + q2 * c, 0.0, r.u * c + r.v * s);
+    jtj += w * (j1 * j1.transpose() + j2 * j2.transpose());
+    jtr += w * (j1 * r1 + j2 * r2);
+  }
+}
+
+Params levenberg_marquardt(std::span<const NormalRay> rays, std::span<const double> weights,
+                           Params p, const LevenbergMarquardtOptions& options) {
+  double energy = energy_of(rays, weights, p);
+  double damping = 1e-3;
+  for (int it = 0; it < options.max_iterations && energy > 0.0; ++it) {
+    Eigen::Matrix3d jtj;
+    Eigen::Vector3d jtr;
+    lm_system(rays, weights, p, jtj, jtr);
+    bool improved = false;
+    while (damping < 1e12) {
+      Eigen::Matrix3d a = jtj;
+      a.diagonal() += damping * jtj.diagonal().cwiseMax(1e-300);
+      const Eigen::Vector3d step = a.ldlt().solve(-jtr);
+      const Params next{p.t + step[0], p.k1 + step[1], p.k2 + step[2]};
+      const double e = energy_of(rays, weights, next);
+      if (std::isfinite(e) && e < energy) {
+        const double decrease = (energy - e) / energy;
+        p = next;
+        energy = e;
+        damping = std::max(damping * 0.1, 1e-12);
+        improved = decrease > options.tolerance;
+        break;
+      }
+      damping *= 10.0;
+    }
+    if (!improved) break;
+  }
+  return p;
+}
+
+/// Converts the paper's (t, k1, k2) into a SlitFit with k1 >= k2: swapping the curvatures
+/// swaps the roles of the two directions.
+SlitFit to_fit(const Params& p, double energy) {
+  SlitFit fit;
+  fit.valid = true;
+  Eigen::Vector2d d1(-std::sin(p.t), std::cos(p.t));
+  double k1 = p.k1, k2 = p.k2;
+  if (k1 < k2) {
+    std::swap(k1, k2);
+    d1 = Eigen::Vector2d(std::cos(p.t), std::sin(p.t));
+  }
+  fit.k1 = k1;
+  fit.k2 = k2;
+  fit.d1 = d1;
+  fit.d2 = Eigen::Vector2d(-d1.y(), d1.x());
+  fit.energy = energy;
+  return fit;
+}
+
+}  // namespace
+
+double two_slit_energy(std::span<const NormalRay> rays, std::span<const double> weights, double t,
+                       double k1, double k2) {
+  const double s = std::sin(t), c = std::cos(t);
+  double e = 0.0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const NormalRay& r = rays[i];
+    const double e1 = (r.u * k1 - r.sigma) * s - (r.v * k1 - r.tau) * c;
+    const double e2 = (r.u * k2 - r.sigma) * c + (r.v * k2 - r.tau) * s;
+    e += weight_at(weights, i) * (e1 * e1 + e2 * e2);
+  }
+  return e;
+}
+
+SlitFit fit_two_slits_closed_form(std::span<const NormalRay> rays,
+                                  std::span<const double> weights) {
+  Eigen::Vector3d w;
+  if (!solve_well_conditioned(accumulate(rays, weights), w)) return invalid_fit();
+  SlitFit fit = decompose(w[0], w[1], w[2]);
+  fit.energy = energy_of_matrix(rays, weights, w[0], w[1], w[2]);
+  return fit;
+}
+
+SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
+                                          std::span<const double> weights,
+                                          const LevenbergMarquardtOptions& options) {
+  // Same well-posedness test as the closed form, so both solvers flag the same vertices.
+  Eigen::Vector3d unused;
+  if (!solve_well_conditioned(accumulate(rays, weights), unused)) return invalid_fit();
+  Params best;
+  double best_energy = std::numeric_limits<double>::infinity();
+  const int starts = std::max(options.initial_angles, 1);
+  for (int k = 0; k < starts; ++k) {
+    Params p;
+    if (!curvatures_at_angle(rays, weights, std::numbers::pi * k / starts, p)) continue;
+    const double e = energy_of(rays, weights, p);
+    if (e < best_energy) {
+      best_energy = e;
+      best = p;
+    }
+  }
+  if (!std::isfinite(best_energy)) return invalid_fit();
+  best = levenberg_marquardt(rays, weights, best, options);
+  return to_fit(best, energy_of(rays, weights, best));
+}
+
+}  // namespace focal

@@ -20,9 +20,13 @@ struct TangentFrame {
   Eigen::Vector3d n;
 
   /// Tangent-plane coordinates of a 3D direction (its x and y components).
-  [[nodiscard]] Eigen::Vector2d to_plane(const Eigen::Vector3d& w) const { return {x.dot(w), y.dot(w)}; }
+  [[nodiscard]] Eigen::Vector2d to_plane(const Eigen::Vector3d& w) const {
+    return {x.dot(w), y.dot(w)};
+  }
   /// The 3D direction of tangent-plane coordinates.
-  [[nodiscard]] Eigen::Vector3d from_plane(const Eigen::Vector2d& p) const { return p.x() * x + p.y() * y; }
+  [[nodiscard]] Eigen::Vector3d from_plane(const Eigen::Vector2d& p) const {
+    return p.x() * x + p.y() * y;
+  }
 };
 
 /// A frame whose n is the given unit normal; x and y are chosen deterministically and smoothly

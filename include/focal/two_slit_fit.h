@@ -30,8 +30,9 @@ struct SlitFit {
 };
 
 /// The paper's objective E(t, k1, k2) for rays with weights (empty weights: all 1).
-[[nodiscard]] double two_slit_energy(std::span<const NormalRay> rays, std::span<const double> weights,
-                                     double t, double k1, double k2);
+[[nodiscard]] double two_slit_energy(std::span<const NormalRay> rays,
+                                     std::span<const double> weights, double t, double k1,
+                                     double k2);
 
 /// Global minimum of E by the closed form. Rays with zero weight are ignored; valid only when
 /// the normal equations are well conditioned (relative pivot above 1e-12).
@@ -40,15 +41,15 @@ struct SlitFit {
 
 /// Options of the paper's Levenberg-Marquardt solver.
 struct LevenbergMarquardtOptions {
-  int initial_angles = 8;       ///< sampled starting angles t in [0, pi)
-  int max_iterations = 50;      ///< per start
-  double tolerance = 1e-14;     ///< relative decrease of E that stops the iteration
+  int initial_angles = 8;    ///< sampled starting angles t in [0, pi)
+  int max_iterations = 50;   ///< per start
+  double tolerance = 1e-14;  ///< relative decrease of E that stops the iteration
 };
 
 /// The paper's method as written: for each sampled t the closed-form k1, k2 at that fixed t
 /// (E is quadratic in them), the best start refined by Levenberg-Marquardt on (t, k1, k2).
-[[nodiscard]] SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
-                                                        std::span<const double> weights = {},
-                                                        const LevenbergMarquardtOptions& options = {});
+[[nodiscard]] SlitFit fit_two_slits_levenberg_marquardt(
+    std::span<const NormalRay> rays, std::span<const double> weights = {},
+    const LevenbergMarquardtOptions& options = {});
 
 }  // namespace focal
