@@ -1,1 +1,60 @@
-int main() { return 0; }
+// The `focal` command: curvature and focal meshes of triangle meshes.
+// Exit codes: 0 success, 1 usage error, 2 input/output or data error, 3 internal error.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "commands.h"
+#include "focal/error.h"
+#include "log.h"
+
+namespace {
+
+constexpr int kUsageError = 1;
+constexpr int kInputError = 2;
+constexpr int kInternalError = 3;
+
+int run(int argc, char** argv) {
+  focal::cli::Log log;
+  CLI::App app{"focal: principal curvatures, directions and focal meshes of triangle meshes\n"
+               "(Yu et al., Focal Surfaces of Discrete Geometry, SGP 2007)"};
+  app.set_version_flag("--version", "focal 0.1.0");
+  app.add_flag_callback("-v,--verbose", [&log] { log.set_verbose(true); },
+                        "stage timings and a summary on stderr");
+  app.require_subcommand(1);
+  app.fallthrough();
+  focal::cli::add_info_command(app, log);
+  focal::cli::add_generate_command(app, log);
+  focal::cli::add_curvature_command(app, log);
+  focal::cli::add_focal_mesh_command(app, log);
+  app.footer("Run 'focal COMMAND -h' for the options and examples of a command.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh ... (see focal -h)\n",
+                 e.what());
+    return kUsageError;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const focal::Error& e) {
+    std::fprintf(stderr, "Error: %s\n", e.what());
+    return kInputError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "Error: internal: %s\n", e.what());
+    return kInternalError;
+  }
+}

@@ -1,1 +1,202 @@
-// TODO: implementation in progress
+#include "focal/triangle_curvature.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "curvature_detail.h"
+#include "focal/error.h"
+#include "focal/normal_rays.h"
+#include "parallel.h"
+
+namespace focal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TriangleCurvatureResult undefined_faces(Eigen::Index m) {
+  TriangleCurvatureResult r;
+  for (Eigen::VectorXd* v : {&r.A, &r.B, &r.C, &r.K, &r.H, &r.k1, &r.k2, &r.lambda1, &r.lambda2}) {
+    *v = Eigen::VectorXd::Constant(m, kNaN);
+  }
+  for (RowMatrixX3d* d : {&r.d1, &r.d2, &r.slit1, &r.slit2, &r.face_normal}) {
+    *d = RowMatrixX3d::Constant(m, 3, kNaN);
+  }
+  r.shape_operator.setConstant(m, 4, kNaN);
+  r.point_class = VectorXu8::Constant(m, static_cast<std::uint8_t>(PointClass::undefined));
+  return r;
+}
+
+/// The three vertex rays of a face in the frame of its mean normal, origin at its centroid.
+struct FaceRays {
+  TangentFrame frame;
+  NormalRay r[3];
+};
+
+bool face_rays(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+               const Eigen::Vector3i& f, FaceRays& out) {
+  if (!ok[f[0]] || !ok[f[1]] || !ok[f[2]]) return false;
+  const Eigen::Vector3d sum = N.row(f[0]) + N.row(f[1]) + N.row(f[2]);
+  const double len = sum.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) return false;
+  out.frame = tangent_frame(sum / len);
+  const Eigen::Vector3d centroid = (V.row(f[0]) + V.row(f[1]) + V.row(f[2])).transpose() / 3.0;
+  for (int c = 0; c < 3; ++c) {
+    const auto ray = normal_ray(out.frame, centroid, V.row(f[c]).transpose(), N.row(f[c]).transpose());
+    if (!ray) return false;
+    out.r[c] = *ray;
+  }
+  return true;
+}
+
+/// Unit slit direction at focal depth lambda from eq. 18, using whichever edge gives the longer
+/// vector (Appendix B: the edge along which the two intersection points do not coincide).
+/// Empty (zero) when both vanish, as at umbilics where all three rays meet in one point.
+Eigen::Vector2d slit_direction(const Eigen::Matrix2d& X, const Eigen::Matrix2d& G, double lambda) {
+  Eigen::Vector2d a = X.col(0) + lambda * G.col(0), b = X.col(1) + lambda * G.col(1);
+  if (std::isinf(lambda)) a = G.col(0), b = G.col(1);  // limit of the direction as lambda -> inf
+  const Eigen::Vector2d& longer = a.squaredNorm() >= b.squaredNorm() ? a : b;
+  const double scale = X.norm() + (std::isinf(lambda) ? G.norm() : std::abs(lambda) * G.norm());
+  return longer.norm() > 1e-9 * scale ? Eigen::Vector2d(longer.normalized()) : Eigen::Vector2d::Zero();
+}
+
+void solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerances& tol,
+                TriangleCurvatureResult& r) {
+  Eigen::Matrix2d X, G;  // columns: differences along the edges 0->1 and 0->2
+  X << fr.r[1].u - fr.r[0].u, fr.r[2].u - fr.r[0].u, fr.r[1].v - fr.r[0].v, fr.r[2].v - fr.r[0].v;
+  G << fr.r[1].sigma - fr.r[0].sigma, fr.r[2].sigma - fr.r[0].sigma, fr.r[1].tau - fr.r[0].tau,
+      fr.r[2].tau - fr.r[0].tau;
+  const double A = G.determinant();
+  const double B = G(0, 0) * X(1, 1) - G(0, 1) * X(1, 0) - G(1, 0) * X(0, 1) + G(1, 1) * X(0, 0);
+  const double C = X.determinant();
+  if (!(std::abs(C) > 1e-14 * X.squaredNorm())) return;  // no area in the ray frame
+  const double K = A / C, H = B / (2.0 * C);
+  // H^2 < K only through rounding or a non-symmetric M (noise): treat as the double root H.
+  const double root = std::sqrt(std::max(H * H - K, 0.0));
+  const double k1 = H + root, k2 = H - root;
+  const Eigen::Matrix2d M = G * X.inverse();
+  const detail::Principal2 p =
+      detail::principal_from_symmetric(M(0, 0), 0.5 * (M(0, 1) + M(1, 0)), M(1, 1));
+  r.A[i] = A, r.B[i] = B, r.C[i] = C, r.K[i] = K, r.H[i] = H, r.k1[i] = k1, r.k2[i] = k2;
+  r.lambda1[i] = -1.0 / k1;
+  r.lambda2[i] = -1.0 / k2;
+  r.d1.row(i) = fr.frame.from_plane(p.d1);
+  r.d2.row(i) = fr.frame.from_plane(p.d2);
+  // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
+  const Eigen::Vector2d s1 = slit_direction(X, G, r.lambda1[i]), s2 = slit_direction(X, G, r.lambda2[i]);
+  r.slit1.row(i) = fr.frame.from_plane(s1.squaredNorm() > 0 ? s1 : p.d2);
+  r.slit2.row(i) = fr.frame.from_plane(s2.squaredNorm() > 0 ? s2 : p.d1);
+  r.face_normal.row(i) = fr.frame.n;
+  r.shape_operator.row(i) << M(0, 0), M(0, 1), M(1, 0), M(1, 1);
+  r.point_class[i] = static_cast<std::uint8_t>(classify(k1, k2, tol.zero, tol.umbilic));
+}
+
+/// Faces incident to each vertex, CSR, in increasing face order (deterministic sums).
+struct Incidence {
+  std::vector<int> offsets, faces;
+};
+
+Incidence vertex_faces(Eigen::Index n, FacesRef F) {
+  Incidence inc;
+  inc.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) ++inc.offsets[F(f, c) + 1];
+  }
+  for (Eigen::Index i = 0; i < n; ++i) inc.offsets[i + 1] += inc.offsets[i];
+  inc.faces.resize(static_cast<std::size_t>(inc.offsets.back()));
+  std::vector<int> fill(inc.offsets.begin(), inc.offsets.end() - 1);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) inc.faces[fill[F(f, c)]++] = static_cast<int>(f);
+  }
+  return inc;
+}
+
+/// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
+/// both normals lie in each other's hemisphere here).
+Eigen::Vector3d rotate_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& w) {
+  const Eigen::Vector3d axis = a.cross(b);
+  const double c = a.dot(b);
+  return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+}
+
+/// The face's symmetrised shape operator in a vertex's tangent frame: the face frame is rotated
+/// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
+/// stays kI exactly, as on a sphere).
+Eigen::Matrix2d operator_in_frame(const TriangleCurvatureResult& t, int f, const TangentFrame& to) {
+  const TangentFrame from = tangent_frame(t.face_normal.row(f).transpose());
+  const auto& m = t.shape_operator.row(f);
+  Eigen::Matrix2d sym;
+  sym << m[0], 0.5 * (m[1] + m[2]), 0.5 * (m[1] + m[2]), m[3];
+  const Eigen::Vector3d x = rotate_between(from.n, to.n, from.x);
+  const Eigen::Vector3d y = rotate_between(from.n, to.n, from.y);
+  Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
+  q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
+  return q * sym * q.transpose();
+}
+
+double face_area(PositionsRef V, FacesRef F, int f) {
+  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+}  // namespace
+
+TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options) {
+  if (N.rows() != V.rows()) {
+    throw InvalidInput("triangle curvature: " + std::to_string(N.rows()) + " normals for " +
+                       std::to_string(V.rows()) + " vertices");
+  }
+  validate_mesh_arrays(V, F, N, "triangle curvature");
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(N, ok);
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
+  TriangleCurvatureResult r = undefined_faces(F.rows());
+  detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
+    FaceRays fr;
+    if (face_rays(V, unit, ok, F.row(f).transpose(), fr)) solve_face(fr, f, tol, r);
+  });
+  return r;
+}
+
+CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
+                                                const CurvatureOptions& options) {
+  const TriangleCurvatureResult faces = triangle_curvature(V, F, N, options);
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(N, ok);
+  const Incidence inc = vertex_faces(V.rows(), F);
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
+  CurvatureResult r = detail::undefined_result(V.rows());
+  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+    if (!ok[i]) return;
+    const TangentFrame frame = tangent_frame(unit.row(i).transpose());
+    thread_local std::vector<std::pair<double, Eigen::Matrix2d>> parts;
+    parts.clear();
+    Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
+    double area = 0.0;
+    for (int k = inc.offsets[i]; k < inc.offsets[i + 1]; ++k) {
+      const int f = inc.faces[k];
+      if (faces.point_class[f] == static_cast<std::uint8_t>(PointClass::undefined) ||
+          !(faces.face_normal.row(f).dot(frame.n) > 0.0)) {
+        ++r.rays_excluded[i];
+        continue;
+      }
+      parts.emplace_back(face_area(V, F, f), operator_in_frame(faces, f, frame));
+      mean += parts.back().first * parts.back().second;
+      area += parts.back().first;
+    }
+    r.rays_used[i] = static_cast<int>(parts.size());
+    if (!(area > 0.0)) return;
+    mean /= area;
+    double spread = 0.0;
+    for (const auto& [a, m] : parts) spread += a * (m - mean).squaredNorm();
+    const auto p = detail::principal_from_symmetric(mean(0, 0), 0.5 * (mean(0, 1) + mean(1, 0)), mean(1, 1));
+    detail::store_vertex(r, i, frame, p, std::sqrt(spread / area), tol);
+  });
+  return r;
+}
+
+}  // namespace focal

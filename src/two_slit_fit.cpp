@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include "curvature_detail.h"
+
 namespace focal {
 namespace {
 
@@ -12,18 +14,14 @@ double weight_at(std::span<const double> weights, std::size_t i) {
   return weights.empty() ? 1.0 : weights[i];
 }
 
-/// Eigen-decomposition of the symmetric W = [a b; b c] into k1 >= k2, d1 (of k1) and d2 = d1
-/// rotated by +90 degrees.
 SlitFit decompose(double a, double b, double c) {
+  const detail::Principal2 p = detail::principal_from_symmetric(a, b, c);
   SlitFit fit;
-  const double mean = 0.5 * (a + c);
-  const double half_gap = std::hypot(0.5 * (a - c), b);
-  const double phi = 0.5 * std::atan2(2.0 * b, a - c);  // angle of d1; 0 when W is isotropic
-  fit.k1 = mean + half_gap;
-  fit.k2 = mean - half_gap;
-  fit.d1 = Eigen::Vector2d(std::cos(phi), std::sin(phi));
-  fit.d2 = Eigen::Vector2d(-fit.d1.y(), fit.d1.x());
   fit.valid = true;
+  fit.k1 = p.k1;
+  fit.k2 = p.k2;
+  fit.d1 = p.d1;
+  fit.d2 = p.d2;
   return fit;
 }
 

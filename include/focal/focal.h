@@ -4,6 +4,7 @@
 
 #include "focal/curvature.h"
 #include "focal/error.h"
+#include "focal/fields_io.h"
 #include "focal/focal_mesh.h"
 #include "focal/mesh.h"
 #include "focal/mesh_io.h"

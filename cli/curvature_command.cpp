@@ -1,0 +1,114 @@
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.h"
+#include "estimator_flags.h"
+#include "focal/error.h"
+#include "focal/fields_io.h"
+#include "focal/focal_mesh.h"
+#include "focal/mesh_io.h"
+
+namespace focal::cli {
+namespace {
+
+struct CurvatureFlags {
+  std::string input;
+  std::string output;
+  bool ascii = false;
+  EstimatorFlags estimator;
+};
+
+struct FocalMeshFlags {
+  std::string input;
+  std::string prefix;
+  bool ascii = false;
+  EstimatorFlags estimator;
+  FocalMeshOptions focal;
+};
+
+Mesh read_input(const std::string& path, const Log& log) {
+  Stage stage(log, "read");
+  Mesh mesh = read_mesh(path);
+  log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
+           " triangles");
+  return mesh;
+}
+
+/// Rejects an output name the command cannot write before any work is done.
+void check_output_extension(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".csv" && ext != ".ply") {
+    throw CLI::ValidationError("-o", "output must end in .csv or .ply, got '" + path + "'");
+  }
+}
+
+void run_curvature(CurvatureFlags& f, const Log& log) {
+  Mesh mesh = read_input(f.input, log);
+  const RowMatrixX3d normals = prepare_normals(mesh, f.estimator.normals, log);
+  const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
+  Stage stage(log, "write");
+  if (std::filesystem::path(f.output).extension() == ".csv") {
+    write_curvature_csv(f.output, fields);
+  } else {
+    mesh.N = normals;
+    write_curvature_ply(f.output, mesh, fields, {.binary = !f.ascii, .comments = {}});
+  }
+}
+
+void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
+  Mesh mesh = read_input(f.input, log);
+  const RowMatrixX3d normals = prepare_normals(mesh, f.estimator.normals, log);
+  const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
+  FocalMeshes meshes;
+  {
+    Stage stage(log, "focal meshes");
+    meshes = focal_meshes(mesh.V, mesh.F, normals, fields, f.focal);
+  }
+  Stage stage(log, "write");
+  const PlyWriteOptions o{.binary = !f.ascii, .comments = {}};
+  write_focal_mesh_ply(f.prefix + ".focal1.ply", meshes.gamma1, o);
+  write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);
+  std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),
+              static_cast<long long>(meshes.gamma1.mesh.F.rows()), f.prefix.c_str(),
+              static_cast<long long>(meshes.gamma2.mesh.F.rows()));
+}
+
+}  // namespace
+
+void add_curvature_command(CLI::App& app, const Log& log) {
+  auto* cmd = app.add_subcommand("curvature", "Principal curvatures and directions per vertex");
+  auto f = std::make_shared<CurvatureFlags>();
+  cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("-o,--output", f->output,
+                  "OUT.csv (one row per input vertex) or OUT.ply (the mesh with per-vertex "
+                  "properties k1,k2,H,K,d1x..d2z,residual,class)")
+      ->required();
+  cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
+  f->estimator.add_to(*cmd);
+  cmd->footer(
+      "Columns: k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class (k1 >= k2; outward normals;\n"
+      "a sphere of radius r has k1 = k2 = +1/r). Examples:\n"
+      "  focal curvature bunny.off -o bunny.csv\n"
+      "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v");
+  cmd->parse_complete_callback([f] { check_output_extension(f->output); });
+  cmd->callback([f, &log] { run_curvature(*f, log); });
+}
+
+void add_focal_mesh_command(CLI::App& app, const Log& log) {
+  auto* cmd = app.add_subcommand("focal-mesh", "The two focal meshes Gamma_1, Gamma_2 (paper eq. 2)");
+  auto f = std::make_shared<FocalMeshFlags>();
+  cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("-o,--output", f->prefix, "writes PREFIX.focal1.ply and PREFIX.focal2.ply")->required();
+  cmd->add_option("--max-distance", f->focal.max_distance,
+                  "clamp focal points farther than this (0 = 10 x bounding-box diagonal)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--drop-infinite", f->focal.drop_faces_at_infinity,
+                "leave out faces touching a focal point at infinity or undefined");
+  cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
+  f->estimator.add_to(*cmd);
+  cmd->footer("Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");
+  cmd->callback([f, &log] { run_focal_mesh(*f, log); });
+}
+
+}  // namespace focal::cli

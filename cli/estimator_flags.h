@@ -1,0 +1,31 @@
+#pragma once
+// Options shared by `focal curvature` and `focal focal-mesh`: how normals are obtained and how
+// the estimator runs.
+
+#include <CLI/CLI.hpp>
+
+#include "focal/curvature.h"
+#include "focal/mesh.h"
+#include "log.h"
+
+namespace focal::cli {
+
+enum class NormalsSource { automatic, file, area, angle, max };
+
+struct EstimatorFlags {
+  CurvatureOptions options;
+  NormalsSource normals = NormalsSource::automatic;
+
+  void add_to(CLI::App& command);
+};
+
+/// The unit normals the estimator uses: the file's, or estimated from the faces (with inward
+/// closed components re-oriented). Warns about what it fixed or suspects.
+/// \throw InvalidInput when `--normals file` is asked for and the file has none.
+[[nodiscard]] RowMatrixX3d prepare_normals(Mesh& mesh, NormalsSource source, const Log& log);
+
+/// Runs the estimator with stage timings and, with -v, a summary of the result.
+[[nodiscard]] CurvatureResult run_estimator(const Mesh& mesh, const RowMatrixX3d& normals,
+                                            const EstimatorFlags& flags, const Log& log);
+
+}  // namespace focal::cli

@@ -1,0 +1,48 @@
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "focal/mesh_io.h"
+#include "focal/neighbourhood.h"
+#include "focal/normals.h"
+
+namespace focal::cli {
+namespace {
+
+void print_info(const std::string& path, const Log& log) {
+  Mesh mesh;
+  {
+    Stage stage(log, "read");
+    mesh = read_mesh(path);
+  }
+  const MeshStatistics s = mesh_statistics(mesh.V, mesh.F);
+  const OrientationReport orientation = orientation_report(mesh.V, mesh.F);
+  std::printf("file:                 %s\n", path.c_str());
+  std::printf("vertices:             %d\n", s.vertex_count);
+  std::printf("triangles:            %d (from %d input faces)\n", s.face_count,
+              mesh.face_source.size() > 0 ? mesh.face_source.maxCoeff() + 1 : 0);
+  std::printf("edges:                %d (boundary %d, non-manifold %d)\n", s.edge_count,
+              s.boundary_edge_count, s.non_manifold_edge_count);
+  std::printf("non-manifold vertices: %d\n", s.non_manifold_vertex_count);
+  std::printf("unreferenced vertices: %d\n", s.unreferenced_vertex_count);
+  std::printf("degenerate triangles: %d, duplicate triangles: %d\n", s.degenerate_face_count,
+              s.duplicate_face_count);
+  std::printf("components:           %d (%d inward)\n", s.component_count, orientation.inward_count());
+  std::printf("bounds:               [%g, %g, %g] - [%g, %g, %g]\n", s.min_corner.x(),
+              s.min_corner.y(), s.min_corner.z(), s.max_corner.x(), s.max_corner.y(),
+              s.max_corner.z());
+  std::printf("mean edge length:     %g\n", s.mean_edge_length);
+  std::printf("vertex normals:       %s\n", mesh.has_normals() ? "present" : "none");
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, const Log& log) {
+  auto* cmd = app.add_subcommand("info", "Counts, bounds and connectivity statistics of a mesh");
+  auto path = std::make_shared<std::string>();
+  cmd->add_option("input", *path, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->footer("Example:\n  focal info bunny.off");
+  cmd->callback([path, &log] { print_info(*path, log); });
+}
+
+}  // namespace focal::cli

@@ -1,0 +1,72 @@
+#include "focal/fields_io.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace focal {
+namespace {
+
+std::string class_codes_comment() {
+  std::string s = "class codes:";
+  for (int c = 0; c <= static_cast<int>(PointClass::undefined); ++c) {
+    s += " " + std::to_string(c) + "=" + std::string(class_name(static_cast<PointClass>(c)));
+  }
+  return s;
+}
+
+/// The numeric fields in file order (all but class).
+std::vector<std::pair<std::string, Eigen::VectorXd>> numeric_fields(const CurvatureResult& r) {
+  const auto& names = curvature_field_names();
+  std::vector<std::pair<std::string, Eigen::VectorXd>> out;
+  out.emplace_back(names[0], r.k1);
+  out.emplace_back(names[1], r.k2);
+  out.emplace_back(names[2], r.H);
+  out.emplace_back(names[3], r.K);
+  for (int c = 0; c < 3; ++c) out.emplace_back(names[4 + c], r.d1.col(c));
+  for (int c = 0; c < 3; ++c) out.emplace_back(names[7 + c], r.d2.col(c));
+  out.emplace_back(names[10], r.residual);
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& curvature_field_names() {
+  static const std::vector<std::string> names = {"k1",  "k2",  "H",   "K",   "d1x",      "d1y",
+                                                 "d1z", "d2x", "d2y", "d2z", "residual", "class"};
+  return names;
+}
+
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields) {
+  std::vector<CsvColumn> columns;
+  for (auto& [name, values] : numeric_fields(fields)) columns.push_back({name, std::move(values)});
+  std::vector<std::string> words(static_cast<std::size_t>(fields.point_class.size()));
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    words[i] = std::string(class_name(fields.class_of(static_cast<int>(i))));
+  }
+  columns.push_back({"class", std::move(words)});
+  write_csv(path, columns);
+}
+
+void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
+                         const CurvatureResult& fields, const PlyWriteOptions& options) {
+  std::vector<VertexProperty> properties;
+  for (auto& [name, values] : numeric_fields(fields)) {
+    properties.push_back({name, std::move(values), PropertyType::float32});
+  }
+  properties.push_back({"class", fields.point_class.cast<double>(), PropertyType::uint8});
+  PlyWriteOptions o = options;
+  o.comments.push_back("focal curvature fields; " + class_codes_comment());
+  write_ply(path, mesh, properties, o);
+}
+
+void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,
+                          const PlyWriteOptions& options) {
+  const std::array<VertexProperty, 1> flag = {
+      VertexProperty{"focal_flag", focal.flag.cast<double>(), PropertyType::uint8}};
+  PlyWriteOptions o = options;
+  o.comments.push_back("focal mesh; focal_flag codes: 0=finite 1=infinite(clamped) 2=undefined");
+  write_ply(path, focal.mesh, flag, o);
+}
+
+}  // namespace focal
