@@ -19,10 +19,12 @@ CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, Norm
 namespace {
 
 void validate_options(const CurvatureOptions& o) {
-  if (o.rings < 1) throw InvalidInput("curvature: rings must be >= 1, got " + std::to_string(o.rings));
+  if (o.rings < 1)
+    throw InvalidInput("curvature: rings must be >= 1, got " + std::to_string(o.rings));
   if (!(o.gaussian_width >= 0.0)) throw InvalidInput("curvature: gaussian_width must be >= 0");
   if (!(o.zero_tolerance >= 0.0)) throw InvalidInput("curvature: zero_tolerance must be >= 0");
-  if (!(o.umbilic_tolerance >= 0.0)) throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
+  if (!(o.umbilic_tolerance >= 0.0))
+    throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
   if (o.threads < 0) throw InvalidInput("curvature: threads must be >= 0");
 }
 
@@ -52,9 +54,11 @@ void fit_vertex(const FitContext& c, Eigen::Index i, CurvatureResult& r) {
   const Eigen::Vector3d p = c.V.row(i).transpose();
   const TangentFrame frame = tangent_frame(c.N.row(i).transpose());
   int excluded = 0;
-  for (const int* j = c.rings.begin(static_cast<int>(i)); j != c.rings.end(static_cast<int>(i)); ++j) {
+  for (const int* j = c.rings.begin(static_cast<int>(i)); j != c.rings.end(static_cast<int>(i));
+       ++j) {
     const Eigen::Vector3d q = c.V.row(*j).transpose();
-    const auto ray = c.normal_ok[*j] ? normal_ray(frame, p, q, c.N.row(*j).transpose()) : std::nullopt;
+    const auto ray =
+        c.normal_ok[*j] ? normal_ray(frame, p, q, c.N.row(*j).transpose()) : std::nullopt;
     if (!ray) {
       ++excluded;
       continue;
@@ -85,7 +89,12 @@ CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRe
   const Neighbourhoods rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
   const double h = mean_edge_length(V, F);
   const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
-  const FitContext context{V,     unit,   normal_ok, rings, options, 0.5 / (width * width),
+  const FitContext context{V,
+                           unit,
+                           normal_ok,
+                           rings,
+                           options,
+                           0.5 / (width * width),
                            detail::class_tolerances(options, h)};
   CurvatureResult result = detail::undefined_result(V.rows());
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
@@ -98,12 +107,18 @@ CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRe
 
 std::string_view class_name(PointClass c) {
   switch (c) {
-    case PointClass::elliptic: return "elliptic";
-    case PointClass::hyperbolic: return "hyperbolic";
-    case PointClass::parabolic: return "parabolic";
-    case PointClass::umbilic: return "umbilic";
-    case PointClass::flat: return "flat";
-    case PointClass::undefined: return "undefined";
+    case PointClass::elliptic:
+      return "elliptic";
+    case PointClass::hyperbolic:
+      return "hyperbolic";
+    case PointClass::parabolic:
+      return "parabolic";
+    case PointClass::umbilic:
+      return "umbilic";
+    case PointClass::flat:
+      return "flat";
+    case PointClass::undefined:
+      return "undefined";
   }
   return "undefined";
 }
@@ -113,7 +128,8 @@ PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_
   const bool zero1 = std::abs(k1) <= zero_tolerance, zero2 = std::abs(k2) <= zero_tolerance;
   if (zero1 && zero2) return PointClass::flat;
   if (zero1 || zero2) return PointClass::parabolic;
-  if (k1 - k2 <= umbilic_tolerance * std::max(std::abs(k1), std::abs(k2))) return PointClass::umbilic;
+  if (k1 - k2 <= umbilic_tolerance * std::max(std::abs(k1), std::abs(k2)))
+    return PointClass::umbilic;
   return k1 * k2 > 0.0 ? PointClass::elliptic : PointClass::hyperbolic;
 }
 
@@ -122,7 +138,8 @@ CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
   validate_options(options);
   if (N.rows() != V.rows()) {
     throw InvalidInput("curvature: " + std::to_string(N.rows()) + " normals for " +
-                       std::to_string(V.rows()) + " vertices (normals are required; estimate "
+                       std::to_string(V.rows()) +
+                       " vertices (normals are required; estimate "
                        "them with vertex_normals)");
   }
   validate_mesh_arrays(V, F, N, "curvature");

@@ -10,7 +10,10 @@ namespace {
 std::string class_codes_comment() {
   std::string s = "class codes:";
   for (int c = 0; c <= static_cast<int>(PointClass::undefined); ++c) {
-    s.append(" ").append(std::to_string(c)).append("=").append(class_name(static_cast<PointClass>(c)));
+    s.append(" ")
+        .append(std::to_string(c))
+        .append("=")
+        .append(class_name(static_cast<PointClass>(c)));
   }
   return s;
 }

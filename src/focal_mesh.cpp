@@ -42,7 +42,8 @@ void keep_faces(FacesRef F, bool drop_at_infinity, FocalMesh& m) {
     const bool finite = m.flag[F(f, 0)] == 0 && m.flag[F(f, 1)] == 0 && m.flag[F(f, 2)] == 0;
     if (finite || !drop_at_infinity) kept.push_back(static_cast<int>(f));
   }
-  m.kept_faces = Eigen::Map<const Eigen::VectorXi>(kept.data(), static_cast<Eigen::Index>(kept.size()));
+  m.kept_faces =
+      Eigen::Map<const Eigen::VectorXi>(kept.data(), static_cast<Eigen::Index>(kept.size()));
   m.mesh.F.resize(m.kept_faces.size(), 3);
   for (Eigen::Index t = 0; t < m.kept_faces.size(); ++t) m.mesh.F.row(t) = F.row(m.kept_faces[t]);
   m.mesh.face_source = m.kept_faces;

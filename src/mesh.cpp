@@ -12,9 +12,9 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
     for (int c = 0; c < 3; ++c) {
       const auto idx = F(f, c);
       if (idx < 0 || idx >= n) {
-        throw InvalidInput(std::string(what) + ": face " + std::to_string(f) + " refers to vertex " +
-                           std::to_string(idx) + ", but there are " + std::to_string(n) +
-                           " vertices");
+        throw InvalidInput(std::string(what) + ": face " + std::to_string(f) +
+                           " refers to vertex " + std::to_string(idx) + ", but there are " +
+                           std::to_string(n) + " vertices");
       }
     }
   }

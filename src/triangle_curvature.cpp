@@ -33,6 +33,7 @@ TriangleCurvatureResult undefined_faces(Eigen::Index m) {
 struct FaceRays {
   TangentFrame frame;
   NormalRay r[3];
+  Eigen::Vector2d offset[3];  ///< tangential position of each vertex relative to the centroid
 };
 
 bool face_rays(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
@@ -44,9 +45,11 @@ bool face_rays(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& o
   out.frame = tangent_frame(sum / len);
   const Eigen::Vector3d centroid = (V.row(f[0]) + V.row(f[1]) + V.row(f[2])).transpose() / 3.0;
   for (int c = 0; c < 3; ++c) {
-    const auto ray = normal_ray(out.frame, centroid, V.row(f[c]).transpose(), N.row(f[c]).transpose());
+    const auto ray =
+        normal_ray(out.frame, centroid, V.row(f[c]).transpose(), N.row(f[c]).transpose());
     if (!ray) return false;
     out.r[c] = *ray;
+    out.offset[c] = out.frame.to_plane(V.row(f[c]).transpose() - centroid);
   }
   return true;
 }
@@ -59,7 +62,8 @@ Eigen::Vector2d slit_direction(const Eigen::Matrix2d& X, const Eigen::Matrix2d& 
   if (std::isinf(lambda)) a = G.col(0), b = G.col(1);  // limit of the direction as lambda -> inf
   const Eigen::Vector2d& longer = a.squaredNorm() >= b.squaredNorm() ? a : b;
   const double scale = X.norm() + (std::isinf(lambda) ? G.norm() : std::abs(lambda) * G.norm());
-  return longer.norm() > 1e-9 * scale ? Eigen::Vector2d(longer.normalized()) : Eigen::Vector2d::Zero();
+  return longer.norm() > 1e-9 * scale ? Eigen::Vector2d(longer.normalized())
+                                      : Eigen::Vector2d::Zero();
 }
 
 void solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerances& tol,
@@ -68,10 +72,20 @@ void solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerance
   X << fr.r[1].u - fr.r[0].u, fr.r[2].u - fr.r[0].u, fr.r[1].v - fr.r[0].v, fr.r[2].v - fr.r[0].v;
   G << fr.r[1].sigma - fr.r[0].sigma, fr.r[2].sigma - fr.r[0].sigma, fr.r[1].tau - fr.r[0].tau,
       fr.r[2].tau - fr.r[0].tau;
+  if (!(std::abs(X.determinant()) > 1e-14 * X.squaredNorm())) return;  // no area in the ray frame
+  // The centroid lies below the surface by the sagitta s = (1/6) sum x_i^T M x_i (second order,
+  // x_i the vertices' tangential offsets). Depths measured from the centroid's plane would
+  // carry that O(h^2) bias into K and H, so the rays are re-parametrised on the plane z = s,
+  // the tangent plane at the surface point above the centroid: (u, v) += s (sigma, tau).
+  const Eigen::Matrix2d M0 = G * X.inverse();
+  const Eigen::Matrix2d S0 = 0.5 * (M0 + M0.transpose());
+  double sagitta = 0.0;
+  for (const Eigen::Vector2d& x : fr.offset) sagitta += x.dot(S0 * x) / 6.0;
+  X += sagitta * G;
   const double A = G.determinant();
   const double B = G(0, 0) * X(1, 1) - G(0, 1) * X(1, 0) - G(1, 0) * X(0, 1) + G(1, 1) * X(0, 0);
   const double C = X.determinant();
-  if (!(std::abs(C) > 1e-14 * X.squaredNorm())) return;  // no area in the ray frame
+  if (!(std::abs(C) > 1e-14 * X.squaredNorm())) return;
   const double K = A / C, H = B / (2.0 * C);
   // H^2 < K only through rounding or a non-symmetric M (noise): treat as the double root H.
   const double root = std::sqrt(std::max(H * H - K, 0.0));
@@ -85,7 +99,8 @@ void solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerance
   r.d1.row(i) = fr.frame.from_plane(p.d1);
   r.d2.row(i) = fr.frame.from_plane(p.d2);
   // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
-  const Eigen::Vector2d s1 = slit_direction(X, G, r.lambda1[i]), s2 = slit_direction(X, G, r.lambda2[i]);
+  const Eigen::Vector2d s1 = slit_direction(X, G, r.lambda1[i]),
+                        s2 = slit_direction(X, G, r.lambda2[i]);
   r.slit1.row(i) = fr.frame.from_plane(s1.squaredNorm() > 0 ? s1 : p.d2);
   r.slit2.row(i) = fr.frame.from_plane(s2.squaredNorm() > 0 ? s2 : p.d1);
   r.face_normal.row(i) = fr.frame.n;
@@ -193,7 +208,8 @@ CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, Norm
     mean /= area;
     double spread = 0.0;
     for (const auto& [a, m] : parts) spread += a * (m - mean).squaredNorm();
-    const auto p = detail::principal_from_symmetric(mean(0, 0), 0.5 * (mean(0, 1) + mean(1, 0)), mean(1, 1));
+    const auto p =
+        detail::principal_from_symmetric(mean(0, 0), 0.5 * (mean(0, 1) + mean(1, 0)), mean(1, 1));
     detail::store_vertex(r, i, frame, p, std::sqrt(spread / area), tol);
   });
   return r;

@@ -23,31 +23,48 @@ AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices, doubl
   return make_surface(o);
 }
 
-// On a sphere the three rays of any triangle meet in the centre: G = X / r exactly, so
-// A = C / r^2 and B = 2 C / r (eq. 7), i.e. K = 1/r^2 and H = 1/r up to rounding (eq. 9).
-TEST(TriangleCurvature, SpherePerFaceIsExact) {
+/// Longest edge of the mesh.
+double longest_edge(const Mesh& m) {
+  double h = 0.0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c)
+      h = std::max(h, (m.V.row(m.F(f, c)) - m.V.row(m.F(f, (c + 1) % 3))).norm());
+  }
+  return h;
+}
+
+// On a sphere the three rays of any triangle meet in the centre, at depth -d below the plane
+// through the face's centroid, and G = X / d exactly. The estimator lifts that plane by the
+// second-order sagitta s = (1/6) sum x^T M x (see triangle_curvature.cpp), so d + s equals r up
+// to fourth-order terms: |K r^2 - 1| and |H r - 1| are O((h/r)^4), bounded here by (h_max/r)^4
+// with h_max the longest edge (measured: 1.4e-6 against a bound of about 2e-4).
+TEST(TriangleCurvature, SpherePerFaceIsFourthOrderAccurate) {
   for (auto tri : {Triangulation::regular, Triangulation::irregular}) {
     for (double r : {1e-2, 1.0, 1e2}) {
       const AnalyticSurface s = surface(SurfaceKind::sphere, tri, 1000, r);
+      const double bound = std::pow(longest_edge(s.mesh) / r, 4);
       const TriangleCurvatureResult t = triangle_curvature(s.mesh.V, s.mesh.F, s.mesh.N);
       for (Eigen::Index f = 0; f < s.mesh.F.rows(); ++f) {
-        ASSERT_NEAR(t.K[f] * r * r, 1.0, 1e-9) << "face " << f;
-        ASSERT_NEAR(t.H[f] * r, 1.0, 1e-9) << "face " << f;
-        ASSERT_NEAR(t.lambda1[f] / r, -1.0, 1e-9);  // focal depth: the centre, r below
+        ASSERT_NEAR(t.K[f] * r * r, 1.0, bound) << "face " << f;
+        ASSERT_NEAR(t.H[f] * r, 1.0, bound) << "face " << f;
+        ASSERT_NEAR(t.lambda1[f] / r, -1.0, bound);  // focal depth: the centre, r below
         ASSERT_EQ(static_cast<PointClass>(t.point_class[f]), PointClass::umbilic);
       }
     }
   }
 }
 
-TEST(TriangleCurvature, SphereVertexAverageIsExact) {
+// The per-face operators are rotated (not projected) into each vertex frame, which keeps the
+// sphere's kI intact: the vertex average inherits the per-face bound.
+TEST(TriangleCurvature, SphereVertexAverage) {
   const AnalyticSurface s = surface(SurfaceKind::sphere, Triangulation::irregular, 1000, 3.0);
+  const double bound = std::pow(longest_edge(s.mesh) / 3.0, 4);
   CurvatureOptions o;
   o.method = Method::triangle;
   const CurvatureResult r = estimate_curvature(s.mesh.V, s.mesh.F, s.mesh.N, o);
   for (Eigen::Index i = 0; i < s.mesh.V.rows(); ++i) {
-    ASSERT_NEAR(r.k1[i] * 3.0, 1.0, 1e-9);
-    ASSERT_NEAR(r.k2[i] * 3.0, 1.0, 1e-9);
+    ASSERT_NEAR(r.k1[i] * 3.0, 1.0, bound);
+    ASSERT_NEAR(r.k2[i] * 3.0, 1.0, bound);
   }
 }
 
@@ -65,16 +82,26 @@ TEST(TriangleCurvature, CylinderFacesAreParabolic) {
   }
 }
 
-// The roots of A l^2 + B l + C are the focal depths -1/k (eq. 6-8).
+// The roots of A l^2 + B l + C are the focal depths -1/k (eq. 6-8). Where rounding or noise
+// makes the discriminant negative (near the umbilics of the ellipsoid) both depths are the
+// double root -1/H.
 TEST(TriangleCurvature, FocalDepthsSolveTheCharacteristicEquation) {
   const AnalyticSurface s = surface(SurfaceKind::ellipsoid, Triangulation::irregular, 1500);
   const TriangleCurvatureResult t = triangle_curvature(s.mesh.V, s.mesh.F, s.mesh.N);
+  int real_roots = 0;
   for (Eigen::Index f = 0; f < s.mesh.F.rows(); ++f) {
+    if (t.B[f] * t.B[f] - 4 * t.A[f] * t.C[f] < 0) {
+      EXPECT_EQ(t.k1[f], t.H[f]);
+      EXPECT_EQ(t.k2[f], t.H[f]);
+      continue;
+    }
+    ++real_roots;
     for (double l : {t.lambda1[f], t.lambda2[f]}) {
       const double scale = std::abs(t.A[f]) * l * l + std::abs(t.B[f] * l) + std::abs(t.C[f]);
       EXPECT_LE(std::abs(t.A[f] * l * l + t.B[f] * l + t.C[f]), 1e-9 * scale) << "face " << f;
     }
   }
+  EXPECT_GT(real_roots, 0.9 * s.mesh.F.rows());
 }
 
 // Appendix B, Lemma 2: the two slits are perpendicular; both lie in the face's tangent plane.
