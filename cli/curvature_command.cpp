@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <system_error>
 
 #include "commands.h"
 #include "estimator_flags.h"
@@ -68,7 +69,14 @@ void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   Stage stage(log, "write");
   const PlyWriteOptions o{.binary = !f.ascii, .comments = {}};
   write_focal_mesh_ply(f.prefix + ".focal1.ply", meshes.gamma1, o);
-  write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);
+  try {
+    write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);
+  } catch (...) {
+    // A failed run leaves no output behind, not one focal mesh without the other.
+    std::error_code ignored;
+    std::filesystem::remove(f.prefix + ".focal1.ply", ignored);
+    throw;
+  }
   std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),
               static_cast<long long>(meshes.gamma1.mesh.F.rows()), f.prefix.c_str(),
               static_cast<long long>(meshes.gamma2.mesh.F.rows()));
@@ -96,10 +104,12 @@ void add_curvature_command(CLI::App& app, const Log& log) {
 }
 
 void add_focal_mesh_command(CLI::App& app, const Log& log) {
-  auto* cmd = app.add_subcommand("focal-mesh", "The two focal meshes Gamma_1, Gamma_2 (paper eq. 2)");
+  auto* cmd =
+      app.add_subcommand("focal-mesh", "The two focal meshes Gamma_1, Gamma_2 (paper eq. 2)");
   auto f = std::make_shared<FocalMeshFlags>();
   cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
-  cmd->add_option("-o,--output", f->prefix, "writes PREFIX.focal1.ply and PREFIX.focal2.ply")->required();
+  cmd->add_option("-o,--output", f->prefix, "writes PREFIX.focal1.ply and PREFIX.focal2.ply")
+      ->required();
   cmd->add_option("--max-distance", f->focal.max_distance,
                   "clamp focal points farther than this (0 = 10 x bounding-box diagonal)")
       ->check(CLI::NonNegativeNumber);
@@ -107,7 +117,8 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
                 "leave out faces touching a focal point at infinity or undefined");
   cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
   f->estimator.add_to(*cmd);
-  cmd->footer("Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");
+  cmd->footer(
+      "Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");
   cmd->callback([f, &log] { run_focal_mesh(*f, log); });
 }
 

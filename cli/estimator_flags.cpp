@@ -19,7 +19,8 @@ constexpr NormalWeighting kDefaultWeighting = NormalWeighting::max;
 RowMatrixX3d estimated_normals(Mesh& mesh, NormalWeighting weighting, const Log& log) {
   const OrientationReport report = orientation_report(mesh.V, mesh.F);
   if (const int inward = report.inward_count(); inward > 0) {
-    log.warning(std::to_string(inward) + " closed component(s) are oriented inward; their faces "
+    log.warning(std::to_string(inward) +
+                " closed component(s) are oriented inward; their faces "
                 "were reversed so that normals point outward");
     mesh.F = orient_outward(mesh.F, report);
   }
@@ -49,10 +50,12 @@ void check_file_normals(const Mesh& mesh, RowMatrixX3d& normals, const Log& log)
       ++rescaled;
     }
   }
-  if (rescaled > 0) log.warning(std::to_string(rescaled) + " normals were not of unit length; normalised");
+  if (rescaled > 0)
+    log.warning(std::to_string(rescaled) + " normals were not of unit length; normalised");
   if (mesh.F.rows() > 0 && fraction_against_faces(mesh.V, mesh.F, normals) > 0.5) {
-    log.warning("most file normals point against the face orientation (inward?); curvature signs "
-                "follow the normals");
+    log.warning(
+        "most file normals point against the face orientation (inward?); curvature signs "
+        "follow the normals");
   }
 }
 
@@ -71,7 +74,8 @@ void print_summary(const CurvatureResult& r, const Log& log) {
   for (auto c : r.point_class) ++counts[c];
   std::string line = "  classes:";
   for (int c = 0; c < 6; ++c) {
-    line += " " + std::string(class_name(static_cast<PointClass>(c))) + "=" + std::to_string(counts[c]);
+    line +=
+        " " + std::string(class_name(static_cast<PointClass>(c))) + "=" + std::to_string(counts[c]);
   }
   log.info(line);
   log.info("  H range: " + range_of(r.H) + "   K range: " + range_of(r.K));
@@ -80,25 +84,34 @@ void print_summary(const CurvatureResult& r, const Log& log) {
 }  // namespace
 
 void EstimatorFlags::add_to(CLI::App& command) {
-  const std::map<std::string, Method> methods = {{"vertex", Method::vertex}, {"triangle", Method::triangle}};
-  const std::map<std::string, Solver> solvers = {{"closed-form", Solver::closed_form},
-                                                 {"levenberg-marquardt", Solver::levenberg_marquardt}};
+  const std::map<std::string, Method> methods = {{"vertex", Method::vertex},
+                                                 {"triangle", Method::triangle}};
+  const std::map<std::string, Solver> solvers = {
+      {"closed-form", Solver::closed_form}, {"levenberg-marquardt", Solver::levenberg_marquardt}};
   const std::map<std::string, RayWeighting> weights = {{"uniform", RayWeighting::uniform},
                                                        {"gaussian", RayWeighting::gaussian}};
-  const std::map<std::string, NormalsSource> sources = {
-      {"file", NormalsSource::file}, {"area", NormalsSource::area},
-      {"angle", NormalsSource::angle}, {"max", NormalsSource::max}};
-  command.add_option("--method", options.method, "per-vertex two-slit fit or per-triangle characteristic equation")
-      ->transform(CLI::CheckedTransformer(methods))->default_str("vertex");
+  const std::map<std::string, NormalsSource> sources = {{"file", NormalsSource::file},
+                                                        {"area", NormalsSource::area},
+                                                        {"angle", NormalsSource::angle},
+                                                        {"max", NormalsSource::max}};
+  command
+      .add_option("--method", options.method,
+                  "per-vertex two-slit fit or per-triangle characteristic equation")
+      ->transform(CLI::CheckedTransformer(methods))
+      ->default_str("vertex");
   command.add_option("--solver", options.solver, "two-slit solver")
-      ->transform(CLI::CheckedTransformer(solvers))->default_str("closed-form");
+      ->transform(CLI::CheckedTransformer(solvers))
+      ->default_str("closed-form");
   command.add_option("--rings", options.rings, "neighbourhood size in rings (1 = the paper's)")
-      ->check(CLI::Range(1, 16))->default_str("1");
+      ->check(CLI::Range(1, 16))
+      ->default_str("1");
   command.add_option("--weights", options.weighting, "ray weights")
-      ->transform(CLI::CheckedTransformer(weights))->default_str("uniform");
-  command.add_option("--normals", normals,
-                     "vertex normals: the file's, or estimated from faces by area, angle or Max "
-                     "(1999) weights [default: the file's when present, else max]")
+      ->transform(CLI::CheckedTransformer(weights))
+      ->default_str("uniform");
+  command
+      .add_option("--normals", normals,
+                  "vertex normals: the file's, or estimated from faces by area, angle or Max "
+                  "(1999) weights [default: the file's when present, else max]")
       ->transform(CLI::CheckedTransformer(sources));
   command.add_option("--threads", options.threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
       ->check(CLI::NonNegativeNumber);
@@ -115,11 +128,10 @@ RowMatrixX3d prepare_normals(Mesh& mesh, NormalsSource source, const Log& log) {
     check_file_normals(mesh, normals, log);
     return normals;
   }
-  const NormalWeighting weighting =
-      source == NormalsSource::automatic ? kDefaultWeighting
-      : source == NormalsSource::area    ? NormalWeighting::area
-      : source == NormalsSource::angle   ? NormalWeighting::angle
-                                         : NormalWeighting::max;
+  const NormalWeighting weighting = source == NormalsSource::automatic ? kDefaultWeighting
+                                    : source == NormalsSource::area    ? NormalWeighting::area
+                                    : source == NormalsSource::angle   ? NormalWeighting::angle
+                                                                       : NormalWeighting::max;
   return estimated_normals(mesh, weighting, log);
 }
 

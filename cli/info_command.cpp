@@ -27,7 +27,8 @@ void print_info(const std::string& path, const Log& log) {
   std::printf("unreferenced vertices: %d\n", s.unreferenced_vertex_count);
   std::printf("degenerate triangles: %d, duplicate triangles: %d\n", s.degenerate_face_count,
               s.duplicate_face_count);
-  std::printf("components:           %d (%d inward)\n", s.component_count, orientation.inward_count());
+  std::printf("components:           %d (%d inward)\n", s.component_count,
+              orientation.inward_count());
   std::printf("bounds:               [%g, %g, %g] - [%g, %g, %g]\n", s.min_corner.x(),
               s.min_corner.y(), s.min_corner.z(), s.max_corner.x(), s.max_corner.y(),
               s.max_corner.z());

@@ -17,20 +17,33 @@ constexpr int kInternalError = 3;
 
 int run(int argc, char** argv) {
   focal::cli::Log log;
-  CLI::App app{"focal: principal curvatures, directions and focal meshes of triangle meshes\n"
-               "(Yu et al., Focal Surfaces of Discrete Geometry, SGP 2007)"};
+  CLI::App app{
+      "focal: principal curvatures, directions and focal meshes of triangle meshes\n"
+      "(Yu et al., Focal Surfaces of Discrete Geometry, SGP 2007)"};
   app.set_version_flag("--version", "focal 0.1.0");
-  app.add_flag_callback("-v,--verbose", [&log] { log.set_verbose(true); },
-                        "stage timings and a summary on stderr");
-  app.require_subcommand(1);
+  app.add_flag_callback(
+      "-v,--verbose", [&log] { log.set_verbose(true); }, "stage timings and a summary on stderr");
+  // At most one command; "at least one" is checked after parsing, so that a misspelt command is
+  // reported by name ("not expected: curvatre") rather than as a missing command.
+  app.require_subcommand(0, 1);
   app.fallthrough();
   focal::cli::add_info_command(app, log);
   focal::cli::add_generate_command(app, log);
   focal::cli::add_curvature_command(app, log);
   focal::cli::add_focal_mesh_command(app, log);
-  app.footer("Run 'focal COMMAND -h' for the options and examples of a command.");
+  app.footer(
+      "Examples:\n"
+      "  focal info mesh.ply\n"
+      "  focal generate torus --vertices 5000 -o torus.ply --truth truth.csv\n"
+      "  focal curvature mesh.ply -o fields.csv\n"
+      "  focal -v curvature mesh.ply -o fields.ply --rings 2\n"
+      "  focal focal-mesh mesh.ply -o prefix   # prefix.focal1.ply, prefix.focal2.ply\n"
+      "Run 'focal COMMAND -h' for the options and examples of a command.\n"
+      "Exit codes: 0 success, 1 usage error, 2 unreadable input or invalid data, 3 internal "
+      "error.");
   try {
     app.parse(argc, argv);
+    if (app.get_subcommands().empty()) throw CLI::RequiredError("A subcommand");
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
@@ -38,8 +51,10 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh ... (see focal -h)\n",
-                 e.what());
+    std::fprintf(
+        stderr,
+        "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh ... (see focal -h)\n",
+        e.what());
     return kUsageError;
   }
   return 0;

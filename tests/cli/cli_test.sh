@@ -1,0 +1,445 @@
+#!/usr/bin/env bash
+# Tests of the `focal` command: exit codes, messages, the files it writes (or does not write) and
+# the values in them. Exit codes (cli/main.cpp): 0 success, 1 usage error, 2 I/O or data error.
+#
+# Usage: cli_test.sh FOCAL_BINARY SCRATCH_DIR
+# Prints one line per check and, last, "N passed, M failed"; exits 1 when any check failed.
+#
+# Most value checks use a unit sphere written by `focal generate` with its exact normals: every
+# normal ray passes through the centre, so the two-slit fit is exact there (k1 = k2 = 1 up to
+# rounding) and any looser bound has a stated reason.
+#
+# Checks run `bash -c '...' _ ARGS` with the script in single quotes on purpose (values come in as
+# $1, $2...), so shellcheck's "expressions don't expand in single quotes" does not apply.
+# shellcheck disable=SC2016
+set -euo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 FOCAL_BINARY SCRATCH_DIR" >&2
+  exit 2
+fi
+FOCAL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+SCRATCH=$2
+[[ -n $SCRATCH && $SCRATCH != / ]] || { echo "refusing to use '$SCRATCH' as scratch folder" >&2; exit 2; }
+rm -rf "$SCRATCH"
+mkdir -p "$SCRATCH"
+cd "$SCRATCH"
+LOG=$PWD/.log # stdout / stderr of the last run, kept out of the way of the outputs checked
+mkdir -p "$LOG"
+OUT=$LOG/stdout
+ERR=$LOG/stderr
+
+passed=0
+failed=0
+ok() {
+  printf 'ok    %s\n' "$1"
+  passed=$((passed + 1))
+}
+bad() {
+  printf 'FAIL  %s%s\n' "$1" "${2:+ -- $2}"
+  failed=$((failed + 1))
+}
+# check NAME COMMAND...: passes when COMMAND succeeds.
+check() {
+  local name=$1
+  shift
+  if "$@"; then ok "$name"; else bad "$name"; fi
+}
+
+# run ARGS...: runs focal; stdout in $OUT, stderr in $ERR, exit status in $rc.
+rc=0
+run() {
+  rc=0
+  "$FOCAL" "$@" >"$OUT" 2>"$ERR" || rc=$?
+}
+
+# expect_ok NAME ARGS...: focal ARGS exits 0.
+expect_ok() {
+  local name=$1
+  shift
+  run "$@"
+  if [[ $rc -eq 0 ]]; then ok "$name"; else bad "$name" "exit $rc: $(head -c 300 "$ERR")"; fi
+}
+
+# expect_error NAME CODE TEXT OUTPUT ARGS...: focal ARGS exits CODE, stderr has an `Error:` line
+# containing TEXT, and the path OUTPUT does not exist afterwards.
+expect_error() {
+  local name=$1 code=$2 text=$3 output=$4
+  shift 4
+  run "$@"
+  local why=""
+  [[ $rc -eq $code ]] || why+="exit $rc, expected $code; "
+  grep -q '^Error: ' "$ERR" || why+="no 'Error:' line on stderr; "
+  grep '^Error: ' "$ERR" | grep -qF -- "$text" || why+="no 'Error:' line mentions '$text'; "
+  [[ ! -e $output ]] || why+="$output was created; "
+  if [[ -z $why ]]; then ok "$name"; else bad "$name" "$why$(head -c 300 "$ERR")"; fi
+}
+
+# A number as focal writes it. Fields are matched against it before any arithmetic: mawk reads
+# "nan" as a NaN, which fails every comparison, so a NaN would pass a "d > tol" test unnoticed.
+NUM='^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$'
+
+# max_dev FILE "COLS" TARGET: max |x - TARGET| over the listed CSV columns of every data row;
+# prints "non-numeric" when any field is not a finite number or there are no rows.
+max_dev() {
+  awk -F, -v cols="$2" -v t="$3" -v re="$NUM" '
+    BEGIN { n = split(cols, c, " ") }
+    NR > 1 {
+      rows++
+      for (i = 1; i <= n; i++) {
+        x = $(c[i])
+        if (x !~ re) { bad = 1; continue }
+        d = x - t; if (d < 0) d = -d; if (d > m) m = d
+      }
+    }
+    END { if (bad || rows == 0) print "non-numeric"; else printf "%.3g\n", m }' "$1" 2>/dev/null || echo "no-file"
+}
+
+# within VALUE BOUND: VALUE is a number <= BOUND.
+within() {
+  awk -v x="$1" -v b="$2" -v re="$NUM" 'BEGIN { exit !(x ~ re && x + 0 <= b + 0) }'
+}
+
+# check_within NAME VALUE BOUND
+check_within() {
+  if within "$2" "$3"; then ok "$1 (got $2, bound $3)"; else bad "$1" "got $2, bound $3"; fi
+}
+
+# classes FILE: the distinct values of the class column (the last) with their counts.
+classes() { awk -F, 'NR > 1 { c[$NF]++ } END { for (k in c) printf "%s=%d ", k, c[k] }' "$1" 2>/dev/null || true; }
+
+# data_rows FILE: lines after the header.
+data_rows() { awk 'END { print NR - 1 }' "$1" 2>/dev/null || echo -1; }
+
+# ply_header FILE: the header lines of a (binary or ascii) PLY file.
+ply_header() { sed '/^end_header/q' "$1" 2>/dev/null || true; }
+
+# ply_vertex_lines FILE: the vertex lines of an ascii PLY file.
+ply_vertex_lines() {
+  awk '/^element vertex / { n = $3 } body && n > 0 { print; n-- } /^end_header/ { body = 1 }' "$1" 2>/dev/null || true
+}
+
+# ico FORMAT: the regular icosahedron with unit circumradius and outward faces, without normals.
+# FORMAT off, or obj (which gets an extra isolated vertex (5, 5, 5) as the 8th vertex).
+ico() {
+  awk -v fmt="$1" 'BEGIN {
+    t = (1 + sqrt(5)) / 2; r = sqrt(1 + t * t)
+    split("-1 t 0|1 t 0|-1 -t 0|1 -t 0|0 -1 t|0 1 t|0 -1 -t|0 1 -t|t 0 -1|t 0 1|-t 0 -1|-t 0 1", P, "|")
+    split("0 11 5|0 5 1|0 1 7|0 7 10|0 10 11|1 5 9|5 11 4|11 10 2|10 7 6|7 1 8|3 9 4|3 4 2|3 2 6|" \
+          "3 6 8|3 8 9|4 9 5|2 4 11|6 2 10|8 6 7|9 8 1", T, "|")
+    if (fmt == "off") { print "OFF"; print "12 20 0" }
+    for (i = 1; i <= 12; i++) {
+      split(P[i], c, " ")
+      for (j = 1; j <= 3; j++) c[j] = (c[j] == "t" ? t : c[j] == "-t" ? -t : c[j]) / r
+      printf "%s%.17g %.17g %.17g\n", (fmt == "obj" ? "v " : ""), c[1], c[2], c[3]
+      if (fmt == "obj" && i == 7) print "v 5 5 5"
+    }
+    for (i = 1; i <= 20; i++) {
+      split(T[i], f, " ")
+      if (fmt == "off") { printf "3 %d %d %d\n", f[1], f[2], f[3]; continue }
+      for (j = 1; j <= 3; j++) { f[j]++; if (f[j] >= 8) f[j]++ }  # 1-based, after the extra vertex
+      printf "f %d %d %d\n", f[1], f[2], f[3]
+    }
+  }'
+}
+
+HEADER='k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class'
+
+# ---------------------------------------------------------------------------------------------
+# Help and version
+run -h
+check "focal -h exits 0" test "$rc" -eq 0
+check "focal -h shows the usage and every command" \
+  bash -c 'grep -q "^Usage: .*SUBCOMMAND" "$1" && grep -q "^  info " "$1" && grep -q "^  generate " "$1" &&
+           grep -q "^  curvature " "$1" && grep -q "^  focal-mesh " "$1"' _ "$OUT"
+check "focal -h shows examples" grep -q '^  focal curvature mesh.ply -o fields.csv' "$OUT"
+
+run curvature -h
+check "focal curvature -h exits 0" test "$rc" -eq 0
+check "focal curvature -h shows usage, options and examples" \
+  bash -c 'grep -q "^Usage: .*curvature" "$1" && grep -q -- "--rings" "$1" && grep -q -- "--normals" "$1" &&
+           grep -q "Examples:" "$1" && grep -q "^  focal curvature bunny.off -o bunny.csv" "$1"' _ "$OUT"
+for sub in info generate focal-mesh; do
+  run "$sub" -h
+  check "focal $sub -h exits 0 with usage and an example" \
+    bash -c '[[ $2 -eq 0 ]] && grep -q "^Usage: .*'"$sub"'" "$1" && grep -q "^  focal '"$sub"' " "$1"' _ "$OUT" "$rc"
+done
+run --version
+check "focal --version prints the version" bash -c '[[ $2 -eq 0 ]] && grep -qx "focal 0.1.0" "$1"' _ "$OUT" "$rc"
+
+# ---------------------------------------------------------------------------------------------
+# The test surface
+run generate sphere -o s.ply --truth t.csv
+check "generate sphere exits 0 and reports what it wrote" \
+  bash -c '[[ $2 -eq 0 ]] && grep -q "^wrote s.ply: sphere, [0-9]* vertices, [0-9]* triangles, truth in t.csv" "$1"' _ "$OUT" "$rc"
+NV=$(sed -n 's/^wrote s.ply: sphere, \([0-9]*\) vertices.*/\1/p' "$OUT" || true)
+NF=$(sed -n 's/^wrote s.ply: sphere, [0-9]* vertices, \([0-9]*\) triangles.*/\1/p' "$OUT" || true)
+NV=${NV:-0} NF=${NF:-0}
+check "generated vertex count is close to the default target 2000 ($NV)" test "$NV" -ge 1800 -a "$NV" -le 2200
+check "s.ply header declares $NV vertices, $NF faces and normals" \
+  bash -c 'h=$(sed "/^end_header/q" s.ply); grep -qx "element vertex $1" <<<"$h" && grep -qx "element face $2" <<<"$h" &&
+           grep -qx "property double nx" <<<"$h"' _ "$NV" "$NF"
+check "truth CSV has the header and one row per vertex" \
+  bash -c '[[ $(head -1 t.csv) == k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z && $(awk "END{print NR-1}" t.csv) -eq $1 ]]' _ "$NV"
+check_within "truth: k1 = k2 = H = K = 1 on the unit sphere" "$(max_dev t.csv "1 2 3 4" 1)" 1e-12
+
+run info s.ply
+check "info exits 0" test "$rc" -eq 0
+check "info shows the vertex count $NV and the triangle count $NF" \
+  bash -c 'grep -Eq "^vertices: +$1\$" "$3" && grep -Eq "^triangles: +$2 " "$3"' _ "$NV" "$NF" "$OUT"
+check "info: the sphere is closed, one component, normals present" \
+  bash -c 'grep -Eq "^edges: .*\(boundary 0, non-manifold 0\)" "$1" && grep -Eq "^components: +1 \(0 inward\)" "$1" &&
+           grep -Eq "^vertex normals: +present" "$1"' _ "$OUT"
+H_EDGE=$(sed -n 's/^mean edge length: *//p' "$OUT" || true)
+check "info shows a mean edge length ($H_EDGE)" within "${H_EDGE:-x}" 1
+H_EDGE=${H_EDGE:-0}
+H2=$(awk -v h="$H_EDGE" 'BEGIN { printf "%.6g", h * h }')
+
+# ---------------------------------------------------------------------------------------------
+# Usage errors: exit 1, an Error: line, no output
+expect_error "no subcommand: exit 1" 1 "subcommand" out.csv
+expect_error "unknown subcommand: exit 1" 1 "frobnicate" out.csv frobnicate s.ply -o out.csv
+expect_error "extra argument: exit 1" 1 "extra" out.csv curvature s.ply -o out.csv extra
+expect_error "two commands at once: exit 1" 1 "curvature" out.csv info s.ply curvature s.ply -o out.csv
+check "two commands at once: nothing on stdout (neither ran)" test ! -s "$OUT"
+expect_error "unknown option: exit 1" 1 "--bogus" out.csv curvature s.ply -o out.csv --bogus
+expect_error "missing -o: exit 1" 1 "--output" out.csv curvature s.ply
+expect_error "missing input: exit 1" 1 "input" out.csv curvature -o out.csv
+expect_error "--solver foo: exit 1" 1 "--solver" out.csv curvature s.ply -o out.csv --solver foo
+expect_error "--method foo: exit 1" 1 "--method" out.csv curvature s.ply -o out.csv --method foo
+expect_error "--weights foo: exit 1" 1 "--weights" out.csv curvature s.ply -o out.csv --weights foo
+expect_error "--normals foo: exit 1" 1 "--normals" out.csv curvature s.ply -o out.csv --normals foo
+expect_error "--rings 0: exit 1" 1 "--rings" out.csv curvature s.ply -o out.csv --rings 0
+expect_error "--rings 17: exit 1" 1 "--rings" out.csv curvature s.ply -o out.csv --rings 17
+expect_error "--rings two: exit 1" 1 "--rings" out.csv curvature s.ply -o out.csv --rings two
+expect_error "--threads -1: exit 1" 1 "--threads" out.csv curvature s.ply -o out.csv --threads -1
+expect_error "curvature -o out.txt (bad extension): exit 1" 1 "out.txt" out.txt curvature s.ply -o out.txt
+expect_error "focal-mesh --max-distance -1: exit 1" 1 "--max-distance" pre.focal1.ply focal-mesh s.ply -o pre --max-distance -1
+expect_error "focal-mesh --solver foo: exit 1" 1 "--solver" pre.focal1.ply focal-mesh s.ply -o pre --solver foo
+expect_error "generate unknown surface: exit 1" 1 "foo" g.ply generate foo -o g.ply
+expect_error "generate -o g.stl (cannot write STL): exit 1" 1 "g.stl" g.stl generate sphere -o g.stl
+expect_error "generate --vertices 3: exit 1" 1 "--vertices" g.ply generate sphere -o g.ply --vertices 3
+expect_error "info without input: exit 1" 1 "input" out.csv info
+check "nothing was written by the usage errors" bash -c '[[ -z $(ls -A | grep -vx -e s.ply -e t.csv -e .log) ]]'
+
+# ---------------------------------------------------------------------------------------------
+# Input errors: exit 2, an Error: line naming the file, no output
+printf 'OFF\n6 8 0\n1 0 0\n-1 0 0\n0 1 0\n' >truncated.off
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n' >bad_index.obj
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2\n3\n' >no_y.ply
+: >empty.ply
+mkdir -p folder.ply
+expect_error "missing input file: exit 2" 2 "missing.ply" out.csv curvature missing.ply -o out.csv
+expect_error "directory as input: exit 2" 2 "folder.ply" out.csv curvature folder.ply -o out.csv
+expect_error "truncated OFF: exit 2" 2 "truncated.off" out.csv curvature truncated.off -o out.csv
+expect_error "truncated OFF: the message says where" 2 "line 5" out.csv curvature truncated.off -o out.csv
+expect_error "OBJ face index out of range: exit 2" 2 "bad_index.obj" out.csv curvature bad_index.obj -o out.csv
+expect_error "PLY without y: exit 2" 2 "no_y.ply" out.csv curvature no_y.ply -o out.csv
+expect_error "empty PLY: exit 2" 2 "empty.ply" out.csv curvature empty.ply -o out.csv
+expect_error "unknown input format: exit 2" 2 "t.csv" out.csv curvature t.csv -o out.csv
+expect_error "info on a missing file: exit 2" 2 "missing.off" out.csv info missing.off
+expect_error "focal-mesh on a truncated OFF: exit 2" 2 "truncated.off" pre.focal1.ply focal-mesh truncated.off -o pre
+check "focal-mesh on a truncated OFF writes no focal2 either" test ! -e pre.focal2.ply
+printf 'old\n' >keep.csv
+run curvature truncated.off -o keep.csv
+check "a failed run leaves an existing output as it was" bash -c '[[ $1 -eq 2 && $(cat keep.csv) == old ]]' _ "$rc"
+
+# Outputs into a folder that does not exist: exit 2, nothing left behind
+expect_error "curvature -o nodir/c.csv: exit 2" 2 "nodir/c.csv" nodir curvature s.ply -o nodir/c.csv
+expect_error "curvature -o nodir/c.ply: exit 2" 2 "nodir/c.ply" nodir curvature s.ply -o nodir/c.ply
+expect_error "focal-mesh -o nodir/pre: exit 2" 2 "nodir/pre" nodir focal-mesh s.ply -o nodir/pre
+expect_error "generate -o nodir/g.ply: exit 2" 2 "nodir/g.ply" nodir generate sphere -o nodir/g.ply
+expect_error "generate --truth nodir/t.csv: exit 2, no mesh left" 2 "nodir/t.csv" g.ply \
+  generate sphere -o g.ply --truth nodir/t.csv
+# The second focal mesh cannot be written (its name is taken by a folder): no first one is left.
+mkdir -p clash.focal2.ply
+expect_error "focal-mesh whose 2nd output fails: exit 2, no 1st output left" 2 "clash.focal2.ply" \
+  clash.focal1.ply focal-mesh s.ply -o clash
+
+# ---------------------------------------------------------------------------------------------
+# Curvature of the unit sphere with its exact normals
+run curvature s.ply -o c.csv
+check "curvature s.ply -o c.csv exits 0 silently" bash -c '[[ $1 -eq 0 && ! -s $2 ]]' _ "$rc" "$ERR"
+check "CSV header is exactly $HEADER" test "$(head -1 c.csv)" = "$HEADER"
+check "CSV has one row per vertex ($NV)" test "$(data_rows c.csv)" -eq "$NV"
+check "CSV rows have 12 fields" bash -c '[[ -s c.csv && -z $(awk -F, "NF != 12" c.csv) ]]'
+# Exact normals: every ray passes through the centre and the closed-form fit is exact.
+check_within "sphere: every k1 and k2 is 1 within 1e-6" "$(max_dev c.csv "1 2" 1)" 1e-6
+check_within "sphere: every H and K is 1 within 1e-6" "$(max_dev c.csv "3 4" 1)" 1e-6
+check_within "sphere: residual 0 within 1e-9 (rays meet exactly)" "$(max_dev c.csv 11 0)" 1e-9
+check "sphere: every class is umbilic" test "$(classes c.csv)" = "umbilic=$NV "
+
+# Radius 2: k = 1/r = 0.5, positive with outward normals.
+run generate sphere --a 2 -o s2.ply
+run curvature s2.ply -o c2.csv
+check_within "sphere of radius 2: k1, k2 = 0.5 within 1e-6" "$(max_dev c2.csv "1 2" 0.5)" 1e-6
+
+# The same fields as ascii PLY: positions, normals and directions together.
+run curvature s.ply -o ca.ply --ascii
+check "curvature -o ca.ply --ascii exits 0" test "$rc" -eq 0
+check "ascii PLY: format ascii, $NV vertices" \
+  bash -c 'h=$(sed "/^end_header/q" ca.ply); grep -qx "format ascii 1.0" <<<"$h" && grep -qx "element vertex $1" <<<"$h"' _ "$NV"
+ply_vertex_lines ca.ply >ca.vertices
+check "ascii PLY: $NV vertex lines of 18 values" \
+  bash -c '[[ $1 -gt 0 && $(wc -l <ca.vertices) -eq $1 && -z $(awk "NF != 18" ca.vertices) ]]' _ "$NV"
+# Columns: x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class; fields are float32
+# (relative rounding 6e-8), so 1e-6 bounds the rounding of these sums of three products.
+DIR_DEV=$(awk -v re="$NUM" '{
+    n++
+    for (i = 1; i <= 17; i++) if ($i !~ re) bad = 1
+    v[1] = $11*$11 + $12*$12 + $13*$13 - 1         # |d1| = 1
+    v[2] = $14*$14 + $15*$15 + $16*$16 - 1         # |d2| = 1
+    v[3] = $11*$14 + $12*$15 + $13*$16             # d1 . d2 = 0
+    v[4] = $11*$4 + $12*$5 + $13*$6                # d1 . N = 0
+    v[5] = $14*$4 + $15*$5 + $16*$6                # d2 . N = 0
+    v[6] = ($12*$16 - $13*$15)*$4 + ($13*$14 - $11*$16)*$5 + ($11*$15 - $12*$14)*$6 - 1  # (d1 x d2) . N = 1
+    for (i = 1; i <= 6; i++) { d = v[i] < 0 ? -v[i] : v[i]; if (d > m) m = d }
+  } END { if (bad || n == 0) print "non-numeric"; else printf "%.3g\n", m }' ca.vertices || true)
+check_within "ascii PLY: d1, d2 unit, orthogonal, tangent, (d1, d2, N) right-handed" "$DIR_DEV" 1e-6
+K_DEV=$(awk -v re="$NUM" '{
+    n++
+    for (i = 7; i <= 8; i++) { if ($i !~ re) { bad = 1; continue } d = $i - 1; if (d < 0) d = -d; if (d > m) m = d }
+  } END { if (bad || n == 0) print "non-numeric"; else printf "%.3g\n", m }' ca.vertices || true)
+check_within "ascii PLY: k1, k2 = 1 within 1e-6 (float32)" "$K_DEV" 1e-6
+check "ascii PLY: class code 3 (umbilic) everywhere" bash -c '[[ -s ca.vertices && -z $(awk "\$18 != 3" ca.vertices) ]]'
+
+# Binary PLY: the header lists the fields and the class codes.
+run curvature s.ply -o c.ply
+check "curvature -o c.ply exits 0" test "$rc" -eq 0
+ply_header c.ply >c.header
+check "PLY: binary little endian with $NV vertices and $NF faces" \
+  bash -c 'grep -qx "format binary_little_endian 1.0" c.header && grep -qx "element vertex $1" c.header &&
+           grep -qx "element face $2" c.header' _ "$NV" "$NF"
+check "PLY: vertex properties are x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class" \
+  test "$(awk '/^element/ { e = $2 } e == "vertex" && $1 == "property" { printf "%s ", $3 }' c.header)" \
+  = "x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class "
+check "PLY: k1 is float, class is uchar" bash -c 'grep -qx "property float k1" c.header && grep -qx "property uchar class" c.header'
+check "PLY: a comment lists the class codes" \
+  grep -q '^comment .*class codes: 0=elliptic 1=hyperbolic 2=parabolic 3=umbilic 4=flat 5=undefined' c.header
+run info c.ply
+check "PLY output reads back with $NV vertices" bash -c '[[ $1 -eq 0 ]] && grep -Eq "^vertices: +$2\$" "$3"' _ "$rc" "$NV" "$OUT"
+
+# ---------------------------------------------------------------------------------------------
+# Estimator options on the sphere
+variant() { # NAME BOUND ARGS...: runs curvature with ARGS into v.csv, checks |k - 1| <= BOUND
+  local name=$1 bound=$2
+  shift 2
+  rm -f v.csv
+  run curvature s.ply -o v.csv "$@"
+  if [[ $rc -ne 0 ]]; then bad "$name: exit $rc" "$(head -c 300 "$ERR")"; return; fi
+  check "$name: one row per vertex" test "$(data_rows v.csv)" -eq "$NV"
+  check_within "$name: |k - 1|" "$(max_dev v.csv "1 2" 1)" "$bound"
+}
+# Rays through the centre are fitted exactly whatever the solver, neighbourhood or weights.
+variant "--solver levenberg-marquardt" 1e-6 --solver levenberg-marquardt
+variant "--rings 2" 1e-6 --rings 2
+variant "--weights gaussian" 1e-6 --weights gaussian
+variant "--rings 3 --weights gaussian --solver levenberg-marquardt" 1e-6 --rings 3 --weights gaussian --solver levenberg-marquardt
+variant "--normals file" 1e-6 --normals file
+# Max's weights give the exact normal at vertices whose neighbours lie on a sphere (Max 1999).
+variant "--normals max" 1e-6 --normals max
+# The triangle method fits rays in the plane of each face, which lies inside the sphere by its
+# sag s ~ r_circ^2 / 2 ~ e^2 / 6 (e the edges), so k = 1 / (1 - s) ~ 1 + e^2 / 6: bound h^2,
+# h the mean edge length, leaves room for edges up to ~2.4 h.
+variant "--method triangle" "$H2" --method triangle
+check "--method triangle: output differs from the vertex method" bash -c '[[ -s v.csv ]] && ! cmp -s v.csv c.csv'
+# Angle weights are exact only on symmetric vertex stars: the normal errors are O(h^2), and a
+# curvature is a normal difference over an edge, so the bound is O(h): h.
+variant "--normals angle" "$H_EDGE" --normals angle
+check "--normals angle: output differs from the file's normals" bash -c '[[ -s v.csv ]] && ! cmp -s v.csv c.csv'
+# Area weights are only first-order where the incident triangles differ in size (next to the
+# poles, thin fan triangles meet grid cells): normal errors O(h), curvature errors O(1). The bound
+# is empirical for this mesh (measured 0.17): it checks the option runs and gives a sphere-like
+# positive curvature, not accuracy.
+variant "--normals area" 0.25 --normals area
+check "--normals area: output differs from the file's normals" bash -c '[[ -s v.csv ]] && ! cmp -s v.csv c.csv'
+check "--normals area: every vertex elliptic or umbilic" \
+  bash -c '[[ -s v.csv && -z $(awk -F, "NR > 1 && \$12 != \"elliptic\" && \$12 != \"umbilic\"" v.csv) ]]'
+
+# Results do not depend on the thread count (README): an irregular torus, non-trivial values.
+run generate torus --triangulation irregular --vertices 3000 -o torus.ply
+run curvature torus.ply -o torus1.csv --threads 1
+run curvature torus.ply -o torus3.csv --threads 3
+check "--threads 1 and --threads 3 give identical files (irregular torus)" \
+  bash -c '[[ -s torus1.csv ]] && cmp -s torus1.csv torus3.csv'
+check "torus: both elliptic and hyperbolic vertices" \
+  bash -c 'c=$(awk -F, "NR > 1 { print \$12 }" torus1.csv | sort -u); grep -qx elliptic <<<"$c" && grep -qx hyperbolic <<<"$c"'
+
+# ---------------------------------------------------------------------------------------------
+# Meshes without normals
+ico off >ico.off
+run info ico.off
+check "hand-written icosahedron: 12 vertices, no normals" \
+  bash -c '[[ $1 -eq 0 ]] && grep -Eq "^vertices: +12\$" "$2" && grep -Eq "^vertex normals: +none" "$2"' _ "$rc" "$OUT"
+expect_error "--normals file on a mesh without normals: exit 2" 2 "no vertex normals" out.csv \
+  curvature ico.off -o out.csv --normals file
+# Default: Max's weights, exact on the icosahedron (its vertices lie on the unit sphere), so
+# every ray again passes through the centre.
+run curvature ico.off -o ico.csv
+check "icosahedron without normals: exit 0, 12 rows" bash -c '[[ $1 -eq 0 && $(awk "END{print NR-1}" ico.csv) -eq 12 ]]' _ "$rc"
+check_within "icosahedron without normals: k1, k2 = 1 within 1e-6" "$(max_dev ico.csv "1 2" 1)" 1e-6
+
+# The generated sphere as OFF is NOFF (normals); stripping them gives a normals-free OFF.
+run generate sphere -o so.off
+check "generate -o so.off writes NOFF (it has normals)" bash -c '[[ $1 -eq 0 && $(head -1 so.off) == NOFF ]]' _ "$rc"
+awk 'NR == 1 { print "OFF"; next } NR == 2 { nv = $1; print; next } nv > 0 { print $1, $2, $3; nv--; next } { print }' \
+  so.off >plain.off 2>/dev/null || true
+run info plain.off
+check "the stripped OFF has $NV vertices and no normals" \
+  bash -c 'grep -Eq "^vertices: +$1\$" "$2" && grep -Eq "^vertex normals: +none" "$2"' _ "$NV" "$OUT"
+expect_error "--normals file on the stripped OFF: exit 2" 2 "no vertex normals" out.csv \
+  curvature plain.off -o out.csv --normals file
+run curvature plain.off -o plain.csv
+check_within "stripped OFF, default (Max) normals: k1, k2 = 1 within 1e-6" "$(max_dev plain.csv "1 2" 1)" 1e-6
+
+# An isolated vertex (the 8th of 13) in an OBJ: its row is NaN and undefined, in place.
+ico obj >iso.obj
+run curvature iso.obj -o iso.csv
+check "OBJ with an isolated vertex: exit 0, 13 rows" bash -c '[[ $1 -eq 0 && $(awk "END{print NR-1}" iso.csv) -eq 13 ]]' _ "$rc"
+check "isolated vertex: row 8 is all nan with class undefined" \
+  test "$(sed -n 9p iso.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined"
+sed 9d iso.csv >iso_others.csv 2>/dev/null || true
+check_within "the other 12 rows: k1, k2 = 1 within 1e-6" "$(max_dev iso_others.csv "1 2" 1)" 1e-6
+check "the other 12 rows are umbilic" test "$(classes iso_others.csv)" = "umbilic=12 "
+
+# ---------------------------------------------------------------------------------------------
+# Focal meshes
+run focal-mesh s.ply -o pre
+check "focal-mesh exits 0 and reports both files" \
+  bash -c '[[ $1 -eq 0 ]] && grep -q "^wrote pre.focal1.ply ($2 faces) and pre.focal2.ply ($2 faces)" "$3"' _ "$rc" "$NF" "$OUT"
+for j in 1 2; do
+  check "pre.focal$j.ply: $NV vertices with focal_flag, $NF faces" \
+    bash -c '[[ -f $1 ]] && h=$(sed "/^end_header/q" "$1") && grep -qx "element vertex $2" <<<"$h" &&
+             grep -qx "property uchar focal_flag" <<<"$h" && grep -qx "element face $3" <<<"$h"' _ "pre.focal$j.ply" "$NV" "$NF"
+done
+# Gamma_j = S - N / k_j: on the unit sphere every focal point is the centre.
+run focal-mesh s.ply -o pa --ascii
+for j in 1 2; do
+  FOCAL_DEV=$(ply_vertex_lines "pa.focal$j.ply" | awk -v re="$NUM" '{
+      n++; if ($4 != 0) flag = 1
+      for (i = 1; i <= 3; i++) { if ($i !~ re) { bad = 1; continue } d = $i < 0 ? -$i : $i; if (d > m) m = d }
+    } END { if (bad || flag || n == 0) print "bad"; else printf "%.3g\n", m }' || true)
+  check_within "pa.focal$j.ply: every focal point at the centre, flag finite" "$FOCAL_DEV" 1e-6
+done
+
+# ---------------------------------------------------------------------------------------------
+# -v: stage timings and a summary on stderr
+stages_ok() { # STDERR STAGE...: a timing line "  <stage>: <ms> ms" for each stage
+  local f=$1
+  shift
+  for s in "$@"; do grep -Eq "^  $s: +[0-9]+\.[0-9] ms\$" "$f" || return 1; done
+}
+run -v curvature s.ply -o cv.csv
+check "-v curvature: exit 0" test "$rc" -eq 0
+check "-v curvature: stage timings read, normals, curvature, write" stages_ok "$ERR" read normals curvature write
+check "-v curvature: summary of classes" grep -q "^  classes: .*umbilic=$NV" "$ERR"
+check "-v curvature: the CSV is the same as without -v" cmp -s cv.csv c.csv
+run curvature s.ply -o cv2.csv -v
+check "-v after the subcommand works too" stages_ok "$ERR" read curvature write
+run -v focal-mesh s.ply -o pv
+check "-v focal-mesh: stage timings include the focal meshes" stages_ok "$ERR" read curvature "focal meshes" write
+run -v generate sphere -o gv.ply
+check "-v generate: a generate timing" stages_ok "$ERR" generate
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]
