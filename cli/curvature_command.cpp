@@ -9,6 +9,7 @@
 #include "focal/fields_io.h"
 #include "focal/focal_mesh.h"
 #include "focal/mesh_io.h"
+#include "paths.h"
 
 namespace focal::cli {
 namespace {
@@ -36,20 +37,12 @@ Mesh read_input(const std::string& path, const Log& log) {
   return mesh;
 }
 
-/// Rejects an output name the command cannot write before any work is done.
-void check_output_extension(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext != ".csv" && ext != ".ply") {
-    throw CLI::ValidationError("-o", "output must end in .csv or .ply, got '" + path + "'");
-  }
-}
-
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, log);
-  const RowMatrixX3d normals = prepare_normals(mesh, f.estimator.normals, log);
+  const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
   const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
   Stage stage(log, "write");
-  if (std::filesystem::path(f.output).extension() == ".csv") {
+  if (lower_extension(f.output) == ".csv") {
     write_curvature_csv(f.output, fields);
   } else {
     mesh.N = normals;
@@ -59,7 +52,7 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, log);
-  const RowMatrixX3d normals = prepare_normals(mesh, f.estimator.normals, log);
+  const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
   const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
   FocalMeshes meshes;
   {
@@ -99,7 +92,7 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "a sphere of radius r has k1 = k2 = +1/r). Examples:\n"
       "  focal curvature bunny.off -o bunny.csv\n"
       "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v");
-  cmd->parse_complete_callback([f] { check_output_extension(f->output); });
+  cmd->parse_complete_callback([f] { require_extension("-o", f->output, {".csv", ".ply"}); });
   cmd->callback([f, &log] { run_curvature(*f, log); });
 }
 

@@ -117,10 +117,11 @@ void EstimatorFlags::add_to(CLI::App& command) {
       ->check(CLI::NonNegativeNumber);
 }
 
-RowMatrixX3d prepare_normals(Mesh& mesh, NormalsSource source, const Log& log) {
+RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name, NormalsSource source,
+                             const Log& log) {
   Stage stage(log, "normals");
   if (source == NormalsSource::file && !mesh.has_normals()) {
-    throw InvalidInput("--normals file: the input has no vertex normals");
+    throw InvalidInput("--normals file: " + mesh_name + " has no vertex normals");
   }
   if (source == NormalsSource::file || (source == NormalsSource::automatic && mesh.has_normals())) {
     RowMatrixX3d normals = mesh.N;

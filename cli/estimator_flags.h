@@ -22,7 +22,8 @@ struct EstimatorFlags {
 /// The unit normals the estimator uses: the file's, or estimated from the faces (with inward
 /// closed components re-oriented). Warns about what it fixed or suspects.
 /// \throw InvalidInput when `--normals file` is asked for and the file has none.
-[[nodiscard]] RowMatrixX3d prepare_normals(Mesh& mesh, NormalsSource source, const Log& log);
+[[nodiscard]] RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name,
+                                           NormalsSource source, const Log& log);
 
 /// Runs the estimator with stage timings and, with -v, a summary of the result.
 [[nodiscard]] CurvatureResult run_estimator(const Mesh& mesh, const RowMatrixX3d& normals,

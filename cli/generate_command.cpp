@@ -1,5 +1,3 @@
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -10,6 +8,7 @@
 #include "commands.h"
 #include "focal/mesh_io.h"
 #include "focal/surfaces.h"
+#include "paths.h"
 
 namespace focal::cli {
 namespace {
@@ -22,16 +21,6 @@ struct GenerateFlags {
   double position_noise = 0.0;
   double normal_noise = 0.0;
 };
-
-/// Rejects an output name write_mesh cannot write before any work is done (a usage error).
-void check_output_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".ply" && ext != ".obj" && ext != ".off") {
-    throw CLI::ValidationError("-o", "output must end in .ply, .obj or .off, got '" + path + "'");
-  }
-}
 
 /// The exact principal curvatures and directions, one row per vertex.
 void write_truth(const std::string& path, const AnalyticSurface& s) {
@@ -111,7 +100,9 @@ void add_generate_command(CLI::App& app, const Log& log) {
   cmd->footer(
       "Example:\n  focal generate torus --triangulation irregular --vertices 5000 -o torus.ply "
       "--truth torus-truth.csv");
-  cmd->parse_complete_callback([f] { check_output_extension(f->output); });
+  cmd->parse_complete_callback([f] {
+    require_extension("-o", f->output, {".ply", ".obj", ".off"});
+  });
   cmd->callback([f, &log] { generate(*f, log); });
 }
 

@@ -1,0 +1,28 @@
+#include "paths.h"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+namespace focal::cli {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void require_extension(const std::string& option, const std::string& path,
+                       std::initializer_list<const char*> allowed) {
+  const std::string ext = lower_extension(path);
+  std::string names;
+  for (const char* a : allowed) {
+    if (ext == a) return;
+    names += (names.empty() ? "" : ", ") + std::string(a);
+  }
+  throw CLI::ValidationError(option, "output must end in " + names + ", got '" + path + "'");
+}
+
+}  // namespace focal::cli
