@@ -67,7 +67,9 @@ TEST(FocalMesh, TorusFocalSetsAreTheCoreCircleAndTheAxis) {
     const Eigen::Vector3d g1 = f.gamma1.mesh.V.row(i), g2 = f.gamma2.mesh.V.row(i);
     EXPECT_NEAR(std::hypot(g1.x(), g1.y()), 1.0, 1e-9);  // default major radius a = 1
     EXPECT_NEAR(g1.z(), 0.0, 1e-9);
-    if (f.gamma2.flag[i] == 0) EXPECT_LT(std::hypot(g2.x(), g2.y()), 1e-9);
+    if (f.gamma2.flag[i] == 0) {
+      EXPECT_LT(std::hypot(g2.x(), g2.y()), 1e-9);
+    }
   }
 }
 

@@ -3,6 +3,7 @@
 /// Everything of the focal library in one include.
 
 #include "focal/curvature.h"
+#include "focal/device.h"
 #include "focal/error.h"
 #include "focal/fields_io.h"
 #include "focal/focal_mesh.h"
