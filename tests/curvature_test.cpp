@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "focal/error.h"
 #include "focal/normals.h"
@@ -255,9 +257,14 @@ TEST_P(Accuracy, ErrorBoundedAndConverging) {
   const AccuracyCase c = GetParam();
   const Measured coarse = measure(c, 2000), fine = measure(c, 8000);
   const double ratio = fine.rms / coarse.rms;
-  RecordProperty("rms_coarse", std::to_string(coarse.rms));
-  RecordProperty("rms_fine", std::to_string(fine.rms));
-  RecordProperty("median_d1_angle_fine", std::to_string(fine.median_angle));
+  const auto text = [](double x) {
+    std::ostringstream s;
+    s << std::setprecision(3) << x;
+    return s.str();
+  };
+  RecordProperty("rms_coarse", text(coarse.rms));
+  RecordProperty("rms_fine", text(fine.rms));
+  RecordProperty("median_d1_angle_fine", text(fine.median_angle));
   if (coarse.rms < 1e-12) {  // exact up to rounding (cylinder): nothing to converge
     EXPECT_LE(fine.rms, 1e-12);
   } else if (c.estimated_normals && c.triangulation == Triangulation::irregular) {
