@@ -4,7 +4,7 @@ PRESET ?= release
 BUILD_DIR := build/$(PRESET)
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps deps-demo configure build test demo install clean format
+.PHONY: all deps deps-demo configure build test demo bench install clean format
 
 all: build
 
@@ -25,6 +25,16 @@ test: build
 
 demo: deps-demo build
 	@bash scripts/demo.sh $(BUILD_DIR)/cli/focal
+
+# Benchmarks (bench/, docs/PERFORMANCE.md): the stages with Google Benchmark, then whole runs
+# of the focal command from 10K to 10M vertices. About 10 minutes on 2 cores.
+bench:
+	@bash scripts/install-deps.sh bench
+	@cmake --preset bench >/dev/null
+	@cmake --build build/bench -j $(JOBS)
+	@build/bench/bench/focal_kernels_bench --benchmark_repetitions=3 \
+	  --benchmark_report_aggregates_only=true --benchmark_out=build/bench/kernels.json
+	@bash bench/run_bench.sh build/bench | tee build/bench/whole-runs.md
 
 install: build
 	@cmake --install $(BUILD_DIR) --prefix $(or $(PREFIX),/usr/local)

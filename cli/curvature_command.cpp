@@ -9,6 +9,7 @@
 #include "focal/fields_io.h"
 #include "focal/focal_mesh.h"
 #include "focal/mesh_io.h"
+#include "input_check.h"
 #include "paths.h"
 
 namespace focal::cli {
@@ -29,16 +30,22 @@ struct FocalMeshFlags {
   FocalMeshOptions focal;
 };
 
-Mesh read_input(const std::string& path, const Log& log) {
-  Stage stage(log, "read");
-  Mesh mesh = read_mesh(path);
-  log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
-           " triangles");
+/// Reads the mesh and reports (or, with --strict, rejects) what is wrong with it.
+Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
+  Mesh mesh;
+  {
+    Stage stage(log, "read");
+    mesh = read_mesh(path);
+    log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
+             " triangles");
+  }
+  const RowMatrixX3d no_normals(0, 3);
+  check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path, flags.strict, log);
   return mesh;
 }
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
-  Mesh mesh = read_input(f.input, log);
+  Mesh mesh = read_input(f.input, f.estimator, log);
   const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
   const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
   Stage stage(log, "write");
@@ -51,7 +58,7 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
 }
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
-  Mesh mesh = read_input(f.input, log);
+  Mesh mesh = read_input(f.input, f.estimator, log);
   const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
   const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
   FocalMeshes meshes;

@@ -115,6 +115,15 @@ void EstimatorFlags::add_to(CLI::App& command) {
       ->transform(CLI::CheckedTransformer(sources));
   command.add_option("--threads", options.threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
       ->check(CLI::NonNegativeNumber);
+  command.add_flag("--strict", strict,
+                   "fail (exit 2, nothing written) when the input has problems such as NaN "
+                   "coordinates, degenerate or non-manifold faces or bad normals, instead of "
+                   "warning and leaving the affected vertices undefined");
+}
+
+bool EstimatorFlags::uses_file_normals(const Mesh& mesh) const {
+  return mesh.has_normals() &&
+         (normals == NormalsSource::file || normals == NormalsSource::automatic);
 }
 
 RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name, NormalsSource source,

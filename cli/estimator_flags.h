@@ -15,8 +15,11 @@ enum class NormalsSource { automatic, file, area, angle, max };
 struct EstimatorFlags {
   CurvatureOptions options;
   NormalsSource normals = NormalsSource::automatic;
+  bool strict = false;  ///< --strict: problems found in the input are errors (input_check.h)
 
   void add_to(CLI::App& command);
+  /// Whether the run uses the normals read from the file (rather than estimating them).
+  [[nodiscard]] bool uses_file_normals(const Mesh& mesh) const;
 };
 
 /// The unit normals the estimator uses: the file's, or estimated from the faces (with inward

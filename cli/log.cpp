@@ -13,10 +13,29 @@ void Log::info(const std::string& message) const {
 }
 
 Stage::Stage(const Log& log, std::string name)
-    : log_(log), name_(std::move(name)), start_(std::chrono::steady_clock::now()) {}
+    : log_(log), name_(std::move(name)), start_(std::chrono::steady_clock::now()) {
+  if (log_.verbose()) watcher_ = std::thread([this] { report_progress(); });
+}
+
+void Stage::report_progress() {
+  std::unique_lock lock(mutex_);
+  auto next = start_ + kProgressPeriod;
+  while (!done_signal_.wait_until(lock, next, [this] { return done_; })) {
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::fprintf(stderr, "  %-22s running for %.0f s\n", (name_ + ":").c_str(), s);
+    next += kProgressPeriod;
+  }
+}
 
 Stage::~Stage() {
   if (!log_.verbose()) return;
+  {
+    const std::lock_guard lock(mutex_);
+    done_ = true;
+  }
+  done_signal_.notify_one();
+  watcher_.join();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
   std::fprintf(stderr, "  %-22s %9.1f ms\n", (name_ + ":").c_str(), ms);

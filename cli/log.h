@@ -3,7 +3,10 @@
 // stage timings and summaries.
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <string>
+#include <thread>
 
 namespace focal::cli {
 
@@ -18,7 +21,9 @@ class Log {
   bool verbose_ = false;
 };
 
-/// Times one stage; with -v prints "  <name>: <ms> ms" when it ends.
+/// Times one stage; with -v prints "  <name>: <ms> ms" when it ends, and on long runs a line
+/// "  <name>: running for <s> s" every second until then (a watcher thread, started only with
+/// -v, so that a 10 M-vertex run shows it is alive without the library knowing about the log).
 class Stage {
  public:
   Stage(const Log& log, std::string name);
@@ -26,10 +31,19 @@ class Stage {
   Stage(const Stage&) = delete;
   Stage& operator=(const Stage&) = delete;
 
+  /// Seconds between the progress lines of a long stage.
+  static constexpr std::chrono::seconds kProgressPeriod{1};
+
  private:
+  void report_progress();
+
   const Log& log_;
   std::string name_;
   std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable done_signal_;
+  bool done_ = false;
+  std::thread watcher_;
 };
 
 }  // namespace focal::cli

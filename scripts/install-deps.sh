@@ -2,11 +2,19 @@
 # Installs the Debian packages focal needs, only those missing; idempotent.
 #   scripts/install-deps.sh          build and test dependencies
 #   scripts/install-deps.sh demo     also the scanned meshes used by `make demo`
+#   scripts/install-deps.sh bench    also Google Benchmark, GNU time and the bunny (`make bench`)
+#   scripts/install-deps.sh fuzz     also clang with libFuzzer and its OpenMP (scripts/fuzz.sh)
 set -euo pipefail
 
 packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev)
 if [[ "${1:-}" == "demo" ]]; then
   packages+=(libcgal-demo)
+elif [[ "${1:-}" == "bench" ]]; then
+  packages+=(libbenchmark-dev time libcgal-demo)
+elif [[ "${1:-}" == "fuzz" ]]; then
+  # libFuzzer and the sanitizer runtimes of clang are in libclang-rt-14-dev, which clang only
+  # recommends; libomp-dev is clang's OpenMP (the library links it).
+  packages+=(clang libclang-rt-14-dev libomp-dev)
 fi
 
 missing=()

@@ -8,7 +8,9 @@
 #include "focal/error.h"
 #include "focal/neighbourhood.h"
 #include "focal/normal_rays.h"
+#include "normal_rays_detail.h"
 #include "parallel.h"
+#include "two_slit_detail.h"
 
 namespace focal {
 
@@ -30,52 +32,64 @@ void validate_options(const CurvatureOptions& o) {
 
 /// Everything one vertex's fit reads, shared by all vertices.
 struct FitContext {
-  PositionsRef V;
-  const RowMatrixX3d& N;
-  const std::vector<char>& normal_ok;
-  const Neighbourhoods& rings;
+  const detail::VertexFitInput& in;
   const CurvatureOptions& options;
   double inverse_two_width_squared;  // Gaussian weights: exp(-d^2 * this)
   detail::ClassTolerances tolerances;
 };
 
+/// One vertex's rays and weights. Owned by a block of vertices, so that the loop over vertices
+/// never touches the heap once the vectors have grown to the largest ring.
+struct RayScratch {
+  std::vector<NormalRay> rays;
+  std::vector<double> weights;  // empty for uniform weights
+};
+
 SlitFit run_solver(const CurvatureOptions& o, std::span<const NormalRay> rays,
                    std::span<const double> weights) {
   return o.solver == Solver::closed_form
-             ? fit_two_slits_closed_form(rays, weights)
+             ? detail::closed_form_fit(rays, weights)
              : fit_two_slits_levenberg_marquardt(rays, weights, o.levenberg_marquardt);
 }
 
-void fit_vertex(const FitContext& c, Eigen::Index i, CurvatureResult& r) {
-  thread_local std::vector<NormalRay> rays;
-  thread_local std::vector<double> weights;
-  rays.clear();
-  weights.clear();
-  const Eigen::Vector3d p = c.V.row(i).transpose();
-  const TangentFrame frame = tangent_frame(c.N.row(i).transpose());
+/// The rays of vertex i's neighbours in its tangent frame (paper 4.1); returns how many
+/// neighbours had none (normal outside the hemisphere, or invalid).
+int gather_rays(const FitContext& c, int i, const TangentFrame& frame, RayScratch& s) {
+  const detail::VertexFitInput& in = c.in;
+  const Eigen::Vector3d p = in.V.row(i).transpose();
   int excluded = 0;
-  for (const int* j = c.rings.begin(static_cast<int>(i)); j != c.rings.end(static_cast<int>(i));
-       ++j) {
-    const Eigen::Vector3d q = c.V.row(*j).transpose();
-    const auto ray =
-        c.normal_ok[*j] ? normal_ray(frame, p, q, c.N.row(*j).transpose()) : std::nullopt;
-    if (!ray) {
+  for (const int* j = in.rings.begin(i); j != in.rings.end(i); ++j) {
+    const Eigen::Vector3d q = in.V.row(*j).transpose();
+    // The ray is made in its slot: copying a just-written NormalRay into the vector stalled on
+    // store forwarding (a fifth of the fit's time).
+    NormalRay& ray = s.rays.emplace_back();
+    if (!in.normal_ok[static_cast<std::size_t>(*j)] ||
+        !detail::ray_of(frame, p, q, in.unit_normals.row(*j).transpose(), ray)) {
+      s.rays.pop_back();
       ++excluded;
       continue;
     }
-    rays.push_back(*ray);
     if (c.options.weighting == RayWeighting::gaussian) {
-      weights.push_back(std::exp(-(q - p).squaredNorm() * c.inverse_two_width_squared));
+      s.weights.push_back(std::exp(-(q - p).squaredNorm() * c.inverse_two_width_squared));
     }
   }
-  r.rays_used[i] = static_cast<int>(rays.size());
-  r.rays_excluded[i] = excluded;
-  const SlitFit fit = run_solver(c.options, rays, weights);
-  if (!fit.valid) return;  // stays undefined with NaN fields
-  double weight_sum = static_cast<double>(rays.size());
-  if (!weights.empty()) {
+  return excluded;
+}
+
+void fit_vertex(const FitContext& c, int i, RayScratch& s, CurvatureResult& r) {
+  s.rays.clear();
+  s.weights.clear();
+  r.rays_used[i] = r.rays_excluded[i] = 0;
+  if (!c.in.normal_ok[static_cast<std::size_t>(i)]) return detail::store_undefined(r, i);
+  const TangentFrame frame = detail::frame_of(c.in.unit_normals.row(i).transpose());
+  r.rays_excluded[i] = gather_rays(c, i, frame, s);
+  r.rays_used[i] = static_cast<int>(s.rays.size());
+  const SlitFit fit = run_solver(c.options, s.rays, s.weights);
+  if (!fit.valid) return detail::store_undefined(r, i);
+  double weight_sum = static_cast<double>(s.rays.size());
+  if (!s.weights.empty()) {
     weight_sum = 0.0;
-    for (double w : weights) weight_sum += w;
+    for (double w : s.weights) weight_sum += w;
   }
   detail::store_vertex(r, i, frame, {fit.k1, fit.k2, fit.d1, fit.d2},
                        std::sqrt(fit.energy / weight_sum), c.tolerances);
@@ -84,23 +98,10 @@ void fit_vertex(const FitContext& c, Eigen::Index i, CurvatureResult& r) {
 CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRef N,
                                            const CurvatureOptions& options) {
   std::vector<char> normal_ok;
-  const RowMatrixX3d unit = detail::unit_rows(N, normal_ok);
+  const RowMatrixX3d unit = detail::unit_rows(N, normal_ok, options.threads);
   const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(V.rows()), F);
   const Neighbourhoods rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
-  const double h = mean_edge_length(V, F);
-  const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
-  const FitContext context{V,
-                           unit,
-                           normal_ok,
-                           rings,
-                           options,
-                           0.5 / (width * width),
-                           detail::class_tolerances(options, h)};
-  CurvatureResult result = detail::undefined_result(V.rows());
-  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
-    if (normal_ok[static_cast<std::size_t>(i)]) fit_vertex(context, i, result);
-  });
-  return result;
+  return detail::fit_vertices({V, unit, normal_ok, rings, mean_edge_length(V, F)}, options);
 }
 
 }  // namespace
@@ -147,4 +148,21 @@ CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
   return vertex_curvature_from_rays(V, F, N, options);
 }
 
+namespace detail {
+
+CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options) {
+  const double h = in.mean_edge_length;
+  const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
+  const FitContext context{in, options, 0.5 / (width * width), class_tolerances(options, h)};
+  CurvatureResult result = unwritten_result(in.V.rows());
+  // Blocks of vertices share one scratch; 256 vertices amortise its allocation and still give
+  // each thread many blocks (static schedule, so the same split for any run).
+  parallel_for_blocks(in.V.rows(), 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    RayScratch scratch;
+    for (auto i = begin; i < end; ++i) fit_vertex(context, static_cast<int>(i), scratch, result);
+  });
+  return result;
+}
+
+}  // namespace detail
 }  // namespace focal

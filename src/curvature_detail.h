@@ -2,12 +2,15 @@
 // Pieces shared by the per-vertex and per-triangle estimators.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "focal/curvature.h"
+#include "focal/neighbourhood.h"
 #include "focal/normal_rays.h"
+#include "parallel.h"
 
 namespace focal::detail {
 
@@ -20,32 +23,66 @@ struct Principal2 {
 
 inline Principal2 principal_from_symmetric(double a, double b, double c) {
   const double mean = 0.5 * (a + c);
-  const double half_gap = std::hypot(0.5 * (a - c), b);
-  const double phi = 0.5 * std::atan2(2.0 * b, a - c);  // angle of d1; 0 when isotropic
-  const Eigen::Vector2d d1(std::cos(phi), std::sin(phi));
-  return {mean + half_gap, mean - half_gap, d1, Eigen::Vector2d(-d1.y(), d1.x())};
+  const double d = 0.5 * (a - c);
+  // In units of s = max(|d|, |b|) squares neither overflow nor underflow, as with std::hypot;
+  // with the algebraic eigenvector below this avoids hypot, atan2 and sincos, which were a
+  // quarter of the per-vertex fit's time.
+  const double s = std::max(std::abs(d), std::abs(b));
+  if (s == 0.0) return {mean, mean, {1.0, 0.0}, {0.0, 1.0}};  // isotropic: any frame, take x
+  const double inv = 1.0 / s;
+  const double ds = d * inv, bs = b * inv;
+  const double r = std::sqrt(ds * ds + bs * bs);  // half the eigenvalue gap, over s
+  // The eigenvector of k1 with angle in (-pi/2, pi/2]: (r + d, b), or where that cancels
+  // (d < 0) the parallel (b, r - d) turned to x >= 0. Both have length sqrt(2 r (r + |d|)).
+  Eigen::Vector2d d1 = ds >= 0.0 ? Eigen::Vector2d(r + ds, bs)
+                                 : Eigen::Vector2d(std::abs(bs), std::copysign(r - ds, bs));
+  d1 /= std::sqrt(2.0 * r * (r + std::abs(ds)));
+  return {mean + s * r, mean - s * r, d1, Eigen::Vector2d(-d1.y(), d1.x())};
 }
 
 /// Unit copies of the rows of N; `valid[i]` is false where a row is zero or not finite.
-inline RowMatrixX3d unit_rows(NormalsRef N, std::vector<char>& valid) {
+/// Rows are independent, so any thread count gives the same result.
+inline RowMatrixX3d unit_rows(NormalsRef N, std::vector<char>& valid, int threads = 0) {
   RowMatrixX3d unit(N.rows(), 3);
-  valid.assign(static_cast<std::size_t>(N.rows()), 0);
-  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+  valid.resize(static_cast<std::size_t>(N.rows()));
+  parallel_for(N.rows(), threads, [&](std::int64_t i) {
     const double len = N.row(i).norm();
     valid[static_cast<std::size_t>(i)] = std::isfinite(len) && len > 0.0;
     unit.row(i) = N.row(i) / len;
-  }
+  });
   return unit;
 }
 
-/// A result of n vertices, every one `undefined` with NaN fields until it is filled.
-inline CurvatureResult undefined_result(Eigen::Index n) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+/// A result of n vertices with every field allocated but not written: the caller writes each
+/// row once, with store_vertex or store_undefined, from the thread that owns it (first touch
+/// then happens in parallel, and nothing is written twice).
+inline CurvatureResult unwritten_result(Eigen::Index n) {
   CurvatureResult r;
-  r.k1 = r.k2 = r.H = r.K = r.residual = Eigen::VectorXd::Constant(n, nan);
-  r.d1 = r.d2 = RowMatrixX3d::Constant(n, 3, nan);
-  r.point_class = VectorXu8::Constant(n, static_cast<std::uint8_t>(PointClass::undefined));
-  r.rays_used = r.rays_excluded = Eigen::VectorXi::Zero(n);
+  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) v->resize(n);
+  r.d1.resize(n, 3);
+  r.d2.resize(n, 3);
+  r.point_class.resize(n);
+  r.rays_used.resize(n);
+  r.rays_excluded.resize(n);
+  return r;
+}
+
+/// Marks vertex i `undefined`: NaN in every numeric field. Leaves the ray counts alone.
+inline void store_undefined(CurvatureResult& r, Eigen::Index i) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r.k1[i] = r.k2[i] = r.H[i] = r.K[i] = r.residual[i] = nan;
+  r.d1.row(i).setConstant(nan);
+  r.d2.row(i).setConstant(nan);
+  r.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
+}
+
+/// A result of n vertices, every one `undefined` with NaN fields until it is filled.
+inline CurvatureResult undefined_result(Eigen::Index n, int threads = 0) {
+  CurvatureResult r = unwritten_result(n);
+  parallel_for(n, threads, [&](std::int64_t i) {
+    store_undefined(r, i);
+    r.rays_used[i] = r.rays_excluded[i] = 0;
+  });
   return r;
 }
 
@@ -71,5 +108,18 @@ inline void store_vertex(CurvatureResult& r, Eigen::Index i, const TangentFrame&
   r.residual[i] = residual;
   r.point_class[i] = static_cast<std::uint8_t>(classify(p.k1, p.k2, tol.zero, tol.umbilic));
 }
+
+/// What the per-vertex fit reads besides the options. Split from estimate_curvature so that
+/// bench/ can time the fit step alone (normals and neighbourhoods already at hand).
+struct VertexFitInput {
+  PositionsRef V;
+  const RowMatrixX3d& unit_normals;    ///< from unit_rows
+  const std::vector<char>& normal_ok;  ///< from unit_rows
+  const Neighbourhoods& rings;
+  double mean_edge_length;  ///< scale of the Gaussian weights and the class tolerances
+};
+
+/// The per-vertex two-slit fit of every vertex (Method::vertex); defined in curvature.cpp.
+CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options);
 
 }  // namespace focal::detail

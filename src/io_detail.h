@@ -33,9 +33,11 @@ namespace focal::io_detail {
 
 /// Throws IoError unless `count` elements of at least `min_bytes` each fit in `available` bytes.
 /// Called before anything is allocated for a count declared in a file header, so that a header
-/// claiming 1e12 vertices is rejected instead of exhausting memory.
-void check_count_fits(const std::filesystem::path& path, std::uint64_t count,
-                      std::uint64_t min_bytes, std::uint64_t available, std::string_view what);
+/// claiming 1e12 vertices is rejected instead of exhausting memory. `where` is the place the
+/// elements start ("line 12", "byte offset 345"), for the message.
+void check_count_fits(const std::filesystem::path& path, std::string_view where,
+                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                      std::string_view what);
 
 /// `'text'`, for messages. (Also avoids "'" + std::string temporaries, on which GCC 12 gives a
 /// false -Wrestrict warning.)
@@ -120,5 +122,13 @@ void write_atomically(const std::filesystem::path& path,
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
+
+// The same readers on the contents of a file already in memory (read_X(path) is
+// parse_X(path, read_whole_file(path))); `path` only names the file in messages. The fuzz targets
+// in fuzz/ call these directly. \throw IoError as the readers.
+[[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
 
 }  // namespace focal::io_detail

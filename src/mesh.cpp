@@ -1,5 +1,8 @@
 #include "focal/mesh.h"
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 #include "focal/error.h"
@@ -25,19 +28,35 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
 }
 
 double mean_edge_length(PositionsRef V, FacesRef F) {
-  if (F.rows() == 0) return 0.0;
+  // Edges with a NaN or infinite end are left out: one bad coordinate would otherwise make the
+  // tolerances derived from this length NaN for the whole mesh, not just near the bad vertex.
   double sum = 0.0;
+  std::int64_t count = 0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int c = 0; c < 3; ++c) {
-      sum += (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+      const double length = (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+      if (std::isfinite(length)) {
+        sum += length;
+        ++count;
+      }
     }
   }
-  return sum / (3.0 * static_cast<double>(F.rows()));
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
 double bounding_box_diagonal(PositionsRef V) {
-  if (V.rows() == 0) return 0.0;
-  return (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  // Rows with a NaN or infinite coordinate are left out (Eigen's min/max are unspecified for
+  // NaN), so that clamping distances stay finite when a few vertices are broken.
+  Eigen::RowVector3d lo = Eigen::RowVector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::RowVector3d hi = -lo;
+  bool any = false;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (!V.row(i).allFinite()) continue;
+    lo = lo.cwiseMin(V.row(i));
+    hi = hi.cwiseMax(V.row(i));
+    any = true;
+  }
+  return any ? (hi - lo).norm() : 0.0;
 }
 
 }  // namespace focal

@@ -55,17 +55,19 @@ std::string read_whole_file(const std::filesystem::path& path) {
   return data;
 }
 
-void check_count_fits(const std::filesystem::path& path, std::uint64_t count,
-                      std::uint64_t min_bytes, std::uint64_t available, std::string_view what) {
+void check_count_fits(const std::filesystem::path& path, std::string_view where,
+                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                      std::string_view what) {
   // The last element of a text file may lack its separator, hence the +1.
   if (min_bytes > 0 && count > (available + 1) / min_bytes) {
-    fail(path, "header declares " + std::to_string(count) + " " + std::string(what) + " but the " +
-                   std::to_string(available) + " bytes that follow can hold at most " +
+    fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
+                   std::string(what) + " but the " + std::to_string(available) +
+                   " bytes that follow can hold at most " +
                    std::to_string((available + 1) / min_bytes));
   }
   if (count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
-    fail(path, "header declares " + std::to_string(count) + " " + std::string(what) +
-                   ", more than 32-bit indices can address");
+    fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
+                   std::string(what) + ", more than 32-bit indices can address");
   }
 }
 

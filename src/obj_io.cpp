@@ -219,10 +219,18 @@ class ObjReader {
 
 namespace io_detail {
 
-Mesh read_obj(const std::filesystem::path& path) {
-  const std::string text = read_whole_file(path);
-  return ObjReader(path).read(text);
+Mesh parse_obj(const std::filesystem::path& path, std::string_view data) {
+  // OBJ has no header, so a 0-byte file would read as a valid empty mesh; it is nearly always a
+  // failed export or copy, so it is reported like the empty files of the other formats.
+  if (data.empty()) fail(path, "empty file (0 bytes), expected OBJ data");
+  // A UTF-8 byte order mark (editors on Windows add one) would turn the first keyword into an
+  // unknown one, silently dropping the first vertex and shifting every index.
+  constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+  if (data.starts_with(kByteOrderMark)) data.remove_prefix(kByteOrderMark.size());
+  return ObjReader(path).read(data);
 }
+
+Mesh read_obj(const std::filesystem::path& path) { return parse_obj(path, read_whole_file(path)); }
 
 }  // namespace io_detail
 

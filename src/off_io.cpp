@@ -32,8 +32,9 @@ class OffReader {
     // purpose: it only has to stop a header claiming 1e12 vertices before allocation, while a
     // merely malformed file gets the precise message of the line where it goes wrong.
     const std::size_t rest = text_.size() - cursor_.offset();
-    io_detail::check_count_fits(path_, vertex_count, 2, rest, "vertices");
-    io_detail::check_count_fits(path_, face_count, 2, rest, "faces");
+    const std::string where = "line " + std::to_string(cursor_.line_number() + 1);
+    io_detail::check_count_fits(path_, where, vertex_count, 2, rest, "vertices");
+    io_detail::check_count_fits(path_, where, face_count, 2, rest, "faces");
 
     Mesh mesh;
     read_vertices(static_cast<Eigen::Index>(vertex_count), normals, mesh);
@@ -181,10 +182,11 @@ class OffReader {
 
 namespace io_detail {
 
-Mesh read_off(const std::filesystem::path& path) {
-  const std::string text = read_whole_file(path);
-  return OffReader(path, text).read();
+Mesh parse_off(const std::filesystem::path& path, std::string_view data) {
+  return OffReader(path, data).read();
 }
+
+Mesh read_off(const std::filesystem::path& path) { return parse_off(path, read_whole_file(path)); }
 
 }  // namespace io_detail
 

@@ -4,6 +4,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 
@@ -25,6 +26,17 @@ void parallel_for(std::int64_t n, int threads, Body&& body) {
   const int t = thread_count(threads);
 #pragma omp parallel for schedule(static) num_threads(t) if (t > 1 && n > 1024)
   for (std::int64_t i = 0; i < n; ++i) body(i);
+}
+
+/// Calls body(begin, end) for consecutive blocks [begin, end) of at most `block` elements that
+/// cover [0, n), in parallel as parallel_for. For loops that keep scratch memory per block
+/// rather than per element; block boundaries do not depend on the thread count.
+template <class Body>
+void parallel_for_blocks(std::int64_t n, std::int64_t block, int threads, Body&& body) {
+  const std::int64_t blocks = (n + block - 1) / block;
+  const int t = thread_count(threads);
+#pragma omp parallel for schedule(static) num_threads(t) if (t > 1 && n > 1024)
+  for (std::int64_t b = 0; b < blocks; ++b) body(b * block, std::min(n, (b + 1) * block));
 }
 
 }  // namespace focal::detail

@@ -293,7 +293,8 @@ class BinaryBody {
                      "file ends inside " + e.name + " " + std::to_string(complete) + " of " +
                          std::to_string(e.count));
     }
-    io_detail::check_count_fits(path_, e.count, min_bytes, remaining, e.name + " elements");
+    io_detail::check_count_fits(path_, "byte offset " + std::to_string(offset()), e.count,
+                                min_bytes, remaining, e.name + " elements");
   }
 
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
@@ -436,7 +437,8 @@ class AsciiBody {
     // has to stop a header claiming 1e12 vertices before allocation; a merely malformed file
     // gets the precise message of the line where it goes wrong.
     if (e.properties.empty()) return;
-    io_detail::check_count_fits(path_, e.count, 2, size_ - cursor_.offset(), e.name + " elements");
+    io_detail::check_count_fits(path_, "line " + std::to_string(cursor_.line_number() + 1), e.count,
+                                2, size_ - cursor_.offset(), e.name + " elements");
   }
 
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
@@ -787,11 +789,12 @@ void write_ply_body(io_detail::OutputSink& sink, const Mesh& mesh,
 
 namespace io_detail {
 
-Mesh read_ply(const std::filesystem::path& path) {
-  const std::string data = read_whole_file(path);
+Mesh read_ply(const std::filesystem::path& path) { return parse_ply(path, read_whole_file(path)); }
+
+Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
   const PlyHeader header = parse_header(path, data);
   if (header.encoding == PlyEncoding::ascii) {
-    AsciiBody body(path, std::string_view(data).substr(header.body_offset), header.body_line);
+    AsciiBody body(path, data.substr(header.body_offset), header.body_line);
     return read_body(path, header, body);
   }
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;

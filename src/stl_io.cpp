@@ -181,8 +181,9 @@ class AsciiStlReader {
 
 namespace io_detail {
 
-Mesh read_stl(const std::filesystem::path& path) {
-  const std::string data = read_whole_file(path);
+Mesh read_stl(const std::filesystem::path& path) { return parse_stl(path, read_whole_file(path)); }
+
+Mesh parse_stl(const std::filesystem::path& path, std::string_view data) {
   // Binary files often start with "solid" too, so the size is the deciding evidence: a binary
   // file is exactly 84 + 50 * (facet count in bytes 80..83) bytes long.
   if (data.size() >= kHeaderBytes + 4) {
@@ -194,7 +195,7 @@ Mesh read_stl(const std::filesystem::path& path) {
   }
   // Ascii STL never contains NUL bytes; binary data (zero attribute bytes) nearly always does,
   // so a binary file with a wrong size gets the size error rather than an ascii syntax error.
-  if (starts_with_solid(data) && data.find('\0') == std::string::npos) {
+  if (starts_with_solid(data) && data.find('\0') == std::string_view::npos) {
     return AsciiStlReader(path).read(data);
   }
   if (data.size() < kHeaderBytes + 4) {

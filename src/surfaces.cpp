@@ -582,7 +582,10 @@ void add_triangle(std::vector<Face>& faces, int a, int b, int c) {
 
 /// A (u, v) grid: rows of constant u, periodic directions wrapped, pole rows collapsed.
 Triangulated regular_grid(const ParameterDomain& d, int target, double log_aspect) {
-  const auto [nu, nv] = grid_size(d, target, log_aspect);
+  // Plain ints, not a structured binding: the lambda below captures them, which clang before 16
+  // rejects for bindings (the fuzz build uses clang 14).
+  const std::pair<int, int> size = grid_size(d, target, log_aspect);
+  const int nu = size.first, nv = size.second;
   const int columns = d.periodic_v ? nv : nv + 1;
   const int rows = d.periodic_u ? nu : nu + 1;
   const double du = (d.u_max - d.u_min) / nu, dv = (d.v_max - d.v_min) / nv;

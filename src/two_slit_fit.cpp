@@ -5,87 +5,12 @@
 #include <limits>
 #include <numbers>
 
-#include "curvature_detail.h"
+#include "two_slit_detail.h"
 
 namespace focal {
 namespace {
 
-double weight_at(std::span<const double> weights, std::size_t i) {
-  return weights.empty() ? 1.0 : weights[i];
-}
-
-SlitFit decompose(double a, double b, double c) {
-  const detail::Principal2 p = detail::principal_from_symmetric(a, b, c);
-  SlitFit fit;
-  fit.valid = true;
-  fit.k1 = p.k1;
-  fit.k2 = p.k2;
-  fit.d1 = p.d1;
-  fit.d2 = p.d2;
-  return fit;
-}
-
-/// sum_i w_i |W x_i - g_i|^2 for W = [a b; b c]: the paper's E, evaluated directly (no
-/// cancellation as in the expanded quadratic form).
-double energy_of_matrix(std::span<const NormalRay> rays, std::span<const double> weights, double a,
-                        double b, double c) {
-  double e = 0.0;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const NormalRay& r = rays[i];
-    const double ru = a * r.u + b * r.v - r.sigma;
-    const double rv = b * r.u + c * r.v - r.tau;
-    e += weight_at(weights, i) * (ru * ru + rv * rv);
-  }
-  return e;
-}
-
-/// Normal equations of min sum_i w_i |W x_i - g_i|^2 in w = (a, b, c): the rows of one ray are
-/// (u, v, 0) -> sigma and (0, u, v) -> tau.
-struct NormalEquations {
-  Eigen::Matrix3d lhs = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-  int rays = 0;
-};
-
-NormalEquations accumulate(std::span<const NormalRay> rays, std::span<const double> weights) {
-  NormalEquations eq;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const double w = weight_at(weights, i);
-    if (!(w > 0.0)) continue;
-    const NormalRay& r = rays[i];
-    const double uu = w * r.u * r.u, uv = w * r.u * r.v, vv = w * r.v * r.v;
-    eq.lhs(0, 0) += uu;
-    eq.lhs(0, 1) += uv;
-    eq.lhs(1, 1) += uu + vv;
-    eq.lhs(1, 2) += uv;
-    eq.lhs(2, 2) += vv;
-    eq.rhs += w * Eigen::Vector3d(r.u * r.sigma, r.v * r.sigma + r.u * r.tau, r.v * r.tau);
-    ++eq.rays;
-  }
-  eq.lhs(1, 0) = eq.lhs(0, 1);
-  eq.lhs(2, 1) = eq.lhs(1, 2);
-  return eq;
-}
-
-/// Solves the 3x3 system when it is well conditioned: det relative to (trace/3)^3, which is
-/// invariant to the scale of the mesh, above 1e-12.
-bool solve_well_conditioned(const NormalEquations& eq, Eigen::Vector3d& w) {
-  if (eq.rays < 2) return false;
-  const double scale = eq.lhs.trace() / 3.0;
-  const double det = eq.lhs.determinant();
-  if (!(scale > 0.0) || !(det > 1e-12 * scale * scale * scale)) return false;
-  w = eq.lhs.inverse() * eq.rhs;  // closed-form cofactor inverse for fixed 3x3 in Eigen
-  return w.allFinite();
-}
-
-SlitFit invalid_fit() {
-  SlitFit fit;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  fit.valid = false;
-  fit.k1 = fit.k2 = fit.energy = nan;
-  fit.d1 = fit.d2 = Eigen::Vector2d::Constant(nan);
-  return fit;
-}
+using detail::weight_at;
 
 // ---- The paper's Levenberg-Marquardt on (t, k1, k2). d1 = (-sin t, cos t), d2 = (cos t, sin t).
 
@@ -203,11 +128,7 @@ double two_slit_energy(std::span<const NormalRay> rays, std::span<const double> 
 
 SlitFit fit_two_slits_closed_form(std::span<const NormalRay> rays,
                                   std::span<const double> weights) {
-  Eigen::Vector3d w;
-  if (!solve_well_conditioned(accumulate(rays, weights), w)) return invalid_fit();
-  SlitFit fit = decompose(w[0], w[1], w[2]);
-  fit.energy = energy_of_matrix(rays, weights, w[0], w[1], w[2]);
-  return fit;
+  return detail::closed_form_fit(rays, weights);
 }
 
 SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
@@ -215,7 +136,9 @@ SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
                                           const LevenbergMarquardtOptions& options) {
   // Same well-posedness test as the closed form, so both solvers flag the same vertices.
   Eigen::Vector3d unused;
-  if (!solve_well_conditioned(accumulate(rays, weights), unused)) return invalid_fit();
+  if (!detail::solve_well_conditioned(detail::accumulate(rays, weights), unused)) {
+    return detail::invalid_fit();
+  }
   Params best;
   double best_energy = std::numeric_limits<double>::infinity();
   const int starts = std::max(options.initial_angles, 1);
@@ -228,7 +151,7 @@ SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
       best = p;
     }
   }
-  if (!std::isfinite(best_energy)) return invalid_fit();
+  if (!std::isfinite(best_energy)) return detail::invalid_fit();
   best = levenberg_marquardt(rays, weights, best, options);
   return to_fit(best, energy_of(rays, weights, best));
 }

@@ -1028,6 +1028,143 @@ TEST_F(MeshIo, MutatedFilesGiveAValidMeshOrAnIoError) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Dirty files (issue 6): empty, truncated anywhere, wrong byte order, bytes that are not UTF-8.
+// The readers are also fuzzed (fuzz/, scripts/fuzz.sh); these are the deterministic cases.
+
+TEST_F(MeshIo, EmptyFilesAreErrorsInEveryFormat) {
+  expect_io_error(write("empty.ply", ""), {"not a PLY file"});
+  expect_io_error(write("empty.off", ""), {"empty file"});
+  expect_io_error(write("empty.stl", ""), {"too short", "0 bytes"});
+  expect_io_error(write("empty.obj", ""), {"empty file (0 bytes)"});
+  // Text without geometry is an explicit empty mesh in OBJ, which has no header to require.
+  EXPECT_EQ(focal::read_mesh(write("comment.obj", "# nothing yet\n")).V.rows(), 0);
+}
+
+/// Every proper prefix of `data` but the one without just the final byte, read as `name`: either
+/// an IoError naming the file, or, when `prefix_ok`, a mesh whose vertices are the first ones of
+/// `full` and whose faces index only them. Returns how many prefixes were read as meshes.
+class MeshIoCut : public MeshIo {
+ protected:
+  int read_every_prefix(const std::string& name, const std::string& data, const Mesh& full,
+                        bool prefix_ok, std::size_t header_bytes) {
+    int meshes = 0;
+    for (std::size_t n = 0; n + 1 < data.size(); ++n) {
+      const fs::path p = write(name, data.substr(0, n));
+      try {
+        const Mesh m = focal::read_mesh(p);
+        EXPECT_TRUE(prefix_ok) << name << " cut at " << n << " was read";
+        if (!prefix_ok) continue;
+        EXPECT_LE(m.V.rows(), full.V.rows()) << n;
+        // Only the last vertex read may have lost digits at the cut ("1e-300" -> "1e-3").
+        const Eigen::Index whole = std::max<Eigen::Index>(m.V.rows() - 1, 0);
+        expect_same(m.V.topRows(whole), full.V.topRows(whole));
+        if (m.F.size() > 0) {
+          EXPECT_LT(m.F.maxCoeff(), m.V.rows()) << n;
+        }
+        ++meshes;
+      } catch (const focal::IoError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind(p.string() + ": ", 0), 0u) << message;
+        // Past the header the message says where: a line (text) or a byte offset (binary).
+        if (n > header_bytes) {
+          EXPECT_TRUE(message.find(": line ") != std::string::npos ||
+                      message.find(": byte offset ") != std::string::npos)
+              << name << " cut at " << n << ": " << message;
+        }
+      }
+    }
+    return meshes;
+  }
+};
+
+TEST_F(MeshIoCut, FilesCutAtEveryByteAreErrorsThatSayWhere) {
+  const Mesh m = sample_mesh(true);
+  // Formats that declare their counts: any cut but the final line break is an error.
+  focal::write_ply(file("full.ply"), m);
+  const std::string binary = slurp(file("full.ply"));
+  read_every_prefix("cut.ply", binary, m, false, binary.find("end_header") + 11);
+  focal::write_ply(file("full.ply"), m, {}, ascii_options());
+  const std::string ascii = slurp(file("full.ply"));
+  read_every_prefix("cut.ply", ascii, m, false, ascii.find("end_header") + 11);
+  focal::write_off(file("full.off"), m);
+  const std::string off = slurp(file("full.off"));
+  read_every_prefix("cut.off", off, m, false, off.find('\n', 5) + 1);
+  Mesh soup;  // STL: three corners per facet
+  soup.V = rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  read_every_prefix("cut.stl", binary_stl("b", {{0, 0, 0, 1, 0, 0, 0, 1, 0}}).data, soup, false,
+                    84);
+  // OBJ has no counts: a cut at a line end is a shorter valid file, one inside a line an error.
+  focal::write_obj(file("full.obj"), m);
+  const std::string obj = slurp(file("full.obj"));
+  EXPECT_GT(read_every_prefix("cut.obj", obj, m, true, 0), 0);
+  // Ascii STL: only cuts in the final `endsolid` line (a solid without its end) can be read.
+  Mesh two;
+  two.V = rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0.05}, {0, 1, 0}});
+  const std::string stl = kAsciiStl;
+  const int read = read_every_prefix("cut.stl", stl, two, true, std::strlen("solid"));
+  EXPECT_LE(read, static_cast<int>(std::string("endsolid two").size()));
+}
+
+TEST_F(MeshIo, BinaryPlyInTheWrongByteOrder) {
+  // Declared big endian, written little endian: the face indices come out byte-swapped (index 1
+  // reads as 16777216) and are rejected with the face and its byte offset.
+  std::string swapped = slurp([&] {
+    focal::write_ply(file("le.ply"), sample_mesh(false));
+    return file("le.ply");
+  }());
+  swapped.replace(swapped.find("binary_little_endian"), 20, "binary_big_endian");
+  expect_io_error(write("swapped.ply", swapped),
+                  {"byte offset", "face 0 refers to vertex 16777216 but there are 5 vertices"});
+  // Without faces nothing in the file can tell: the positions are read byte-swapped, as declared.
+  Bytes le;
+  le.text(
+      "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n");
+  le.put(1.0).put(2.0).put(0.0);
+  const Mesh m = focal::read_mesh(write("cloud.ply", le.data));
+  const auto swap = [](double v) {
+    std::array<char, 8> b;
+    std::memcpy(b.data(), &v, 8);
+    std::reverse(b.begin(), b.end());
+    std::memcpy(&v, b.data(), 8);
+    return v;
+  };
+  expect_same(m.V, rows({{swap(1.0), swap(2.0), 0.0}}));
+}
+
+TEST_F(MeshIo, BytesThatAreNotUtf8) {
+  // In comments, names and ignored statements they are skipped like any other byte...
+  const Mesh obj = focal::read_mesh(
+      write("latin1.obj", "# caf\xe9\ng gr\xfc\xdf\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_EQ(obj.F.rows(), 1);
+  const Mesh ply = focal::read_mesh(
+      write("latin1.ply",
+            "ply\nformat ascii 1.0\ncomment \xff\xfe\nelement vertex 1\nproperty float x\n"
+            "property float y\nproperty float z\nproperty float \xe9t\xe9\n"
+            "end_header\n1 2 3 4\n"));
+  expect_same(ply.V, rows({{1, 2, 3}}));
+  const Mesh stl =
+      focal::read_mesh(write("latin1.stl", std::string(kAsciiStl).replace(6, 3, "\xe9\xe9\xe9")));
+  EXPECT_EQ(stl.V.rows(), 6);
+  // ...and where a number or keyword belongs they are an error that names the line.
+  expect_io_error(write("v.obj", "v 0 0 0\nv 1 \xff 0\n"), {"line 2", "is not a number"});
+  expect_io_error(write("v.off", "OFF\n1 0 0\n0 \xc3\xa9 0\n"), {"line 3"});
+  expect_io_error(write("v.ply",
+                        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                        "property float y\nproperty float z\nend_header\n1 \x80 3\n"),
+                  {"line 8", "is not a number"});
+  expect_io_error(write("k.ply",
+                        "ply\nformat ascii 1.0\n\xef\xbb\xbf"
+                        "element vertex 0\nend_header\n"),
+                  {"line 3", "unknown header keyword"});
+  // A UTF-8 byte order mark before an OBJ file is skipped: the first vertex must not be lost.
+  const Mesh bom =
+      focal::read_mesh(write("bom.obj", "\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_EQ(bom.V.rows(), 3);
+  expect_faces(bom, {{0, 1, 2}}, {0});
+}
+
+// ---------------------------------------------------------------------------------------------
 // Speed (run on demand: mesh_io_test --gtest_also_run_disabled_tests --gtest_filter='*Speed*')
 
 TEST_F(MeshIo, DISABLED_SpeedBinaryPly1MVertices2MFaces) {

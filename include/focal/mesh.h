@@ -41,10 +41,12 @@ struct Mesh {
 /// N has #V rows. `what` names the caller in the message.
 void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what);
 
-/// Mean length of the triangle edges (each undirected edge once per incident face); 0 for no faces.
+/// Mean length of the triangle edges (each undirected edge once per incident face). Edges with a
+/// NaN or infinite length are left out; 0 when no edge is left.
 [[nodiscard]] double mean_edge_length(PositionsRef V, FacesRef F);
 
-/// Length of the diagonal of the axis-aligned bounding box of V; 0 for no vertices.
+/// Length of the diagonal of the axis-aligned bounding box of the rows of V whose coordinates are
+/// all finite; 0 when there are none.
 [[nodiscard]] double bounding_box_diagonal(PositionsRef V);
 
 }  // namespace focal

@@ -403,6 +403,61 @@ check_within "the other 12 rows: k1, k2 = 1 within 1e-6" "$(max_dev iso_others.c
 check "the other 12 rows are umbilic" test "$(classes iso_others.csv)" = "umbilic=12 "
 
 # ---------------------------------------------------------------------------------------------
+# Dirty input: one Warning: line counting the problems, affected rows undefined, --strict errors
+run curvature iso.obj -o iso2.csv
+check "isolated vertex: exactly one Warning: line, naming the file and the count" \
+  bash -c '[[ $(grep -c "^Warning: " "$1") -eq 1 ]] && grep -q "^Warning: iso.obj: found 1 unreferenced vertex (--strict" "$1"' _ "$ERR"
+check "the warning changes nothing in the output" cmp -s iso.csv iso2.csv
+expect_error "--strict on the isolated vertex: exit 2" 2 "iso.obj: --strict: 1 unreferenced vertex" iso3.csv \
+  curvature iso.obj -o iso3.csv --strict
+expect_error "focal-mesh --strict: exit 2, no focal mesh" 2 "--strict" isof.focal1.ply focal-mesh iso.obj -o isof --strict
+check "focal-mesh --strict writes no focal2 either" test ! -e isof.focal2.ply
+run curvature s.ply -o strict.csv --strict
+check "--strict on the clean sphere: exit 0, no warning, same output" \
+  bash -c '[[ $1 -eq 0 && ! -s $2 ]] && cmp -s strict.csv c.csv' _ "$rc" "$ERR"
+
+# A NaN coordinate (vertex 2) and a duplicate face: the run completes, vertex 2 is undefined.
+printf 'OFF\n5 5 0\n0 0 0\n1 0 0\nnan 1 0\n0 1 0\n0.5 0.5 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n3 0 1 4\n' >nan.off
+run curvature nan.off -o nan.csv
+check "NaN coordinate: exit 0, 5 rows" bash -c '[[ $1 -eq 0 && $2 -eq 5 ]]' _ "$rc" "$(data_rows nan.csv)"
+check "NaN coordinate: the warning counts it and the duplicate face" \
+  grep -q "^Warning: nan.off: found 1 non-finite vertex, 1 duplicate face" "$ERR"
+check "NaN coordinate: row 2 is all nan with class undefined" \
+  test "$(sed -n 4p nan.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined"
+expect_error "NaN coordinate with --strict: exit 2" 2 "1 non-finite vertex" nan2.csv curvature nan.off -o nan2.csv --strict
+
+# File normals that are not unit length are normalised, and counted in the summary.
+printf 'NOFF\n3 1\n0 0 0 0 0 2\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n' >long.off
+run curvature long.off -o long.csv
+check "non-unit normal: exit 0, counted, and every vertex flat" \
+  bash -c '[[ $1 -eq 0 && $3 == "flat=3 " ]] && grep -q "^Warning: long.off: found 1 non-unit normal" "$2"' _ "$rc" "$ERR" "$(classes long.csv)"
+
+# A single triangle without normals: nothing to report, three flat vertices.
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >one.off
+run curvature one.off -o one.csv --strict
+check "single triangle: exit 0 with --strict, no warning, 3 flat rows" \
+  bash -c '[[ $1 -eq 0 && ! -s $2 && $3 == "flat=3 " ]]' _ "$rc" "$ERR" "$(classes one.csv)"
+
+# Unwritable output: a folder in the way; nothing is left behind.
+mkdir -p taken.csv
+expect_error "output path is a folder: exit 2" 2 "taken.csv" taken.csv/x curvature s.ply -o taken.csv
+
+# ---------------------------------------------------------------------------------------------
+# Determinism: byte-identical files for FOCAL_NUM_THREADS=1 and 2, both methods, all outputs.
+# The irregular torus has 3000 vertices, above the size from which loops run in parallel.
+for method in vertex triangle; do
+  for n in 1 2; do
+    FOCAL_NUM_THREADS=$n "$FOCAL" curvature torus.ply -o "det-$method-$n.csv" --method "$method" >/dev/null 2>&1 || true
+    FOCAL_NUM_THREADS=$n "$FOCAL" curvature torus.ply -o "det-$method-$n.ply" --method "$method" --rings 2 >/dev/null 2>&1 || true
+    FOCAL_NUM_THREADS=$n "$FOCAL" focal-mesh torus.ply -o "det-$method-$n" --method "$method" >/dev/null 2>&1 || true
+  done
+  for out in csv ply focal1.ply focal2.ply; do
+    check "FOCAL_NUM_THREADS=1 and 2 give identical $out files (--method $method)" \
+      bash -c '[[ -s $1 ]] && cmp -s "$1" "$2"' _ "det-$method-1.$out" "det-$method-2.$out"
+  done
+done
+
+# ---------------------------------------------------------------------------------------------
 # Focal meshes
 run focal-mesh s.ply -o pre
 check "focal-mesh exits 0 and reports both files" \
@@ -440,6 +495,16 @@ run -v focal-mesh s.ply -o pv
 check "-v focal-mesh: stage timings include the focal meshes" stages_ok "$ERR" read curvature "focal meshes" write
 run -v generate sphere -o gv.ply
 check "-v generate: a generate timing" stages_ok "$ERR" generate
+
+# eval: every estimator on every analytic case (8 surfaces x 2 triangulations x 3 noise models)
+run eval --vertices 300 --csv ev.csv --markdown ev.md
+check "eval: exit 0" test "$rc" -eq 0
+check "eval: 48 cases x 10 estimators in the CSV" test "$(data_rows ev.csv)" -eq 480
+check "eval: the Markdown table has a row per case" test "$(grep -c '^| [a-z-]*, ' ev.md)" -eq 48
+check "eval: exact on the clean sphere (relative H error below 1e-9)" \
+  awk -F, '$1 == "sphere" && $3 == "clean" && $4 == "focal closed-form 1-ring / file normals" { found = 1; if (!($7 + 0 < 1e-9)) exit 1 } END { exit !found }' ev.csv
+run eval --markdown ev.txt
+check "eval: a wrong report extension is a usage error" test "$rc" -eq 1
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -1,0 +1,43 @@
+#include "bench_meshes.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+
+#include "focal/mesh_io.h"
+#include "focal/surfaces.h"
+
+namespace focal::bench {
+
+namespace {
+
+std::filesystem::path cache_dir() {
+  const char* dir = std::getenv("FOCAL_BENCH_DATA");
+  return dir != nullptr ? dir : "build/bench-data";
+}
+
+}  // namespace
+
+const Mesh& torus(int vertices) {
+  static std::map<int, Mesh> meshes;
+  if (auto it = meshes.find(vertices); it != meshes.end()) return it->second;
+  const auto path = cache_dir() / ("torus-" + std::to_string(vertices) + ".ply");
+  Mesh mesh;
+  if (std::filesystem::exists(path)) {
+    mesh = read_mesh(path);
+  } else {
+    SurfaceOptions o;
+    o.kind = SurfaceKind::torus;
+    o.target_vertices = vertices;
+    mesh = make_surface(o).mesh;
+    std::filesystem::create_directories(cache_dir());
+    write_ply(path, mesh);
+  }
+  return meshes.emplace(vertices, std::move(mesh)).first->second;
+}
+
+void use_threads(int threads) {
+  setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+}
+
+}  // namespace focal::bench

@@ -1,0 +1,18 @@
+#pragma once
+// Meshes for the kernel benchmarks: regular tori generated with make_surface, cached as binary
+// PLY under build/bench-data (FOCAL_BENCH_DATA) so that a run does not regenerate them.
+
+#include <string>
+
+#include "focal/mesh.h"
+
+namespace focal::bench {
+
+/// The regular torus of about `vertices` vertices with exact normals, loaded from the cache or
+/// generated and cached. Meshes stay in memory for the rest of the run (one per size).
+const Mesh& torus(int vertices);
+
+/// Sets FOCAL_NUM_THREADS, which every library loop without a `threads` option reads.
+void use_threads(int threads);
+
+}  // namespace focal::bench

@@ -1,0 +1,148 @@
+// Google Benchmark of the pipeline's stages on regular tori of 10K to 1M vertices, on 1 and 2
+// threads. Rates are per wall-clock second (UseRealTime: the work runs on OpenMP threads).
+// Run: build/bench/bench/focal_kernels_bench (make bench runs it with the whole-run script).
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "bench_meshes.h"
+#include "curvature_detail.h"
+#include "focal/curvature.h"
+#include "focal/fields_io.h"
+#include "focal/focal_mesh.h"
+#include "focal/mesh_io.h"
+#include "focal/neighbourhood.h"
+#include "focal/normals.h"
+#include "focal/triangle_curvature.h"
+
+namespace focal::bench {
+namespace {
+
+// Arguments of every benchmark: {vertices, threads}.
+void sizes_and_threads(benchmark::internal::Benchmark* b) {
+  for (int n : {10'000, 100'000, 1'000'000}) {
+    for (int t : {1, 2}) b->Args({n, t});
+  }
+  b->ArgNames({"vertices", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
+const Mesh& setup(benchmark::State& state) {
+  use_threads(static_cast<int>(state.range(1)));
+  return torus(static_cast<int>(state.range(0)));
+}
+
+void per_vertex(benchmark::State& state, const Mesh& m) {
+  state.counters["vertices/s"] =
+      benchmark::Counter(static_cast<double>(m.V.rows()), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_Normals(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  for (auto _ : state) benchmark::DoNotOptimize(vertex_normals(m.V, m.F, NormalWeighting::max));
+  per_vertex(state, m);
+}
+BENCHMARK(BM_Normals)->Apply(sizes_and_threads);
+
+void BM_Adjacency(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  for (auto _ : state) benchmark::DoNotOptimize(vertex_adjacency(static_cast<int>(m.V.rows()), m.F));
+  per_vertex(state, m);
+}
+BENCHMARK(BM_Adjacency)->Apply(sizes_and_threads);
+
+void BM_TwoRing(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  for (auto _ : state) benchmark::DoNotOptimize(k_ring(one, 2));
+  per_vertex(state, m);
+}
+BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
+
+// The fit step alone (issue 5 target: 20 M vertices/s on 2 threads, closed form, 1-ring):
+// rays, normal equations, solve, eigen-decomposition, residual and the result arrays.
+void fit_step(benchmark::State& state, CurvatureOptions o) {
+  const Mesh& m = setup(state);
+  o.threads = static_cast<int>(state.range(1));
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings);
+  const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F)};
+  for (auto _ : state) benchmark::DoNotOptimize(detail::fit_vertices(in, o));
+  per_vertex(state, m);
+}
+
+CurvatureOptions with_rings(int rings) {
+  CurvatureOptions o;
+  o.rings = rings;
+  return o;
+}
+
+void BM_FitClosedForm(benchmark::State& state) { fit_step(state, {}); }
+BENCHMARK(BM_FitClosedForm)->Apply(sizes_and_threads);
+
+void BM_FitClosedForm2Ring(benchmark::State& state) { fit_step(state, with_rings(2)); }
+BENCHMARK(BM_FitClosedForm2Ring)->Apply(sizes_and_threads);
+
+void BM_FitLevenbergMarquardt(benchmark::State& state) {
+  CurvatureOptions o;
+  o.solver = Solver::levenberg_marquardt;
+  fit_step(state, o);
+}
+BENCHMARK(BM_FitLevenbergMarquardt)->Args({10'000, 1})->Args({10'000, 2})->ArgNames({"vertices", "threads"})
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// estimate_curvature as the library user calls it: unit normals, 1-ring, mean edge length, fit.
+void BM_EstimateCurvature(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  CurvatureOptions o;
+  o.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, m.N, o));
+  per_vertex(state, m);
+}
+BENCHMARK(BM_EstimateCurvature)->Apply(sizes_and_threads);
+
+// The per-triangle path (issue 5 target: 50 M faces/s on 2 threads).
+void BM_TriangleCurvature(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  CurvatureOptions o;
+  o.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(triangle_curvature(m.V, m.F, m.N, o));
+  state.counters["faces/s"] = benchmark::Counter(static_cast<double>(m.F.rows()),
+                                                 benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_TriangleCurvature)->Apply(sizes_and_threads);
+
+void BM_FocalMeshes(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
+  for (auto _ : state) benchmark::DoNotOptimize(focal_meshes(m.V, m.F, m.N, c));
+  per_vertex(state, m);
+}
+BENCHMARK(BM_FocalMeshes)->Apply(sizes_and_threads);
+
+void BM_WriteCurvaturePly(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
+  const auto path = std::filesystem::temp_directory_path() / "focal-bench-write.ply";
+  for (auto _ : state) write_curvature_ply(path, m, c);
+  std::filesystem::remove(path);
+  per_vertex(state, m);
+}
+BENCHMARK(BM_WriteCurvaturePly)->Apply(sizes_and_threads);
+
+void BM_ReadPly(benchmark::State& state) {
+  const Mesh& m = setup(state);
+  const auto path = std::filesystem::temp_directory_path() / "focal-bench-read.ply";
+  write_ply(path, m);
+  for (auto _ : state) benchmark::DoNotOptimize(read_mesh(path));
+  std::filesystem::remove(path);
+  per_vertex(state, m);
+}
+BENCHMARK(BM_ReadPly)->Apply(sizes_and_threads);
+
+}  // namespace
+}  // namespace focal::bench
+
+BENCHMARK_MAIN();

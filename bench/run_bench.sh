@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Whole `focal curvature IN -o OUT.ply` runs (read, normals, 1-ring, fit, write binary PLY) on
+# generated tori and on the Stanford bunny midpoint-subdivided to size, 10K to 10M vertices, on
+# 1 and 2 threads. Prints a markdown table: the fastest of REPS runs (wall time, vertices/s and
+# its -v stage times) and the largest peak RSS of them (/usr/bin/time -v).
+#
+# Usage: bench/run_bench.sh [BUILD_DIR]   (default build/bench; needs cli/focal and
+#        bench/focal_subdivide there). Environment: FOCAL_BENCH_REPS (default 3),
+#        FOCAL_BENCH_MAX (largest size, default 10000000), FOCAL_BENCH_DATA (mesh cache,
+#        default build/bench-data).
+set -euo pipefail
+
+build=${1:-build/bench}
+focal=$build/cli/focal
+subdivide=$build/bench/focal_subdivide
+data=${FOCAL_BENCH_DATA:-build/bench-data}
+reps=${FOCAL_BENCH_REPS:-3}
+max=${FOCAL_BENCH_MAX:-10000000}
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+mkdir -p "$data"
+
+# Generated meshes are cached: the 10M torus takes seconds to make and 740 MB to keep.
+torus() {
+  local n=$1 path=$data/torus-$1.ply
+  [[ -f $path ]] || "$focal" generate torus --vertices "$n" -o "$path" >&2
+  echo "$path"
+}
+
+bunny() {
+  local level=$1 path=$data/bunny-sub$1.ply
+  if [[ ! -f $path ]]; then
+    [[ -f $data/bunny.off ]] ||
+      tar -xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/bunny00.off >"$data/bunny.off"
+    "$subdivide" "$data/bunny.off" "$path" "$level" >&2
+  fi
+  echo "$path"
+}
+
+vertex_count() { grep -a -m1 '^element vertex' "$1" | awk '{print $3}'; }
+
+# One run: prints "wall_s rss_kb read_ms check_ms normals_ms curvature_ms write_ms" (a stage
+# the command does not report prints as 0).
+run_once() {
+  local mesh=$1 threads=$2
+  /usr/bin/time -v -o "$scratch/time" \
+    "$focal" -v curvature "$mesh" -o "$scratch/out.ply" --threads "$threads" 2>"$scratch/log" >/dev/null
+  local wall rss
+  wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, t, ":"); s = 0;
+         for (i = 1; i <= n; i++) s = s * 60 + t[i]; print s}' "$scratch/time")
+  rss=$(awk -F': ' '/Maximum resident set size/ {print $2}' "$scratch/time")
+  # The final "  name: 123.4 ms" line of a stage, not its "running for" progress lines.
+  stage() { awk -v s="$1:" '$1 == s && $NF == "ms" {t = $2} END {print t + 0}' "$scratch/log"; }
+  echo "$wall $rss $(stage read) $(stage check) $(stage normals) $(stage curvature) $(stage write)"
+}
+
+report() {
+  local name=$1 mesh=$2 threads=$3 n best="" best_rss=0
+  n=$(vertex_count "$mesh")
+  for ((r = 0; r < reps; r++)); do
+    local line
+    line=$(run_once "$mesh" "$threads")
+    read -r wall rss _ <<<"$line"
+    ((rss > best_rss)) && best_rss=$rss
+    if [[ -z $best ]] || awk -v a="$wall" -v b="${best%% *}" 'BEGIN {exit !(a < b)}'; then
+      best=$line
+    fi
+  done
+  read -r wall _ t_read t_check t_normals t_curv t_write <<<"$best"
+  awk -v name="$name" -v n="$n" -v t="$threads" -v w="$wall" -v rss="$best_rss" \
+    -v a="$t_read" -v k="$t_check" -v b="$t_normals" -v c="$t_curv" -v d="$t_write" 'BEGIN {
+      printf "| %-10s | %9d | %d | %6.2f | %5.2f | %6.0f | %5.0f | %5.0f | %5.0f | %5.0f | %5.0f |\n",
+             name, n, t, w, n / w / 1e6, rss / 1024, a, k, b, c, d }'
+}
+
+echo "Whole runs: focal -v curvature IN -o OUT.ply --threads T; fastest of $reps (wall), largest peak RSS"
+echo
+echo "Stage columns in ms, from -v of the fastest run."
+echo
+echo "| mesh       |  vertices | T | wall s | M v/s | RSS MB |  read | check | normals | curvature | write |"
+echo "|------------|----------:|--:|-------:|------:|-------:|------:|------:|------:|------:|------:|"
+for n in 10000 100000 1000000 10000000; do
+  ((n <= max)) || continue
+  mesh=$(torus "$n")
+  for t in 1 2; do report "torus" "$mesh" "$t"; done
+done
+for level in 0 1 2 3 4; do
+  ((37706 * 4 ** level <= max * 1)) || continue
+  mesh=$(bunny "$level")
+  for t in 1 2; do report "bunny/$level" "$mesh" "$t"; done
+done

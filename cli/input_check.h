@@ -1,0 +1,18 @@
+#pragma once
+// The findings summary of `focal curvature` and `focal focal-mesh`: one `Warning:` line that
+// counts what is wrong with the input mesh, or with --strict an error before any work.
+
+#include <string>
+
+#include "focal/mesh.h"
+#include "log.h"
+
+namespace focal::cli {
+
+/// Checks the mesh (and the normals the run will use, `normals` with 0 rows when they are
+/// estimated from the faces) and prints "Warning: <file>: <counts>" when anything was found.
+/// \throw InvalidInput naming the file and the counts when `strict` and anything was found.
+void check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name, bool strict,
+                 const Log& log);
+
+}  // namespace focal::cli

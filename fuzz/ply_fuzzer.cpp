@@ -1,0 +1,6 @@
+// libFuzzer target for the PLY reader (scripts/fuzz.sh builds and runs it; seeds in corpus/ply/).
+#include "fuzz_reader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  return focal::fuzz::check_reader(&focal::io_detail::parse_ply, "fuzz.ply", data, size);
+}
