@@ -63,4 +63,11 @@ void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> col
   });
 }
 
+void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
+    sink.buffer().append(text);
+    sink.maybe_flush();
+  });
+}
+
 }  // namespace focal

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -93,5 +94,9 @@ struct CsvColumn {
 /// Writes a header line with the column names, then one row per element.
 /// \throw InvalidInput when the columns differ in length; IoError on write failure.
 void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns);
+
+/// Writes a text file (a report, a Markdown table) through the same temporary-file-and-rename
+/// path as the other writers. \throw IoError on write failure.
+void write_text_file(const std::filesystem::path& path, std::string_view text);
 
 }  // namespace focal
