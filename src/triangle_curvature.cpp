@@ -10,6 +10,7 @@
 #include "focal/error.h"
 #include "focal/normal_rays.h"
 #include "parallel.h"
+#include "topology_incidence.h"
 
 namespace focal {
 namespace {
@@ -108,26 +109,6 @@ void solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerance
   r.point_class[i] = static_cast<std::uint8_t>(classify(k1, k2, tol.zero, tol.umbilic));
 }
 
-/// Faces incident to each vertex, CSR, in increasing face order (deterministic sums).
-struct Incidence {
-  std::vector<int> offsets, faces;
-};
-
-Incidence vertex_faces(Eigen::Index n, FacesRef F) {
-  Incidence inc;
-  inc.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) ++inc.offsets[F(f, c) + 1];
-  }
-  for (Eigen::Index i = 0; i < n; ++i) inc.offsets[i + 1] += inc.offsets[i];
-  inc.faces.resize(static_cast<std::size_t>(inc.offsets.back()));
-  std::vector<int> fill(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) inc.faces[fill[F(f, c)]++] = static_cast<int>(f);
-  }
-  return inc;
-}
-
 /// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
 /// both normals lie in each other's hemisphere here).
 Eigen::Vector3d rotate_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -182,7 +163,7 @@ CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, Norm
   const TriangleCurvatureResult faces = triangle_curvature(V, F, N, options);
   std::vector<char> ok;
   const RowMatrixX3d unit = detail::unit_rows(N, ok);
-  const Incidence inc = vertex_faces(V.rows(), F);
+  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F);
   const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
   CurvatureResult r = detail::undefined_result(V.rows());
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
@@ -192,7 +173,7 @@ CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, Norm
     parts.clear();
     Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
     double area = 0.0;
-    for (int k = inc.offsets[i]; k < inc.offsets[i + 1]; ++k) {
+    for (int k = inc.begin(i); k < inc.end(i); ++k) {
       const int f = inc.faces[k];
       if (faces.point_class[f] == static_cast<std::uint8_t>(PointClass::undefined) ||
           !(faces.face_normal.row(f).dot(frame.n) > 0.0)) {
