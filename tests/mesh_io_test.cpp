@@ -257,6 +257,13 @@ TEST_F(MeshIo, UnreadableFileIsAnIoError) {
   fs::permissions(p, fs::perms::owner_all);
 }
 
+// A path that no user can open, root included (CI runs as root, where the permission test above
+// skips): a regular file used as a folder (ENOTDIR).
+TEST_F(MeshIo, PathThroughAFileIsAnIoError) {
+  const fs::path plain = write("plain.obj", "v 0 0 0\n");
+  expect_io_error(plain / "inner.obj", {"inner.obj"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Round trips through the writers
 
