@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "focal/error.h"
 #include "focal/mesh_io.h"
@@ -228,48 +229,31 @@ T load(const unsigned char* p, bool swap) {
   return value;
 }
 
-double load_double(const unsigned char* p, Scalar t, bool swap) {
+/// A binary scalar of type t converted to Out. Integer reads (indices, list counts) only see
+/// integer types: the header parser rejects float index and count types.
+template <class Out>
+Out load_as(const unsigned char* p, Scalar t, bool swap) {
   switch (t) {
     case Scalar::int8:
-      return load<std::int8_t>(p, swap);
+      return static_cast<Out>(load<std::int8_t>(p, swap));
     case Scalar::uint8:
-      return load<std::uint8_t>(p, swap);
+      return static_cast<Out>(load<std::uint8_t>(p, swap));
     case Scalar::int16:
-      return load<std::int16_t>(p, swap);
+      return static_cast<Out>(load<std::int16_t>(p, swap));
     case Scalar::uint16:
-      return load<std::uint16_t>(p, swap);
+      return static_cast<Out>(load<std::uint16_t>(p, swap));
     case Scalar::int32:
-      return load<std::int32_t>(p, swap);
+      return static_cast<Out>(load<std::int32_t>(p, swap));
     case Scalar::uint32:
-      return load<std::uint32_t>(p, swap);
+      return static_cast<Out>(load<std::uint32_t>(p, swap));
     case Scalar::float32:
-      return load<float>(p, swap);
+      if constexpr (std::is_floating_point_v<Out>) return static_cast<Out>(load<float>(p, swap));
+      break;
     case Scalar::float64:
-      return load<double>(p, swap);
-  }
-  return 0.0;
-}
-
-/// Integer types only (checked in the header).
-std::int64_t load_int(const unsigned char* p, Scalar t, bool swap) {
-  switch (t) {
-    case Scalar::int8:
-      return load<std::int8_t>(p, swap);
-    case Scalar::uint8:
-      return load<std::uint8_t>(p, swap);
-    case Scalar::int16:
-      return load<std::int16_t>(p, swap);
-    case Scalar::uint16:
-      return load<std::uint16_t>(p, swap);
-    case Scalar::int32:
-      return load<std::int32_t>(p, swap);
-    case Scalar::uint32:
-      return load<std::uint32_t>(p, swap);
-    case Scalar::float32:
-    case Scalar::float64:
+      if constexpr (std::is_floating_point_v<Out>) return static_cast<Out>(load<double>(p, swap));
       break;
   }
-  return 0;
+  return Out{0};
 }
 
 class BinaryBody {
@@ -309,7 +293,7 @@ class BinaryBody {
         require(scalar_size(prop.type), e, i, start);
         const int role = roles[k];
         if (role >= 0) {
-          const double value = load_double(p_, prop.type, swap_);
+          const double value = load_as<double>(p_, prop.type, swap_);
           if (role < 3) {
             V[3 * i + role] = value;
           } else {
@@ -347,7 +331,7 @@ class BinaryBody {
         require(static_cast<std::size_t>(n) * item, e, f, start);
         corners.resize(static_cast<std::size_t>(n));
         for (std::int64_t c = 0; c < n; ++c) {
-          const std::int64_t v = load_int(p_, prop.type, swap_);
+          const std::int64_t v = load_as<std::int64_t>(p_, prop.type, swap_);
           if (v < 0 || v >= vertex_count) {
             fail_at_offset(path_, offset_of(start),
                            "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
@@ -399,7 +383,7 @@ class BinaryBody {
   std::int64_t read_count(const PlyProperty& prop, const PlyElement& e, std::uint64_t index,
                           const unsigned char* start) {
     require(scalar_size(prop.count_type), e, index, start);
-    const std::int64_t n = load_int(p_, prop.count_type, swap_);
+    const std::int64_t n = load_as<std::int64_t>(p_, prop.count_type, swap_);
     p_ += scalar_size(prop.count_type);
     if (n < 0) {
       fail_at_offset(

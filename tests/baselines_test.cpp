@@ -27,13 +27,8 @@ std::vector<Baseline> baselines_under_test() {
            [](PositionsRef V, FacesRef F) { return baselines::cohen_steiner_morvan_2003(V, F); }}};
 }
 
-AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices) {
-  SurfaceOptions o;
-  o.kind = kind;
-  o.triangulation = tri;
-  o.target_vertices = vertices;
-  o.seed = 42;
-  return make_surface(o);
+AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices, double a = 0) {
+  return test::analytic_surface(kind, tri, vertices, a, 42);
 }
 
 double rms_k_error(const CurvatureResult& r, const AnalyticSurface& s, const std::vector<int>& at) {

@@ -20,13 +20,7 @@ using test::rms;
 using test::rms_error;
 
 AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices, double a = 0) {
-  SurfaceOptions o;
-  o.kind = kind;
-  o.triangulation = tri;
-  o.target_vertices = vertices;
-  o.a = a;
-  o.seed = 42;
-  return make_surface(o);
+  return test::analytic_surface(kind, tri, vertices, a, 42);
 }
 
 CurvatureOptions with(Solver solver, int rings = 1, RayWeighting w = RayWeighting::uniform) {

@@ -23,7 +23,8 @@ CurvatureResult as_estimate(const AnalyticSurface& s, double scale) {
   r.K = r.k1.cwiseProduct(r.k2);
   r.d1 = s.d1;
   r.d2 = s.d2;
-  r.point_class = VectorXu8::Constant(s.k1.size(), static_cast<std::uint8_t>(PointClass::hyperbolic));
+  r.point_class =
+      VectorXu8::Constant(s.k1.size(), static_cast<std::uint8_t>(PointClass::hyperbolic));
   return r;
 }
 

@@ -14,13 +14,8 @@
 namespace focal {
 namespace {
 
-AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices) {
-  SurfaceOptions o;
-  o.kind = kind;
-  o.triangulation = tri;
-  o.target_vertices = vertices;
-  o.seed = 3;
-  return make_surface(o);
+AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices, double a = 0) {
+  return test::analytic_surface(kind, tri, vertices, a, 3);
 }
 
 /// A CurvatureResult holding the exact principal curvatures of an analytic surface.

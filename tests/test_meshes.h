@@ -6,6 +6,7 @@
 
 #include "focal/mesh.h"
 #include "focal/neighbourhood.h"
+#include "focal/surfaces.h"
 
 namespace focal::test {
 
@@ -30,6 +31,19 @@ inline Mesh flat_grid(int n, double spacing = 1.0) {
     }
   }
   return m;
+}
+
+/// An analytic surface with the given triangulation, about `vertices` vertices, first shape
+/// parameter `a` (0 = default) and seed.
+inline AnalyticSurface analytic_surface(SurfaceKind kind, Triangulation triangulation, int vertices,
+                                        double a, std::uint64_t seed) {
+  SurfaceOptions o;
+  o.kind = kind;
+  o.triangulation = triangulation;
+  o.target_vertices = vertices;
+  o.a = a;
+  o.seed = seed;
+  return make_surface(o);
 }
 
 /// Vertices at least `rings` rings away from any boundary (all vertices of closed meshes).

@@ -14,13 +14,7 @@ namespace focal {
 namespace {
 
 AnalyticSurface surface(SurfaceKind kind, Triangulation tri, int vertices, double a = 0) {
-  SurfaceOptions o;
-  o.kind = kind;
-  o.triangulation = tri;
-  o.target_vertices = vertices;
-  o.a = a;
-  o.seed = 7;
-  return make_surface(o);
+  return test::analytic_surface(kind, tri, vertices, a, 7);
 }
 
 /// Longest edge of the mesh.
