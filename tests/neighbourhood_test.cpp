@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "focal/error.h"
+#include "test_meshes.h"
 
 namespace focal {
 namespace {
@@ -76,27 +77,6 @@ TestMesh tetrahedron() {
   m.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
   return m;
 }
-
-// Sets FOCAL_NUM_THREADS for the lifetime of the object.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int threads) {
-    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
-  }
-  ~ScopedThreads() {
-    if (old_) {
-      setenv("FOCAL_NUM_THREADS", old_->c_str(), 1);
-    } else {
-      unsetenv("FOCAL_NUM_THREADS");
-    }
-  }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  std::optional<std::string> old_;
-};
 
 // --- vertex_adjacency / k_ring -------------------------------------------------------------------
 
@@ -186,12 +166,12 @@ TEST(VertexAdjacency, BitwiseIdenticalForAnyThreadCount) {
   const TestMesh m = grid(60, 50);
   Neighbourhoods one_a, one_b, ring_a, ring_b;
   {
-    const ScopedThreads threads(1);
+    const test::ScopedThreads threads(1);
     one_a = vertex_adjacency(3000, m.F);
     ring_a = k_ring(one_a, 3);
   }
   {
-    const ScopedThreads threads(3);
+    const test::ScopedThreads threads(3);
     one_b = vertex_adjacency(3000, m.F);
     ring_b = k_ring(one_b, 3);
   }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "focal/error.h"
+#include "test_meshes.h"
 
 namespace focal {
 namespace {
@@ -164,27 +165,6 @@ TestMesh join(const TestMesh& a, const TestMesh& b) {
   return m;
 }
 
-// Sets FOCAL_NUM_THREADS for the lifetime of the object.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int threads) {
-    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
-  }
-  ~ScopedThreads() {
-    if (old_) {
-      setenv("FOCAL_NUM_THREADS", old_->c_str(), 1);
-    } else {
-      unsetenv("FOCAL_NUM_THREADS");
-    }
-  }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  std::optional<std::string> old_;
-};
-
 // --- vertex_normals -------------------------------------------------------------------------
 
 // By symmetry every weighting gives the radial direction at a vertex of a regular polyhedron.
@@ -316,11 +296,11 @@ TEST(VertexNormals, BitwiseIdenticalForAnyThreadCount) {
   for (const auto weighting : kAllWeightings) {
     RowMatrixX3d one, three;
     {
-      const ScopedThreads threads(1);
+      const test::ScopedThreads threads(1);
       one = vertex_normals(m.V, m.F, weighting);
     }
     {
-      const ScopedThreads threads(3);
+      const test::ScopedThreads threads(3);
       three = vertex_normals(m.V, m.F, weighting);
     }
     EXPECT_TRUE((one.array() == three.array()).all());

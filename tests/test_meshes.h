@@ -2,6 +2,9 @@
 // Small meshes and error measures shared by the estimator tests.
 
 #include <cmath>
+#include <cstdlib>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "focal/mesh.h"
@@ -9,6 +12,27 @@
 #include "focal/surfaces.h"
 
 namespace focal::test {
+
+/// Sets FOCAL_NUM_THREADS for the lifetime of the object.
+class ScopedThreads {
+ public:
+  explicit ScopedThreads(int threads) {
+    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+  }
+  ~ScopedThreads() {
+    if (old_) {
+      setenv("FOCAL_NUM_THREADS", old_->c_str(), 1);
+    } else {
+      unsetenv("FOCAL_NUM_THREADS");
+    }
+  }
+  ScopedThreads(const ScopedThreads&) = delete;
+  ScopedThreads& operator=(const ScopedThreads&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
 
 /// An n x n grid of unit squares in the plane z = 0, two triangles each, normals +z.
 inline Mesh flat_grid(int n, double spacing = 1.0) {
