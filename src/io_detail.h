@@ -92,6 +92,17 @@ void append_number(std::string& out, double value);
 void append_number(std::string& out, float value);
 void append_number(std::string& out, std::int64_t value);
 
+/// "3 a b c\n": one triangle as OFF and ascii PLY write it.
+inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMatrixX3i>& F,
+                                  Eigen::Index f) {
+  out += '3';
+  for (int c = 0; c < 3; ++c) {
+    out += ' ';
+    append_number(out, static_cast<std::int64_t>(F(f, c)));
+  }
+  out += '\n';
+}
+
 /// Buffered output to the temporary file of write_atomically().
 class OutputSink {
  public:

@@ -210,12 +210,7 @@ void write_off(const std::filesystem::path& path, const Mesh& mesh) {
       sink.maybe_flush();
     }
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-      out += '3';
-      for (int c = 0; c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, static_cast<std::int64_t>(mesh.F(f, c)));
-      }
-      out += '\n';
+      io_detail::append_ascii_triangle(out, mesh.F, f);
       sink.maybe_flush();
     }
   });

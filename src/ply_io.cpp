@@ -758,12 +758,7 @@ void write_ply_body(io_detail::OutputSink& sink, const Mesh& mesh,
       out += static_cast<char>(3);
       for (int c = 0; c < 3; ++c) append_little_endian(out, mesh.F(f, c));
     } else {
-      out += '3';
-      for (int c = 0; c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, static_cast<std::int64_t>(mesh.F(f, c)));
-      }
-      out += '\n';
+      io_detail::append_ascii_triangle(out, mesh.F, f);
     }
     sink.maybe_flush();
   }
