@@ -32,6 +32,7 @@ int run(int argc, char** argv) {
   focal::cli::add_curvature_command(app, log);
   focal::cli::add_focal_mesh_command(app, log);
   focal::cli::add_eval_command(app, log);
+  focal::cli::add_render_command(app, log);
   app.footer(
       "Examples:\n"
       "  focal info mesh.ply\n"

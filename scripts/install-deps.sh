@@ -6,7 +6,10 @@
 #   scripts/install-deps.sh fuzz     also clang with libFuzzer and its OpenMP (scripts/fuzz.sh)
 set -euo pipefail
 
-packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev)
+# libegl-dev, libopengl-dev and Mesa (libegl-mesa0, libgl1-mesa-dri): headless OpenGL for
+# rasterised G-buffers and `focal render`; libpng-dev writes its pictures.
+packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev
+          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libpng-dev)
 if [[ "${1:-}" == "demo" ]]; then
   packages+=(libcgal-demo)
 elif [[ "${1:-}" == "bench" ]]; then
