@@ -3,6 +3,7 @@
 /// Everything of the focal library in one include.
 
 #include "focal/baselines.h"
+#include "focal/cuda_curvature.h"
 #include "focal/curvature.h"
 #include "focal/device.h"
 #include "focal/error.h"

@@ -1,0 +1,74 @@
+#pragma once
+// Checked CUDA runtime calls and a device buffer that frees itself. Only for .cu files.
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "focal/error.h"
+
+namespace focal::cuda {
+
+/// Throws DeviceError naming the call and the CUDA error unless `status` is cudaSuccess.
+inline void check(cudaError_t status, const char* what) {
+  if (status != cudaSuccess) {
+    throw DeviceError(std::string("CUDA: ") + what + ": " + cudaGetErrorString(status));
+  }
+}
+
+/// Checks a kernel launch (configuration errors) without waiting for the kernel.
+inline void check_launch(const char* kernel) { check(cudaGetLastError(), kernel); }
+
+/// n elements of T in device memory, freed on scope exit.
+template <class T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  explicit DeviceBuffer(std::size_t n) : size_(n) {
+    if (n > 0) check(cudaMalloc(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMalloc");
+  }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  DeviceBuffer(DeviceBuffer&& o) noexcept : data_(o.data_), size_(o.size_) {
+    o.data_ = nullptr;
+    o.size_ = 0;
+  }
+  DeviceBuffer& operator=(DeviceBuffer&& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(size_, o.size_);
+    return *this;
+  }
+  ~DeviceBuffer() {
+    if (data_ != nullptr) cudaFree(data_);  // no throw from a destructor; errors surface later
+  }
+
+  /// A buffer holding a copy of `host`.
+  static DeviceBuffer from_host(const std::vector<T>& host) {
+    DeviceBuffer b(host.size());
+    b.upload(host.data(), host.size());
+    return b;
+  }
+  void upload(const T* host, std::size_t n) {
+    check(cudaMemcpy(data_, host, n * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy to device");
+  }
+  void download(T* host, std::size_t n) const {
+    check(cudaMemcpy(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to host");
+  }
+  [[nodiscard]] std::vector<T> to_host() const {
+    std::vector<T> host(size_);
+    download(host.data(), size_);
+    return host;
+  }
+
+  [[nodiscard]] T* data() const { return data_; }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  T* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+}  // namespace focal::cuda
