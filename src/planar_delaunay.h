@@ -1,5 +1,5 @@
 #pragma once
-// Internal: Delaunay triangulation of points in the plane, used by surfaces.cpp to triangulate
+// Internal: Delaunay triangulation of points in the plane, used by surfaces/irregular_triangulation.cpp to triangulate
 // random samples in a planar parameter chart. Bowyer-Watson insertion with a vertex at infinity
 // (Shewchuk's ghost triangles), so the convex hull comes out exactly and a triangulated sphere
 // is one fan away: closing every hull edge with one extra vertex gives the Delaunay
