@@ -1,6 +1,6 @@
 #pragma once
-// Internal: Delaunay triangulation of points in the plane, used by surfaces/irregular_triangulation.cpp to triangulate
-// random samples in a planar parameter chart. Bowyer-Watson insertion with a vertex at infinity
+// Internal: Delaunay triangulation of points in the plane, used by
+// surfaces/irregular_triangulation.cpp to triangulate random samples in a planar parameter chart. Bowyer-Watson insertion with a vertex at infinity
 // (Shewchuk's ghost triangles), so the convex hull comes out exactly and a triangulated sphere
 // is one fan away: closing every hull edge with one extra vertex gives the Delaunay
 // triangulation on the sphere when the points are a stereographic projection.
