@@ -506,5 +506,41 @@ check "eval: exact on the clean sphere (relative H error below 1e-9)" \
 run eval --markdown ev.txt
 check "eval: a wrong report extension is a usage error" test "$rc" -eq 1
 
+# ---------------------------------------------------------------------------------------------
+# render: a PNG picture of a field (OpenGL on a headless EGL context; Mesa llvmpipe without a GPU)
+
+# png_size FILE: "WIDTH HEIGHT" from the IHDR chunk (big-endian 32-bit at bytes 16 and 20),
+# after checking the 8-byte PNG signature and that IHDR is the first chunk.
+png_size() {
+  local bytes
+  bytes=$(od -An -tu1 -N24 "$1" 2>/dev/null | tr -s ' \n' ' ') || return 0
+  awk -v b="$bytes" 'BEGIN {
+    n = split(b, x, " ")
+    if (n < 24 || x[1] != 137 || x[2] != 80 || x[3] != 78 || x[4] != 71) exit
+    if (x[13] != 73 || x[14] != 72 || x[15] != 68 || x[16] != 82) exit  # "IHDR"
+    printf "%d %d\n", ((x[17] * 256 + x[18]) * 256 + x[19]) * 256 + x[20],
+                       ((x[21] * 256 + x[22]) * 256 + x[23]) * 256 + x[24]
+  }'
+}
+run render s.ply -o r.png --size 320x240
+check "render: exit 0" test "$rc" -eq 0
+check "render: a PNG of the requested size 320x240" test "$(png_size r.png)" = "320 240"
+check "render: says what it wrote" grep -q "^wrote r.png (320 x 240)" "$OUT"
+run render s.ply -o rc.png --field class --directions d1 --focal-meshes --camera 30,20 --size 300x100 --orthographic
+check "render --field class --directions d1 --focal-meshes: exit 0" test "$rc" -eq 0
+check "render: --size 300x100 gives a 300 x 100 PNG" test "$(png_size rc.png)" = "300 100"
+run render s.ply -o rr.png --field k2 --range -2,2 --size 64x64
+check "render --range -2,2 --size 64x64 (the smallest): exit 0" test "$(png_size rr.png)" = "64 64"
+expect_error "render --field bad: exit 1" 1 "--field" rb.png render s.ply -o rb.png --field curvedness
+expect_error "render --size 10x10 (too small): exit 1" 1 "--size" rb.png render s.ply -o rb.png --size 10x10
+expect_error "render --size 300 (no height): exit 1" 1 "--size" rb.png render s.ply -o rb.png --size 300
+expect_error "render --camera 30 (no elevation): exit 1" 1 "--camera" rb.png render s.ply -o rb.png --camera 30
+expect_error "render --range 2,1 (LO > HI): exit 1" 1 "--range" rb.png render s.ply -o rb.png --range 2,1
+expect_error "render --range with --field class: exit 1" 1 "--range" rb.png render s.ply -o rb.png --field class --range -1,1
+expect_error "render -o r.jpg (not PNG): exit 1" 1 "r.jpg" r.jpg render s.ply -o r.jpg
+expect_error "render of a missing input: exit 2" 2 "missing.ply" rb.png render missing.ply -o rb.png
+expect_error "render into a missing folder: exit 2, nothing written" 2 "rb.png" nofolder/rb.png render s.ply -o nofolder/rb.png
+check "render: no temporary files left behind" bash -c '! ls -A | grep -q "\.tmp-"'
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]
