@@ -40,6 +40,8 @@ int run(int argc, char** argv) {
       "  focal curvature mesh.ply -o fields.csv\n"
       "  focal -v curvature mesh.ply -o fields.ply --rings 2\n"
       "  focal focal-mesh mesh.ply -o prefix   # prefix.focal1.ply, prefix.focal2.ply\n"
+      "  focal eval --markdown eval.md         # every estimator against analytic truth\n"
+      "  focal render mesh.ply -o mesh-H.png --field H   # a picture of H\n"
       "Run 'focal COMMAND -h' for the options and examples of a command.\n"
       "Exit codes: 0 success, 1 usage error, 2 unreadable input or invalid data, 3 internal "
       "error.");
@@ -53,10 +55,10 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(
-        stderr,
-        "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh ... (see focal -h)\n",
-        e.what());
+    std::fprintf(stderr,
+                 "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|eval|render ... "
+                 "(see focal -h)\n",
+                 e.what());
     return kUsageError;
   }
   return 0;
