@@ -497,14 +497,38 @@ run -v generate sphere -o gv.ply
 check "-v generate: a generate timing" stages_ok "$ERR" generate
 
 # eval: every estimator on every analytic case (8 surfaces x 2 triangulations x 3 noise models)
-run eval --vertices 300 --csv ev.csv --markdown ev.md
+run eval --vertices 300 --csv ev.csv --markdown ev.md --export evx
 check "eval: exit 0" test "$rc" -eq 0
-check "eval: 48 cases x 10 estimators in the CSV" test "$(data_rows ev.csv)" -eq 480
+check "eval: 48 cases x 12 estimators in the CSV" test "$(data_rows ev.csv)" -eq 576
+check "eval: focal default with and without normals in every case" \
+  test "$(grep -c ',focal default / \(file\|no\) normals,' ev.csv)" -eq 96
 check "eval: the Markdown table has a row per case" test "$(grep -c '^| [a-z-]*, ' ev.md)" -eq 48
 check "eval: exact on the clean sphere (relative H error below 1e-9)" \
   awk -F, '$1 == "sphere" && $3 == "clean" && $4 == "focal closed-form 1-ring / file normals" { found = 1; if (!($7 + 0 < 1e-9)) exit 1 } END { exit !found }' ev.csv
+check "eval --export: an index of the 48 cases" test "$(data_rows evx/cases.csv)" -eq 48
+check "eval --export: a mesh and a truth CSV per case" \
+  test "$(ls evx/*.ply | wc -l)" -eq 48 -a "$(ls evx/*.truth.csv | wc -l)" -eq 48
+check "eval --export: the mesh carries the (noisy) file normals" \
+  grep -q "^property double nx" <(ply_header evx/sphere-regular-normal-noise.ply)
+check "eval --export: truth columns with the interior flag" \
+  test "$(head -n 1 evx/saddle-irregular-clean.truth.csv)" = "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,interior"
+check "eval --export: the open saddle has vertices near its boundary" \
+  awk -F, 'NR > 1 && $11 == 0 { found = 1 } END { exit !found }' evx/saddle-irregular-clean.truth.csv
 run eval --markdown ev.txt
 check "eval: a wrong report extension is a usage error" test "$rc" -eq 1
+
+# eval --scan: smoothness of H on meshes without truth (paper Fig. 7)
+run eval --scan s.ply --csv sc.csv --markdown sc.md --export scx
+check "eval --scan: exit 0" test "$rc" -eq 0
+check "eval --scan: a row per method (s.ply has normals: 5 methods)" test "$(data_rows sc.csv)" -eq 5
+check "eval --scan: H keeps its sign on the sphere" \
+  awk -F, 'NR > 1 { n++; if ($12 != 0) exit 1 } END { exit n != 5 }' sc.csv
+check "eval --scan: coloured PLYs of H" \
+  grep -q "^property uchar red" <(ply_header scx/s.focal-default-no-normals.ply)
+run eval --scan no-such-mesh.off
+check "eval --scan: a missing mesh is exit 2" test "$rc" -eq 2
+run eval --scan s.ply --seed 3
+check "eval --scan with --seed is a usage error" test "$rc" -eq 1
 
 # ---------------------------------------------------------------------------------------------
 # render: a PNG picture of a field (OpenGL on a headless EGL context; Mesa llvmpipe without a GPU)
