@@ -46,25 +46,23 @@ Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log&
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, f.estimator, log);
-  const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
-  const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
+  Estimate e = estimate(mesh, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
-    write_curvature_csv(f.output, fields);
+    write_curvature_csv(f.output, e.fields);
   } else {
-    mesh.N = normals;
-    write_curvature_ply(f.output, mesh, fields, {.binary = !f.ascii, .comments = {}});
+    mesh.N = std::move(e.normals);
+    write_curvature_ply(f.output, mesh, e.fields, {.binary = !f.ascii, .comments = {}});
   }
 }
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, f.estimator, log);
-  const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
-  const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
+  const Estimate e = estimate(mesh, f.input, f.estimator, log);
   FocalMeshes meshes;
   {
     Stage stage(log, "focal meshes");
-    meshes = focal_meshes(mesh.V, mesh.F, normals, fields, f.focal);
+    meshes = focal_meshes(mesh.V, mesh.F, e.normals, e.fields, f.focal);
   }
   Stage stage(log, "write");
   const PlyWriteOptions o{.binary = !f.ascii, .comments = {}};
@@ -97,8 +95,12 @@ void add_curvature_command(CLI::App& app, const Log& log) {
   cmd->footer(
       "Columns: k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class (k1 >= k2; outward normals;\n"
       "a sphere of radius r has k1 = k2 = +1/r). Examples:\n"
-      "  focal curvature bunny.off -o bunny.csv\n"
-      "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v");
+      "  focal curvature bunny.off -o bunny.csv          # the recommended estimator\n"
+      "  focal curvature bunny.off -o bunny.csv --paper  # the paper's method as written\n"
+      "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v\n"
+      "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
+      "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
+      "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
   cmd->parse_complete_callback([f] { require_extension("-o", f->output, {".csv", ".ply"}); });
   cmd->callback([f, &log] { run_curvature(*f, log); });
 }

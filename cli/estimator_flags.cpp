@@ -8,6 +8,7 @@
 
 #include "focal/error.h"
 #include "focal/normals.h"
+#include "focal/recommended.h"
 
 namespace focal::cli {
 namespace {
@@ -16,7 +17,8 @@ namespace {
 /// sphere and second-order accurate on smooth surfaces, also on irregular meshes.
 constexpr NormalWeighting kDefaultWeighting = NormalWeighting::max;
 
-RowMatrixX3d estimated_normals(Mesh& mesh, NormalWeighting weighting, const Log& log) {
+/// Normals estimated from faces take their side from the faces' orientation.
+void orient_faces_outward(Mesh& mesh, const Log& log) {
   const OrientationReport report = orientation_report(mesh.V, mesh.F);
   if (const int inward = report.inward_count(); inward > 0) {
     log.warning(std::to_string(inward) +
@@ -24,6 +26,10 @@ RowMatrixX3d estimated_normals(Mesh& mesh, NormalWeighting weighting, const Log&
                 "were reversed so that normals point outward");
     mesh.F = orient_outward(mesh.F, report);
   }
+}
+
+RowMatrixX3d estimated_normals(Mesh& mesh, NormalWeighting weighting, const Log& log) {
+  orient_faces_outward(mesh, log);
   return vertex_normals(mesh.V, mesh.F, weighting);
 }
 
@@ -94,31 +100,46 @@ void EstimatorFlags::add_to(CLI::App& command) {
                                                         {"area", NormalsSource::area},
                                                         {"angle", NormalsSource::angle},
                                                         {"max", NormalsSource::max}};
-  command
-      .add_option("--method", options.method,
-                  "per-vertex two-slit fit or per-triangle characteristic equation")
-      ->transform(CLI::CheckedTransformer(methods))
-      ->default_str("vertex");
-  command.add_option("--solver", options.solver, "two-slit solver")
-      ->transform(CLI::CheckedTransformer(solvers))
-      ->default_str("closed-form");
-  command.add_option("--rings", options.rings, "neighbourhood size in rings (1 = the paper's)")
-      ->check(CLI::Range(1, 16))
-      ->default_str("1");
-  command.add_option("--weights", options.weighting, "ray weights")
-      ->transform(CLI::CheckedTransformer(weights))
-      ->default_str("uniform");
-  command
-      .add_option("--normals", normals,
-                  "vertex normals: the file's, or estimated from faces by area, angle or Max "
-                  "(1999) weights [default: the file's when present, else max]")
-      ->transform(CLI::CheckedTransformer(sources));
+  method_options.push_back(
+      command
+          .add_option("--method", options.method,
+                      "per-vertex two-slit fit or per-triangle characteristic equation")
+          ->transform(CLI::CheckedTransformer(methods))
+          ->default_str("vertex"));
+  method_options.push_back(command.add_option("--solver", options.solver, "two-slit solver")
+                               ->transform(CLI::CheckedTransformer(solvers))
+                               ->default_str("closed-form"));
+  method_options.push_back(
+      command.add_option("--rings", options.rings, "neighbourhood size in rings (1 = the paper's)")
+          ->check(CLI::Range(1, 16))
+          ->default_str("1"));
+  method_options.push_back(command.add_option("--weights", options.weighting, "ray weights")
+                               ->transform(CLI::CheckedTransformer(weights))
+                               ->default_str("uniform"));
+  method_options.push_back(
+      command
+          .add_option("--normals", normals,
+                      "vertex normals: the file's, or estimated from faces by area, angle or Max "
+                      "(1999) weights [paper's method default: the file's when present, else max]")
+          ->transform(CLI::CheckedTransformer(sources)));
+  command.add_flag("--paper", paper,
+                   "the paper's method as written (1-ring closed-form two-slit fit of the "
+                   "file's normals, else of Max normals) instead of the recommended estimator; "
+                   "implied by any of --method --solver --rings --weights --normals");
   command.add_option("--threads", options.threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
       ->check(CLI::NonNegativeNumber);
   command.add_flag("--strict", strict,
                    "fail (exit 2, nothing written) when the input has problems such as NaN "
                    "coordinates, degenerate or non-manifold faces or bad normals, instead of "
                    "warning and leaving the affected vertices undefined");
+}
+
+bool EstimatorFlags::recommended() const {
+  if (paper) return false;
+  for (const CLI::Option* o : method_options) {
+    if (o->count() > 0) return false;
+  }
+  return true;
 }
 
 bool EstimatorFlags::uses_file_normals(const Mesh& mesh) const {
@@ -143,6 +164,43 @@ RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name, NormalsSo
                                     : source == NormalsSource::angle   ? NormalWeighting::angle
                                                                        : NormalWeighting::max;
   return estimated_normals(mesh, weighting, log);
+}
+
+namespace {
+
+/// The recommended estimator (recommended.h) on the file's normals when it has them.
+Estimate run_recommended(Mesh& mesh, const std::string& mesh_name, const EstimatorFlags& flags,
+                         const Log& log) {
+  RowMatrixX3d file_normals(0, 3);
+  if (mesh.has_normals()) {
+    file_normals = prepare_normals(mesh, mesh_name, NormalsSource::file, log);
+  } else {
+    Stage stage(log, "normals");
+    orient_faces_outward(mesh, log);  // the jets' normals take their side from the faces
+  }
+  RecommendedResult r;
+  {
+    Stage stage(log, "curvature");
+    r = estimate_curvature_recommended_full(mesh.V, mesh.F, file_normals, flags.options.threads);
+  }
+  std::ostringstream plan;
+  plan << "  recommended estimator: " << (mesh.has_normals() ? "file" : "Max")
+       << " normals, jet normals where smoother"
+       << ", position noise " << r.plan.noise << " x edge length, " << r.plan.rings << "-ring "
+       << (r.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
+  log.info(plan.str());
+  print_summary(r.curvature, log);
+  return {std::move(r.N), std::move(r.curvature)};
+}
+
+}  // namespace
+
+Estimate estimate(Mesh& mesh, const std::string& mesh_name, const EstimatorFlags& flags,
+                  const Log& log) {
+  if (flags.recommended()) return run_recommended(mesh, mesh_name, flags, log);
+  RowMatrixX3d normals = prepare_normals(mesh, mesh_name, flags.normals, log);
+  CurvatureResult fields = run_estimator(mesh, normals, flags, log);
+  return {std::move(normals), std::move(fields)};
 }
 
 CurvatureResult run_estimator(const Mesh& mesh, const RowMatrixX3d& normals,

@@ -3,6 +3,7 @@
 // the estimator runs.
 
 #include <CLI/CLI.hpp>
+#include <vector>
 
 #include "focal/curvature.h"
 #include "focal/mesh.h"
@@ -16,11 +17,29 @@ struct EstimatorFlags {
   CurvatureOptions options;
   NormalsSource normals = NormalsSource::automatic;
   bool strict = false;  ///< --strict: problems found in the input are errors (input_check.h)
+  bool paper = false;   ///< --paper: the paper's method as configured by the options above
+  /// --method, --solver, --rings, --weights, --normals: giving any selects the paper's method.
+  std::vector<CLI::Option*> method_options;
 
   void add_to(CLI::App& command);
+  /// Whether the run uses focal's recommended estimator (recommended.h): no estimator option and
+  /// no --paper were given.
+  [[nodiscard]] bool recommended() const;
   /// Whether the run uses the normals read from the file (rather than estimating them).
   [[nodiscard]] bool uses_file_normals(const Mesh& mesh) const;
 };
+
+/// The normals and fields of a run.
+struct Estimate {
+  RowMatrixX3d normals;  ///< the unit normals the fit used (written to PLY outputs, focal meshes)
+  CurvatureResult fields;
+};
+
+/// Prepares the normals and runs the estimator the flags select, with stage timings and, with -v,
+/// a summary. May re-orient inward closed components of mesh.F when normals are estimated.
+/// \throw InvalidInput when `--normals file` is asked for and the file has none.
+[[nodiscard]] Estimate estimate(Mesh& mesh, const std::string& mesh_name,
+                                const EstimatorFlags& flags, const Log& log);
 
 /// The unit normals the estimator uses: the file's, or estimated from the faces (with inward
 /// closed components re-oriented). Warns about what it fixed or suspects.
