@@ -30,20 +30,6 @@ struct FocalMeshFlags {
   FocalMeshOptions focal;
 };
 
-/// Reads the mesh and reports (or, with --strict, rejects) what is wrong with it.
-Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
-  Mesh mesh;
-  {
-    Stage stage(log, "read");
-    mesh = read_mesh(path);
-    log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
-             " triangles");
-  }
-  const RowMatrixX3d no_normals(0, 3);
-  check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path, flags.strict, log);
-  return mesh;
-}
-
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, f.estimator, log);
   Estimate e = estimate(mesh, f.input, f.estimator, log);

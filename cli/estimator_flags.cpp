@@ -7,8 +7,10 @@
 #include <sstream>
 
 #include "focal/error.h"
+#include "focal/mesh_io.h"
 #include "focal/normals.h"
 #include "focal/recommended.h"
+#include "input_check.h"
 
 namespace focal::cli {
 namespace {
@@ -194,6 +196,19 @@ Estimate run_recommended(Mesh& mesh, const std::string& mesh_name, const Estimat
 }
 
 }  // namespace
+
+Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
+  Mesh mesh;
+  {
+    Stage stage(log, "read");
+    mesh = read_mesh(path);
+    log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
+             " triangles");
+  }
+  const RowMatrixX3d no_normals(0, 3);
+  check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path, flags.strict, log);
+  return mesh;
+}
 
 Estimate estimate(Mesh& mesh, const std::string& mesh_name, const EstimatorFlags& flags,
                   const Log& log) {

@@ -29,6 +29,10 @@ struct EstimatorFlags {
   [[nodiscard]] bool uses_file_normals(const Mesh& mesh) const;
 };
 
+/// Reads the mesh and reports (or, with --strict, rejects) what is wrong with it.
+/// \throw InvalidInput / IoError for unreadable files or (with --strict) problems found.
+[[nodiscard]] Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log);
+
 /// The normals and fields of a run.
 struct Estimate {
   RowMatrixX3d normals;  ///< the unit normals the fit used (written to PLY outputs, focal meshes)

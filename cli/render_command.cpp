@@ -105,23 +105,11 @@ Eigen::VectorXd field_values(const CurvatureResult& c, const std::string& field)
   return c.point_class.cast<double>();
 }
 
-Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
-  Mesh mesh;
-  {
-    Stage stage(log, "read");
-    mesh = read_mesh(path);
-    log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
-             " triangles");
-  }
-  const RowMatrixX3d no_normals(0, 3);
-  check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path, flags.strict, log);
-  return mesh;
-}
-
 void run_render(RenderFlags& f, const Log& log) {
   Mesh mesh = read_input(f.input, f.estimator, log);
-  const RowMatrixX3d normals = prepare_normals(mesh, f.input, f.estimator.normals, log);
-  const CurvatureResult fields = run_estimator(mesh, normals, f.estimator, log);
+  const Estimate e = estimate(mesh, f.input, f.estimator, log);
+  const RowMatrixX3d& normals = e.normals;
+  const CurvatureResult& fields = e.fields;
   FieldPictureOptions& p = f.picture;
   if (f.focal_meshes) {
     Stage stage(log, "focal meshes");
