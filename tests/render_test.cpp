@@ -12,6 +12,7 @@
 #include <numbers>
 #include <random>
 
+#include "focal/image_space.h"
 #include "focal/surfaces.h"
 #include "test_meshes.h"
 
@@ -501,4 +502,49 @@ TEST(RenderErrors, NoEglDriverIsRenderError) {
         std::exit(0);
       },
       ::testing::ExitedWithCode(7), "no headless OpenGL 3.3 context: tried");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The image-space estimator (paper 5.1) on a rasterised G-buffer
+
+// The sphere's vertex normals are its vertex positions over r, and the rasteriser interpolates
+// both with the same barycentric weights, so every pixel's normal ray passes through the centre:
+// both focal depths equal the pixel's distance |p| from it, which lies between r sqrt(1 - rho^2)
+// (rho the largest facet circumradius) and r. So k1 = k2 = 1 / |p| up to float rounding.
+TEST(ImageSpaceOnGBuffer, SphereGivesOneOverRadiusAwayFromTheSilhouette) {
+  constexpr double r = 2.0;
+  SurfaceOptions o;
+  o.kind = SurfaceKind::sphere;
+  o.a = r;
+  o.target_vertices = 8000;
+  const Mesh m = make_surface(o).mesh;
+  const int side = 256;
+  const Camera camera = fit_camera(m.V, {.azimuth = 30.0, .elevation = 20.0});
+  const GBuffer g = rasterise_gbuffer(m.V, m.F, m.N, camera, side, side);
+  const ImageCurvature c = estimate_image_curvature(g);
+
+  const double facet = largest_circumradius(m);  // in units of r: the mesh has radius r
+  const double h_low = 1.0 / r, h_high = 1.0 / (r * std::sqrt(1.0 - facet * facet / (r * r)));
+  // Float: positions and normals to ~1e-7 relative, normal differences between neighbouring
+  // pixels ~ footprint / r ~ 1e-2, so ~1e-5 relative in k; 1e-4 leaves a margin of ten.
+  constexpr double kFloat = 1e-4;
+  const double R = silhouette_radius_pixels(camera, r, side);
+  int inside = 0, valid = 0;
+  for (int y = 0; y < side; ++y) {
+    for (int x = 0; x < side; ++x) {
+      const double rho = std::hypot(x + 0.5 - side / 2.0, side / 2.0 - (y + 0.5));
+      if (rho > 0.9 * R) continue;  // away from the silhouette
+      ++inside;
+      const std::size_t i = std::size_t(y) * side + x;
+      if (!c.valid[i]) continue;
+      ++valid;
+      ASSERT_GE(c.H[i], h_low * (1.0 - kFloat)) << x << "," << y;
+      ASSERT_LE(c.H[i], h_high * (1.0 + kFloat)) << x << "," << y;
+      ASSERT_NEAR(c.k1[i], c.k2[i], 2 * kFloat * h_high) << x << "," << y;
+      ASSERT_NEAR(c.K[i], c.H[i] * c.H[i], 4 * kFloat * h_high * h_high) << x << "," << y;
+    }
+  }
+  // Inside 0.9 R every triplet is covered and smooth: all pixels must be valid.
+  EXPECT_EQ(valid, inside);
+  EXPECT_GT(inside, 0.8 * kPi * 0.81 * R * R);
 }
