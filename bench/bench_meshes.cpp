@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <string>
 
 #include "focal/mesh_io.h"
 #include "focal/surfaces.h"
@@ -36,8 +37,26 @@ const Mesh& torus(int vertices) {
   return meshes.emplace(vertices, std::move(mesh)).first->second;
 }
 
-void use_threads(int threads) {
-  setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+const Mesh* bunny() {
+  static const Mesh* cached = []() -> const Mesh* {
+    const auto path = cache_dir() / "bunny.off";
+    if (!std::filesystem::exists(path)) {
+      // The scan run_bench.sh uses: Debian's libcgal-demo ships it inside a tarball.
+      std::filesystem::create_directories(cache_dir());
+      const std::string extract =
+          "tar -xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/bunny00.off > '" +
+          path.string() + "' 2>/dev/null";
+      if (std::system(extract.c_str()) != 0) {
+        std::filesystem::remove(path);
+        return nullptr;
+      }
+    }
+    static Mesh mesh = read_mesh(path);
+    return &mesh;
+  }();
+  return cached;
 }
+
+void use_threads(int threads) { setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1); }
 
 }  // namespace focal::bench

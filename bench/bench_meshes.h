@@ -12,6 +12,10 @@ namespace focal::bench {
 /// generated and cached. Meshes stay in memory for the rest of the run (one per size).
 const Mesh& torus(int vertices);
 
+/// The Stanford bunny (37,706 vertices, no normals) from build/bench-data/bunny.off, extracted
+/// there from Debian's libcgal-demo data when missing; nullptr when neither exists.
+const Mesh* bunny();
+
 /// Sets FOCAL_NUM_THREADS, which every library loop without a `threads` option reads.
 void use_threads(int threads);
 

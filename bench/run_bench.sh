@@ -4,6 +4,8 @@
 # 1 and 2 threads. Prints a markdown table: the fastest of REPS runs (wall time, vertices/s and
 # its -v stage times) and the largest peak RSS of them (/usr/bin/time -v).
 #
+# Then, when bench/peers/.venv exists, bench/peers/peers.py times the peer libraries on the bunny.
+#
 # Usage: bench/run_bench.sh [BUILD_DIR]   (default build/bench; needs cli/focal and
 #        bench/focal_subdivide there). Environment: FOCAL_BENCH_REPS (default 3),
 #        FOCAL_BENCH_MAX (largest size, default 10000000), FOCAL_BENCH_DATA (mesh cache,
@@ -89,3 +91,15 @@ for level in 0 1 2 3 4; do
   mesh=$(bunny "$level")
   for t in 1 2; do report "bunny/$level" "$mesh" "$t"; done
 done
+
+# Peers (libigl, pymeshlab, trimesh, VTK) on the bunny as ratios to focal, from their own venv
+# made by bench/peers/setup.sh; skipped, with a line saying so, when it is not there.
+echo
+peers=$(dirname "$0")/peers
+if [[ -x $peers/.venv/bin/python ]]; then
+  bunny 0 >/dev/null  # extracts bunny.off into the cache
+  "$peers/.venv/bin/python" "$peers/peers.py" timing "$data/bunny.off" --focal "$focal" ||
+    echo "Peers failed (exit $?); see the messages above."
+else
+  echo "Peers skipped: no $peers/.venv (bench/peers/setup.sh creates it)."
+fi

@@ -64,6 +64,12 @@ inline CurvatureResult unwritten_result(Eigen::Index n) {
   r.point_class.resize(n);
   r.rays_used.resize(n);
   r.rays_excluded.resize(n);
+  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) {
+    advise_huge_pages(v->data(), sizeof(double) * static_cast<std::size_t>(n));
+  }
+  for (RowMatrixX3d* d : {&r.d1, &r.d2}) {
+    advise_huge_pages(d->data(), 3 * sizeof(double) * static_cast<std::size_t>(n));
+  }
   return r;
 }
 

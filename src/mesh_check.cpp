@@ -1,7 +1,9 @@
 #include "focal/mesh_check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "focal/neighbourhood.h"
@@ -14,47 +16,37 @@ namespace {
 /// Tolerance on |n| - 1 below which a given normal counts as unit (the estimator's, curvature.h).
 constexpr double kUnitTolerance = 1e-6;
 
-int count_non_finite_rows(const Eigen::Ref<const RowMatrixX3d>& M) {
-  int count = 0;
-  for (Eigen::Index i = 0; i < M.rows(); ++i) count += M.row(i).allFinite() ? 0 : 1;
-  return count;
-}
-
-int count_repeated_index_faces(FacesRef F) {
-  int count = 0;
-  for (Eigen::Index f = 0; f < F.rows(); ++f) count += detail::has_repeated_index(F, f) ? 1 : 0;
-  return count;
-}
-
-/// Component of each vertex (that of its lowest-index face), -1 for vertices in no face.
-std::vector<int> vertex_components(Eigen::Index vertex_count, FacesRef F,
-                                   const OrientationReport& report) {
-  std::vector<int> component(static_cast<std::size_t>(vertex_count), -1);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      int& slot = component[static_cast<std::size_t>(F(f, c))];
-      if (slot < 0) slot = report.face_component[f];
-    }
-  }
-  return component;
+/// Sums count(i) over [0, n) in parallel blocks (integers: exact for any split).
+template <class Count>
+int parallel_count(std::int64_t n, Count&& count) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<int> sums(static_cast<std::size_t>(blocks), 0);
+  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
+    int sum = 0;
+    for (auto i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) sum += count(i);
+    sums[static_cast<std::size_t>(b)] = sum;
+  });
+  int total = 0;
+  for (const int sum : sums) total += sum;
+  return total;
 }
 
 /// The findings about given normals: their rows, and their direction against the faces.
-void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const OrientationReport& report,
-                   MeshFindings& out) {
-  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshTopology& topology,
+                   const OrientationReport& report, MeshFindings& out) {
+  out.non_finite_normal_count =
+      parallel_count(N.rows(), [&](std::int64_t i) { return !N.row(i).allFinite(); });
+  out.zero_normal_count = parallel_count(
+      N.rows(), [&](std::int64_t i) { return N.row(i).allFinite() && N.row(i).norm() == 0.0; });
+  out.non_unit_normal_count = parallel_count(N.rows(), [&](std::int64_t i) {
     const double length = N.row(i).norm();
-    if (!N.row(i).allFinite()) {
-      ++out.non_finite_normal_count;
-    } else if (length == 0.0) {
-      ++out.zero_normal_count;
-    } else if (std::abs(length - 1.0) > kUnitTolerance) {
-      ++out.non_unit_normal_count;
-    }
-  }
+    return N.row(i).allFinite() && length != 0.0 && std::abs(length - 1.0) > kUnitTolerance;
+  });
   // Area weights: the face normals' own average, NaN where it does not exist (no usable face).
-  const RowMatrixX3d from_faces = vertex_normals(V, F, NormalWeighting::area);
-  const std::vector<int> component = vertex_components(V.rows(), F, report);
+  const RowMatrixX3d from_faces =
+      detail::vertex_normals_from(V, F, topology.incidence, NormalWeighting::area);
+  const std::vector<int>& component = topology.components.vertex_component;
   std::vector<int> inward(report.components.size(), 0), counted(report.components.size(), 0);
   for (Eigen::Index i = 0; i < N.rows(); ++i) {
     const double dot = N.row(i).dot(from_faces.row(i));
@@ -106,23 +98,28 @@ std::string MeshFindings::summary() const {
 }
 
 MeshFindings check_mesh(PositionsRef V, FacesRef F, NormalsRef N) {
-  validate_mesh_arrays(V, F, N, "check_mesh");
-  const MeshStatistics stats = mesh_statistics(V, F);
-  const OrientationReport report = orientation_report(V, F);
+  if (!detail::face_indices_in_range(V.rows(), F) || (N.rows() != 0 && N.rows() != V.rows())) {
+    validate_mesh_arrays(V, F, N, "check_mesh");  // throws, naming the first bad face
+  }
+  // One topology pass serves the statistics and the orientation report (each computed its own).
+  const detail::MeshTopology topology = detail::mesh_topology(V.rows(), F);
+  const OrientationReport report = detail::orientation_report_from(V, F, topology);
   MeshFindings out;
-  out.non_finite_vertex_count = count_non_finite_rows(V);
-  out.repeated_index_face_count = count_repeated_index_faces(F);
-  // mesh_statistics counts faces with a repeated index as degenerate too.
-  out.degenerate_face_count = stats.degenerate_face_count - out.repeated_index_face_count;
-  out.duplicate_face_count = stats.duplicate_face_count;
-  out.unreferenced_vertex_count = stats.unreferenced_vertex_count;
-  out.non_manifold_edge_count = stats.non_manifold_edge_count;
-  out.non_manifold_vertex_count = stats.non_manifold_vertex_count;
+  out.non_finite_vertex_count =
+      parallel_count(V.rows(), [&](std::int64_t i) { return !V.row(i).allFinite(); });
+  out.repeated_index_face_count =
+      parallel_count(F.rows(), [&](std::int64_t f) { return detail::has_repeated_index(F, f); });
+  // degenerate_face_count counts faces with a repeated index as degenerate too.
+  out.degenerate_face_count = detail::degenerate_face_count(V, F) - out.repeated_index_face_count;
+  out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
+  out.unreferenced_vertex_count = static_cast<int>(topology.unreferenced_vertex_count);
+  out.non_manifold_edge_count = static_cast<int>(topology.non_manifold_edge_count);
+  out.non_manifold_vertex_count = static_cast<int>(topology.non_manifold_vertex_count);
   for (const auto& c : report.components) out.inconsistent_component_count += c.consistent ? 0 : 1;
   out.inward_component_count = report.inward_count();
-  out.boundary_edge_count = stats.boundary_edge_count;
-  out.component_count = stats.component_count;
-  if (N.rows() > 0) check_normals(V, F, N, report, out);
+  out.boundary_edge_count = static_cast<int>(topology.boundary_edge_count);
+  out.component_count = topology.components.count;
+  if (N.rows() > 0) check_normals(V, F, N, topology, report, out);
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include "topology_incidence.h"
 
 namespace focal {
+namespace detail {
 namespace {
 
 // What one vertex contributes to the counts: edges to higher-indexed neighbours (so each edge is
@@ -18,91 +19,136 @@ struct VertexCounts {
   int non_manifold_edges = 0;
   int duplicate_faces = 0;
   bool non_manifold_vertex = false;
+  std::uint8_t edge_flags = 0;
 };
 
 struct Scratch {
-  std::vector<detail::EdgeSide> sides;
+  std::vector<EdgeSide> sides;
   std::vector<int> fan_parent;
-  std::vector<std::array<int, 3>> triples;  // (middle, largest index, face) of faces at v
+  std::vector<std::uint64_t> pairs;  // (middle, largest index) of faces whose smallest is v
 };
 
-// Number of fans at v: its incident faces joined whenever they share an edge at v. Faces with a
-// repeated index span no wedge at v (a face (v, v, v) has no edge at all), so they neither form
-// nor link fans.
-int fan_count(FacesRef F, const detail::VertexFaces& inc, std::int64_t v,
-              const std::vector<detail::EdgeSide>& sides, std::vector<int>& parent) {
-  const int face_count = inc.size(v);
-  parent.resize(static_cast<std::size_t>(face_count));
-  for (int i = 0; i < face_count; ++i) parent[static_cast<std::size_t>(i)] = i;
-  const auto proper = [&](int local_face) {
-    return !detail::has_repeated_index(
-        F, inc.faces[static_cast<std::size_t>(inc.begin(v) + local_face)]);
-  };
-  detail::for_each_edge(sides,
-                        [&](int, const detail::EdgeSide* first, const detail::EdgeSide* last) {
-                          const detail::EdgeSide* anchor = nullptr;
-                          for (const auto* s = first; s < last; ++s) {
-                            if (!proper(s->local_face)) continue;
-                            if (anchor) detail::unite(parent, anchor->local_face, s->local_face);
-                            if (!anchor) anchor = s;
-                          }
-                        });
-  int fans = 0;
-  for (int i = 0; i < face_count; ++i) {
-    fans += proper(i) && detail::find_root(parent, i) == i ? 1 : 0;
-  }
-  return fans;
-}
-
-// Faces whose sorted index triple starts with v and repeats that of an earlier face.
-int duplicate_faces_at(FacesRef F, const detail::VertexFaces& inc, std::int64_t v,
-                       std::vector<std::array<int, 3>>& triples) {
-  triples.clear();
+// Faces whose sorted index triple starts with v and repeats that of an earlier face. Only the
+// number of repeats is needed, so the pairs are sorted without their faces.
+int duplicate_faces_at(FacesRef F, const VertexFaces& inc, std::int64_t v,
+                       std::vector<std::uint64_t>& pairs) {
+  pairs.clear();
   for (int j = inc.begin(v); j < inc.end(v); ++j) {
     const int f = inc.faces[static_cast<std::size_t>(j)];
     std::array<int, 3> t{F(f, 0), F(f, 1), F(f, 2)};
+    if (std::min({t[0], t[1], t[2]}) != v) continue;
     std::sort(t.begin(), t.end());
-    if (t[0] == v) triples.push_back({t[1], t[2], f});
+    pairs.push_back(static_cast<std::uint64_t>(t[1]) << 32 | static_cast<std::uint32_t>(t[2]));
   }
-  // Sorting by face last puts the earliest face of each vertex set first; the rest are copies.
-  std::sort(triples.begin(), triples.end());
+  sort_small(pairs.data(), pairs.data() + pairs.size(), std::less<>());
   int duplicates = 0;
-  for (std::size_t i = 1; i < triples.size(); ++i) {
-    if (triples[i][0] == triples[i - 1][0] && triples[i][1] == triples[i - 1][1]) ++duplicates;
-  }
+  for (std::size_t i = 1; i < pairs.size(); ++i) duplicates += pairs[i] == pairs[i - 1] ? 1 : 0;
   return duplicates;
 }
 
-VertexCounts vertex_counts(FacesRef F, const detail::VertexFaces& inc, std::int64_t v, Scratch& s) {
+// All of v's findings from one sorted list of its edge sides. Fans: v's faces without a
+// repeated index (direction != 0), joined whenever they share an edge at v; their number is the
+// faces less the joins that merged two fans.
+VertexCounts vertex_counts(FacesRef F, const VertexFaces& inc, std::int64_t v, bool statistics,
+                           Scratch& s) {
   VertexCounts counts;
-  detail::collect_edge_sides(F, inc, v, s.sides);
-  detail::for_each_edge(
-      s.sides, [&](int other, const detail::EdgeSide* first, const detail::EdgeSide* last) {
-        if (other < v) return;
-        ++counts.edges;
-        counts.boundary_edges += last - first == 1 ? 1 : 0;
-        counts.non_manifold_edges += last - first >= 3 ? 1 : 0;
-      });
-  counts.non_manifold_vertex = fan_count(F, inc, v, s.sides, s.fan_parent) > 1;
-  counts.duplicate_faces = duplicate_faces_at(F, inc, v, s.triples);
-  return counts;
-}
-
-int degenerate_face_count(PositionsRef V, FacesRef F) {
-  std::vector<std::uint8_t> degenerate(static_cast<std::size_t>(F.rows()));
-  detail::parallel_for(F.rows(), 0, [&](std::int64_t f) {
-    degenerate[static_cast<std::size_t>(f)] =
-        detail::has_repeated_index(F, f) ||
-        detail::is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
-                                       V.row(F(f, 2)).transpose());
+  const int proper_faces = collect_edge_sides(F, inc, v, s.sides);
+  s.fan_parent.resize(statistics ? static_cast<std::size_t>(inc.size(v)) : 0);
+  for (std::size_t i = 0; i < s.fan_parent.size(); ++i) s.fan_parent[i] = static_cast<int>(i);
+  int joins = 0;
+  for_each_edge(s.sides, [&](int other, const EdgeSide* first, const EdgeSide* last) {
+    const EdgeSide* anchor = nullptr;
+    for (const auto* side = first; statistics && side < last; ++side) {
+      if (side->direction == 0) continue;
+      if (anchor) {
+        const int a = find_root(s.fan_parent, anchor->local_face);
+        const int b = find_root(s.fan_parent, side->local_face);
+        joins += a != b ? 1 : 0;
+        unite(s.fan_parent, a, b);
+      } else {
+        anchor = side;
+      }
+    }
+    if (other < v) return;
+    const auto faces = last - first;
+    ++counts.edges;
+    counts.boundary_edges += faces == 1 ? 1 : 0;
+    counts.non_manifold_edges += faces >= 3 ? 1 : 0;
+    if (faces != 2) {
+      counts.edge_flags |= kOpenEdge;
+    } else if (!is_consistent_interior_edge(first, last)) {
+      counts.edge_flags |= kInconsistentEdge;
+    }
   });
-  return static_cast<int>(std::count(degenerate.begin(), degenerate.end(), 1));
+  if (!statistics) return counts;
+  counts.non_manifold_vertex = proper_faces - joins > 1;
+  counts.duplicate_faces = duplicate_faces_at(F, inc, v, s.pairs);
+  return counts;
 }
 
 }  // namespace
 
+MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F, TopologyDetail detail) {
+  const bool statistics = detail == TopologyDetail::statistics;
+  MeshTopology t;
+  t.incidence = vertex_face_incidence(vertex_count, F);
+  t.components = face_components(vertex_count, F);
+  t.edge_flags.resize(static_cast<std::size_t>(vertex_count));
+  // Per-block sums of integers: exact, so the totals do not depend on the split.
+  constexpr std::int64_t kBlock = 4096;
+  const std::int64_t blocks = (vertex_count + kBlock - 1) / kBlock;
+  std::vector<std::array<std::int64_t, 6>> sums(static_cast<std::size_t>(blocks));
+  PerThread<Scratch> scratch;
+  parallel_for(blocks, 0, [&](std::int64_t b) {
+    Scratch& s = scratch.local();
+    std::array<std::int64_t, 6> sum{};
+    for (auto v = b * kBlock; v < std::min(vertex_count, (b + 1) * kBlock); ++v) {
+      const VertexCounts c = vertex_counts(F, t.incidence, v, statistics, s);
+      t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
+      sum[0] += c.edges;
+      sum[1] += c.boundary_edges;
+      sum[2] += c.non_manifold_edges;
+      sum[3] += c.non_manifold_vertex ? 1 : 0;
+      sum[4] += c.duplicate_faces;
+      sum[5] += t.incidence.size(v) == 0 ? 1 : 0;
+    }
+    sums[static_cast<std::size_t>(b)] = sum;
+  });
+  for (const auto& sum : sums) {
+    t.edge_count += sum[0];
+    t.boundary_edge_count += sum[1];
+    t.non_manifold_edge_count += sum[2];
+    t.non_manifold_vertex_count += sum[3];
+    t.duplicate_face_count += sum[4];
+    t.unreferenced_vertex_count += sum[5];
+  }
+  return t;
+}
+
+int degenerate_face_count(PositionsRef V, FacesRef F) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
+  std::vector<int> count(static_cast<std::size_t>(blocks), 0);
+  parallel_for(blocks, 0, [&](std::int64_t b) {
+    int n = 0;
+    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+      n += has_repeated_index(F, f) ||
+           is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
+                                  V.row(F(f, 2)).transpose());
+    }
+    count[static_cast<std::size_t>(b)] = n;
+  });
+  int total = 0;
+  for (const int n : count) total += n;
+  return total;
+}
+
+}  // namespace detail
+
 MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "mesh_statistics");
+  if (!detail::face_indices_in_range(V.rows(), F)) {
+    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "mesh_statistics");  // throws, naming the face
+  }
   MeshStatistics stats;
   stats.vertex_count = static_cast<int>(V.rows());
   stats.face_count = static_cast<int>(F.rows());
@@ -111,24 +157,15 @@ MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
     stats.max_corner = V.colwise().maxCoeff().transpose();
   }
   stats.mean_edge_length = mean_edge_length(V, F);
-  stats.degenerate_face_count = degenerate_face_count(V, F);
-  stats.component_count = detail::face_components(V.rows(), F).count;
-
-  const auto inc = detail::vertex_face_incidence(V.rows(), F);
-  std::vector<VertexCounts> per_vertex(static_cast<std::size_t>(V.rows()));
-  detail::PerThread<Scratch> scratch;
-  detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
-    per_vertex[static_cast<std::size_t>(v)] = vertex_counts(F, inc, v, scratch.local());
-  });
-  for (std::size_t v = 0; v < per_vertex.size(); ++v) {
-    const auto& c = per_vertex[v];
-    stats.edge_count += c.edges;
-    stats.boundary_edge_count += c.boundary_edges;
-    stats.non_manifold_edge_count += c.non_manifold_edges;
-    stats.duplicate_face_count += c.duplicate_faces;
-    stats.non_manifold_vertex_count += c.non_manifold_vertex ? 1 : 0;
-    stats.unreferenced_vertex_count += inc.size(static_cast<std::int64_t>(v)) == 0 ? 1 : 0;
-  }
+  stats.degenerate_face_count = detail::degenerate_face_count(V, F);
+  const detail::MeshTopology t = detail::mesh_topology(V.rows(), F);
+  stats.component_count = t.components.count;
+  stats.edge_count = static_cast<int>(t.edge_count);
+  stats.boundary_edge_count = static_cast<int>(t.boundary_edge_count);
+  stats.non_manifold_edge_count = static_cast<int>(t.non_manifold_edge_count);
+  stats.non_manifold_vertex_count = static_cast<int>(t.non_manifold_vertex_count);
+  stats.duplicate_face_count = static_cast<int>(t.duplicate_face_count);
+  stats.unreferenced_vertex_count = static_cast<int>(t.unreferenced_vertex_count);
   return stats;
 }
 

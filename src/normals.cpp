@@ -23,74 +23,113 @@ constexpr double kVanishingSum = 1e-12;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Plain scalars rather than Eigen::Vector3d here: Eigen pairs 3-vectors into one SSE2 register
+// plus a scalar, and the packing cost more than the arithmetic (a third of vertex_normals).
+struct Vec3 {
+  double x, y, z;
+};
+
+inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+inline Vec3 row(PositionsRef V, Eigen::Index i) { return {V(i, 0), V(i, 1), V(i, 2)}; }
+
 // A face's weighted normal at one corner, and that vector's length.
 struct CornerTerm {
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Vec3 normal{0.0, 0.0, 0.0};
   double length = 0.0;
 };
 
 // Contribution of a face to the normal at its corner p, with q and r following p
-// counter-clockwise; zero for a degenerate face.
-CornerTerm corner_contribution(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
-                               const Eigen::Vector3d& r, NormalWeighting weighting) {
-  const Eigen::Vector3d e1 = q - p;
-  const Eigen::Vector3d e2 = r - p;
-  const Eigen::Vector3d n = e1.cross(e2);
-  const double n_norm = n.norm();
-  const double e1_sq = e1.squaredNorm();
-  const double e2_sq = e2.squaredNorm();
+// counter-clockwise; zero for a degenerate face. The weighting is a template parameter so that
+// the per-face switch is hoisted out of the vertex loop.
+template <NormalWeighting weighting>
+CornerTerm corner_contribution(const Vec3& p, const Vec3& q, const Vec3& r) {
+  const Vec3 e1 = q - p;
+  const Vec3 e2 = r - p;
+  const Vec3 n = cross(e1, e2);
+  const double n_norm = std::sqrt(dot(n, n));
+  const double e1_sq = dot(e1, e1);
+  const double e2_sq = dot(e2, e2);
+  const Vec3 e3 = r - q;
   // Same test as detail::is_degenerate_triangle, reusing the cross product computed here.
-  if (!(n_norm > detail::kDegenerateArea * std::max({e1_sq, e2_sq, (r - q).squaredNorm()}))) {
-    return {};
+  if (!(n_norm > detail::kDegenerateArea * std::max({e1_sq, e2_sq, dot(e3, e3)}))) return {};
+  if constexpr (weighting == NormalWeighting::area) {
+    return {n, n_norm};
+  } else if constexpr (weighting == NormalWeighting::angle) {
+    // atan2 keeps full precision for angles near 0 and pi, unlike acos of a dot product.
+    const double angle = std::atan2(n_norm, dot(e1, e2));
+    const double scale = angle / n_norm;
+    return {{scale * n.x, scale * n.y, scale * n.z}, angle};
+  } else {
+    const double scale = 1.0 / (e1_sq * e2_sq);
+    return {{scale * n.x, scale * n.y, scale * n.z}, scale * n_norm};
   }
-  switch (weighting) {
-    case NormalWeighting::area:
-      return {n, n_norm};
-    case NormalWeighting::angle: {
-      // atan2 keeps full precision for angles near 0 and pi, unlike acos of a dot product.
-      const double angle = std::atan2(n_norm, e1.dot(e2));
-      return {angle / n_norm * n, angle};
-    }
-    case NormalWeighting::max: {
-      const double scale = 1.0 / (e1_sq * e2_sq);
-      return {scale * n, scale * n_norm};
-    }
-  }
-  return {};
 }
 
 // Weighted normal of vertex v from its incident faces, in ascending face order; NaN when no face
 // contributes or the contributions cancel.
+template <NormalWeighting weighting>
 Eigen::Vector3d gathered_normal(PositionsRef V, FacesRef F, const detail::VertexFaces& inc,
-                                std::int64_t v, NormalWeighting weighting) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+                                std::int64_t v) {
+  Vec3 sum{0.0, 0.0, 0.0};
   double total = 0.0;
+  const Vec3 p = row(V, v);
   for (int j = inc.begin(v); j < inc.end(v); ++j) {
     const int f = inc.faces[static_cast<std::size_t>(j)];
-    if (detail::has_repeated_index(F, f)) continue;
-    const int c = F(f, 0) == v ? 0 : (F(f, 1) == v ? 1 : 2);
-    const CornerTerm term =
-        corner_contribution(V.row(v).transpose(), V.row(F(f, (c + 1) % 3)).transpose(),
-                            V.row(F(f, (c + 2) % 3)).transpose(), weighting);
-    sum += term.normal;
+    const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+    if (a == b || b == c || a == c) continue;  // a repeated index spans no triangle
+    // The corners following v counter-clockwise.
+    const int q = a == v ? b : (b == v ? c : a);
+    const int r = a == v ? c : (b == v ? a : b);
+    const CornerTerm term = corner_contribution<weighting>(p, row(V, q), row(V, r));
+    sum = {sum.x + term.normal.x, sum.y + term.normal.y, sum.z + term.normal.z};
     total += term.length;
   }
-  const double length = sum.norm();
+  const double length = std::sqrt(dot(sum, sum));
   if (!(length > kVanishingSum * total)) return Eigen::Vector3d::Constant(kNaN);
-  return sum / length;
+  return {sum.x / length, sum.y / length, sum.z / length};
+}
+
+template <NormalWeighting weighting>
+void gather_normals(PositionsRef V, FacesRef F, const detail::VertexFaces& inc, RowMatrixX3d& N) {
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
+    N.row(v) = gathered_normal<weighting>(V, F, inc, v).transpose();
+  });
 }
 
 }  // namespace
 
 RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F, NormalWeighting weighting) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "vertex_normals");
-  const auto inc = detail::vertex_face_incidence(V.rows(), F);
+  if (!detail::face_indices_in_range(V.rows(), F)) {
+    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "vertex_normals");  // throws, naming the face
+  }
+  return detail::vertex_normals_from(V, F, detail::vertex_face_incidence(V.rows(), F), weighting);
+}
+
+namespace detail {
+
+RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
+                                 NormalWeighting weighting) {
   RowMatrixX3d N(V.rows(), 3);
-  detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
-    N.row(v) = gathered_normal(V, F, inc, v, weighting).transpose();
-  });
+  switch (weighting) {
+    case NormalWeighting::area:
+      gather_normals<NormalWeighting::area>(V, F, inc, N);
+      break;
+    case NormalWeighting::angle:
+      gather_normals<NormalWeighting::angle>(V, F, inc, N);
+      break;
+    case NormalWeighting::max:
+      gather_normals<NormalWeighting::max>(V, F, inc, N);
+      break;
+  }
   return N;
 }
+
+}  // namespace detail
 
 int OrientationReport::inward_count() const {
   int count = 0;
@@ -99,35 +138,6 @@ int OrientationReport::inward_count() const {
 }
 
 namespace {
-
-// Per-vertex edge findings, for the edges from a vertex to its higher-indexed neighbours (so that
-// each edge is examined once).
-enum EdgeFlag : std::uint8_t {
-  kOpenEdge = 1,          // an edge without exactly two incident faces
-  kInconsistentEdge = 2,  // an interior edge traversed the same way by both faces
-};
-
-std::vector<std::uint8_t> edge_flags(std::int64_t vertex_count, FacesRef F,
-                                     const detail::VertexFaces& inc) {
-  std::vector<std::uint8_t> flags(static_cast<std::size_t>(vertex_count), 0);
-  detail::PerThread<std::vector<detail::EdgeSide>> scratch;
-  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
-    auto& sides = scratch.local();
-    detail::collect_edge_sides(F, inc, v, sides);
-    std::uint8_t flag = 0;
-    detail::for_each_edge(
-        sides, [&](int other, const detail::EdgeSide* first, const detail::EdgeSide* last) {
-          if (other < v) return;
-          if (last - first != 2) {
-            flag |= kOpenEdge;
-          } else if (!detail::is_consistent_interior_edge(first, last)) {
-            flag |= kInconsistentEdge;
-          }
-        });
-    flags[static_cast<std::size_t>(v)] = flag;
-  });
-  return flags;
-}
 
 // Signed volumes per component, each about its vertex centroid: for a surface far from the origin
 // the determinants would otherwise be large terms that cancel.
@@ -153,11 +163,16 @@ void add_signed_volumes(PositionsRef V, FacesRef F, const detail::FaceComponents
 }  // namespace
 
 OrientationReport orientation_report(PositionsRef V, FacesRef F) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "orientation_report");
-  const auto comp = detail::face_components(V.rows(), F);
-  const auto inc = detail::vertex_face_incidence(V.rows(), F);
-  const auto flags = edge_flags(V.rows(), F, inc);
+  if (!detail::face_indices_in_range(V.rows(), F)) {
+    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "orientation_report");  // throws
+  }
+  return detail::orientation_report_from(
+      V, F, detail::mesh_topology(V.rows(), F, detail::TopologyDetail::orientation));
+}
 
+OrientationReport detail::orientation_report_from(PositionsRef V, FacesRef F,
+                                                  const MeshTopology& t) {
+  const FaceComponents& comp = t.components;
   OrientationReport report;
   report.face_component = Eigen::Map<const Eigen::VectorXi>(comp.face_component.data(), F.rows());
   report.components.assign(static_cast<std::size_t>(comp.count), ComponentOrientation{});
@@ -165,13 +180,13 @@ OrientationReport orientation_report(PositionsRef V, FacesRef F) {
   for (const int c : comp.face_component) {
     ++report.components[static_cast<std::size_t>(c)].face_count;
   }
-  for (std::size_t v = 0; v < flags.size(); ++v) {
+  for (std::size_t v = 0; v < t.edge_flags.size(); ++v) {
     const int c = comp.vertex_component[v];
     if (c < 0) continue;
     auto& component = report.components[static_cast<std::size_t>(c)];
     ++component.vertex_count;
-    if (flags[v] & kOpenEdge) component.closed = false;
-    if (flags[v] & kInconsistentEdge) component.consistent = false;
+    if (t.edge_flags[v] & kOpenEdge) component.closed = false;
+    if (t.edge_flags[v] & kInconsistentEdge) component.consistent = false;
   }
   add_signed_volumes(V, F, comp, report.components);
   for (auto& c : report.components) c.inward = c.closed && c.consistent && c.signed_volume < 0.0;

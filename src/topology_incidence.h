@@ -14,13 +14,16 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "focal/error.h"
 #include "focal/mesh.h"
+#include "focal/normals.h"
 #include "parallel.h"
 
 namespace focal::detail {
@@ -77,7 +80,26 @@ struct VertexFaces {
   [[nodiscard]] int size(std::int64_t v) const { return end(v) - begin(v); }
 };
 
-/// Builds the incidence by a counting sort over the faces (two linear passes, no comparisons).
+/// Face chunks of the parallel counting sort below: each chunk counts into an #V array of its
+/// own, so more chunks cost memory (4 #V bytes each) and a longer prefix pass.
+inline int incidence_chunks(std::int64_t face_count) {
+  constexpr std::int64_t kMinFacesPerChunk = 1 << 16;
+  const std::int64_t by_size = std::max<std::int64_t>(1, face_count / kMinFacesPerChunk);
+  return static_cast<int>(std::min<std::int64_t>({by_size, thread_count(0), 8}));
+}
+
+/// Visits the distinct corners of face f, so that (a, a, b) is listed once under a.
+template <class Fn>
+void for_each_distinct_corner(FacesRef F, Eigen::Index f, Fn&& fn) {
+  const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+  fn(a);
+  if (b != a) fn(b);
+  if (c != a && c != b) fn(c);
+}
+
+/// Builds the incidence by a counting sort over the faces. The faces are split into consecutive
+/// chunks that count and fill in parallel; chunk k's faces go after those of chunks < k in each
+/// list, so every list is ascending and the result is the same for any thread count.
 /// F must already be validated against vertex_count.
 /// \throw InvalidInput when 3 #F exceeds 32-bit offsets.
 inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F) {
@@ -85,28 +107,37 @@ inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F) 
     throw InvalidInput("too many faces (" + std::to_string(F.rows()) +
                        ") for 32-bit neighbourhood offsets");
   }
+  const auto n = static_cast<std::size_t>(vertex_count);
+  const int chunks = incidence_chunks(F.rows());
+  const auto chunk_begin = [&](std::int64_t k) { return k * F.rows() / chunks; };
+  // cursor[k][v]: first counts of chunk k's faces at v, then where chunk k writes its next face.
+  std::vector<std::vector<int>> cursor(static_cast<std::size_t>(chunks));
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int k = 0; k < chunks; ++k) {
+    auto& count = cursor[static_cast<std::size_t>(k)];
+    count.assign(n, 0);
+    for (auto f = chunk_begin(k); f < chunk_begin(k + 1); ++f) {
+      for_each_distinct_corner(F, f, [&](int v) { ++count[static_cast<std::size_t>(v)]; });
+    }
+  }
   VertexFaces inc;
-  inc.offsets.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
-  // Visits the distinct corners of face f, so that (a, a, b) is listed once under a.
-  const auto for_each_distinct_corner = [&F](Eigen::Index f, auto&& fn) {
-    const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
-    fn(a);
-    if (b != a) fn(b);
-    if (c != a && c != b) fn(c);
-  };
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for_each_distinct_corner(f, [&](int v) { ++inc.offsets[static_cast<std::size_t>(v) + 1]; });
+  inc.offsets.resize(n + 1);
+  int total = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    inc.offsets[v] = total;
+    for (auto& c : cursor) total += std::exchange(c[v], total);
   }
-  for (std::size_t v = 0; v < static_cast<std::size_t>(vertex_count); ++v) {
-    inc.offsets[v + 1] += inc.offsets[v];
-  }
-  inc.faces.resize(static_cast<std::size_t>(inc.offsets.back()));
-  std::vector<int> cursor(inc.offsets.begin(), inc.offsets.end() - 1);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for_each_distinct_corner(f, [&](int v) {
-      inc.faces[static_cast<std::size_t>(cursor[static_cast<std::size_t>(v)]++)] =
-          static_cast<int>(f);
-    });
+  inc.offsets[n] = total;
+  inc.faces.resize(static_cast<std::size_t>(total));
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int k = 0; k < chunks; ++k) {
+    auto& next = cursor[static_cast<std::size_t>(k)];
+    for (auto f = chunk_begin(k); f < chunk_begin(k + 1); ++f) {
+      for_each_distinct_corner(F, f, [&](int v) {
+        inc.faces[static_cast<std::size_t>(next[static_cast<std::size_t>(v)]++)] =
+            static_cast<int>(f);
+      });
+    }
   }
   return inc;
 }
@@ -119,35 +150,58 @@ struct EdgeSide {
   int direction;
 };
 
+/// Sorts a short range by `less` in place: insertion sort for the dozen entries of a typical
+/// vertex (std::sort's call and dispatch cost more than the sort there), std::sort beyond.
+template <class T, class Less>
+void sort_small(T* first, T* last, Less less) {
+  if (last - first > 32) return std::sort(first, last, less);
+  for (T* i = first + (first != last); i < last; ++i) {
+    const T x = *i;
+    T* j = i;
+    for (; j > first && less(x, j[-1]); --j) *j = j[-1];
+    *j = x;
+  }
+}
+
 /// Fills `sides` with one entry per (edge at v, incident face), sorted by (other, local_face), so
-/// that the faces of each edge at v are consecutive.
-inline void collect_edge_sides(FacesRef F, const VertexFaces& inc, std::int64_t v,
-                               std::vector<EdgeSide>& sides) {
-  sides.clear();
-  for (int j = inc.begin(v); j < inc.end(v); ++j) {
-    const int f = inc.faces[static_cast<std::size_t>(j)];
-    const int local = j - inc.begin(v);
-    for (int c = 0; c < 3; ++c) {
-      const int p = F(f, c), q = F(f, (c + 1) % 3);
-      if (p == q) continue;
-      if (p == v) sides.push_back({q, local, +1});
-      if (q == v) sides.push_back({p, local, -1});
+/// that the faces of each edge at v are consecutive. Returns how many incident faces have no
+/// repeated index (their sides have direction +1 or -1; the others' have 0).
+inline int collect_edge_sides(FacesRef F, const VertexFaces& inc, std::int64_t v,
+                              std::vector<EdgeSide>& sides) {
+  const int begin = inc.begin(v), count = inc.size(v);
+  // Every face has at most two sides at v; written through a pointer (no push_back checks).
+  sides.resize(2 * static_cast<std::size_t>(count));
+  EdgeSide* out = sides.data();
+  int proper = 0;
+  for (int local = 0; local < count; ++local) {
+    const int f = inc.faces[static_cast<std::size_t>(begin + local)];
+    const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+    if (a != b && b != c && a != c) {
+      // v is exactly one corner: its successor is traversed v -> next, its predecessor prev -> v.
+      const int next = a == v ? b : (b == v ? c : a);
+      const int prev = a == v ? c : (b == v ? a : b);
+      *out++ = {next, local, +1};
+      *out++ = {prev, local, -1};
+      ++proper;
+      continue;
+    }
+    // A face with a repeated index lists its edge at v both ways: one side, direction 0.
+    for (int k = 0; k < 3; ++k) {
+      const int p = F(f, k), q = F(f, (k + 1) % 3);
+      if (p != q && (p == v || q == v)) {
+        *out++ = {p == v ? q : p, local, 0};
+        break;
+      }
     }
   }
-  std::sort(sides.begin(), sides.end(), [](const EdgeSide& a, const EdgeSide& b) {
-    return a.other != b.other ? a.other < b.other : a.local_face < b.local_face;
-  });
-  // A face with a repeated index lists the same edge twice with opposite directions: merge.
-  std::size_t m = 0;
-  for (std::size_t i = 0; i < sides.size(); ++i) {
-    if (m > 0 && sides[m - 1].other == sides[i].other &&
-        sides[m - 1].local_face == sides[i].local_face) {
-      sides[m - 1].direction += sides[i].direction;
-    } else {
-      sides[m++] = sides[i];
-    }
-  }
-  sides.resize(m);
+  sides.resize(static_cast<std::size_t>(out - sides.data()));
+  // One 64-bit comparison instead of two branches: both fields are non-negative ints.
+  const auto key = [](const EdgeSide& x) {
+    return static_cast<std::uint64_t>(x.other) << 32 | static_cast<std::uint32_t>(x.local_face);
+  };
+  sort_small(sides.data(), out,
+             [&](const EdgeSide& x, const EdgeSide& y) { return key(x) < key(y); });
+  return proper;
 }
 
 /// Calls fn(other, first, last) for each edge {v, other} in the sorted output of
@@ -208,30 +262,162 @@ struct FaceComponents {
   int count = 0;
 };
 
-/// Union-find over vertices (serial: a near-linear pass that costs a few ms per million faces).
-/// F must already be validated against vertex_count.
+/// Root of x in a union-find forest shared by threads, whose links always point to a smaller
+/// index (so a root is the smallest vertex of its set). Path halving writes only to non-roots and
+/// only replaces a parent by one of its ancestors, so it cannot undo a concurrent link.
+inline int find_shared_root(int* parent, int x) {
+  for (;;) {
+    std::atomic_ref<int> link(parent[x]);
+    const int p = link.load(std::memory_order_relaxed);
+    if (p == x) return x;
+    const int grand = std::atomic_ref<int>(parent[p]).load(std::memory_order_relaxed);
+    if (grand != p) link.store(grand, std::memory_order_relaxed);
+    x = grand;
+  }
+}
+
+/// Joins the sets of a and b in a forest shared by threads: the larger root is linked under the
+/// smaller by compare-and-swap, retried when another thread linked it first.
+inline void unite_shared(int* parent, int a, int b) {
+  for (;;) {
+    a = find_shared_root(parent, a);
+    b = find_shared_root(parent, b);
+    if (a == b) return;
+    if (a < b) std::swap(a, b);
+    int expected = a;
+    if (std::atomic_ref<int>(parent[a]).compare_exchange_weak(expected, b,
+                                                              std::memory_order_relaxed)) {
+      return;
+    }
+  }
+}
+
+/// Numbers the sets of `root` (#V, each vertex's set root) in order of their first face:
+/// label[r] for each root r of a face's corners, -1 elsewhere. Returns the number of sets.
+inline int label_components_by_first_face(FacesRef F, const std::vector<int>& root,
+                                          std::vector<int>& label) {
+  // first[r]: the smallest face of set r, by an atomic minimum (the same for any schedule).
+  std::vector<int> first(root.size(), std::numeric_limits<int>::max());
+  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+    std::atomic_ref<int> slot(
+        first[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])]);
+    int current = slot.load(std::memory_order_relaxed);
+    while (f < current &&
+           !slot.compare_exchange_weak(current, static_cast<int>(f), std::memory_order_relaxed)) {
+    }
+  });
+  // Faces that start a set, counted per block and numbered in face order.
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
+  const auto starts_set = [&](std::int64_t f) {
+    return first[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] == f;
+  };
+  std::vector<int> block_start(static_cast<std::size_t>(blocks) + 1, 0);
+  parallel_for(blocks, 0, [&](std::int64_t b) {
+    int n = 0;
+    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) n += starts_set(f);
+    block_start[static_cast<std::size_t>(b) + 1] = n;
+  });
+  for (std::size_t b = 0; b < static_cast<std::size_t>(blocks); ++b) {
+    block_start[b + 1] += block_start[b];
+  }
+  label.assign(root.size(), -1);
+  parallel_for(blocks, 0, [&](std::int64_t b) {
+    int next = block_start[static_cast<std::size_t>(b)];
+    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+      if (starts_set(f))
+        label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] = next++;
+    }
+  });
+  return block_start.back();
+}
+
+/// Union-find over vertices, in parallel (shared forest, see unite_shared). The sets do not
+/// depend on the order of the unions and each is numbered by its first face, so the result is
+/// the same for any thread count. F must already be validated against vertex_count.
 inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F) {
-  std::vector<int> parent(static_cast<std::size_t>(vertex_count));
-  for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    unite(parent, F(f, 0), F(f, 1));
-    unite(parent, F(f, 0), F(f, 2));
-  }
+  const auto n = static_cast<std::size_t>(vertex_count);
+  std::vector<int> parent(n);
+  parallel_for(vertex_count, 0,
+               [&](std::int64_t v) { parent[static_cast<std::size_t>(v)] = static_cast<int>(v); });
+  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+    unite_shared(parent.data(), F(f, 0), F(f, 1));
+    unite_shared(parent.data(), F(f, 0), F(f, 2));
+  });
+  std::vector<int> root(n);
+  parallel_for(vertex_count, 0, [&](std::int64_t v) {
+    root[static_cast<std::size_t>(v)] = find_shared_root(parent.data(), static_cast<int>(v));
+  });
   FaceComponents result;
+  std::vector<int> label;
+  result.count = label_components_by_first_face(F, root, label);
   result.face_component.resize(static_cast<std::size_t>(F.rows()));
-  std::vector<int> label(static_cast<std::size_t>(vertex_count), -1);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    int& l = label[static_cast<std::size_t>(find_root(parent, F(f, 0)))];
-    if (l < 0) l = result.count++;
-    result.face_component[static_cast<std::size_t>(f)] = l;
-  }
+  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+    result.face_component[static_cast<std::size_t>(f)] =
+        label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])];
+  });
   // An unreferenced vertex is its own, never labelled root, hence -1.
-  result.vertex_component.resize(static_cast<std::size_t>(vertex_count));
-  for (std::size_t v = 0; v < parent.size(); ++v) {
-    result.vertex_component[v] =
-        label[static_cast<std::size_t>(find_root(parent, static_cast<int>(v)))];
-  }
+  result.vertex_component.resize(n);
+  parallel_for(vertex_count, 0, [&](std::int64_t v) {
+    result.vertex_component[static_cast<std::size_t>(v)] =
+        label[static_cast<std::size_t>(root[static_cast<std::size_t>(v)])];
+  });
   return result;
+}
+
+/// Edge findings of one vertex for its edges to higher-indexed neighbours (each edge once).
+enum EdgeFlag : std::uint8_t {
+  kOpenEdge = 1,          ///< an edge without exactly two incident faces
+  kInconsistentEdge = 2,  ///< an interior edge traversed the same way by both faces
+};
+
+/// What mesh_statistics, orientation_report and check_mesh need of the connectivity, computed in
+/// one parallel pass over the vertices' edge sides (each was a pass of its own before).
+struct MeshTopology {
+  VertexFaces incidence;
+  FaceComponents components;
+  std::vector<std::uint8_t> edge_flags;  ///< #V, EdgeFlag bits
+  std::int64_t edge_count = 0;
+  std::int64_t boundary_edge_count = 0;
+  std::int64_t non_manifold_edge_count = 0;
+  std::int64_t non_manifold_vertex_count = 0;
+  std::int64_t duplicate_face_count = 0;
+  std::int64_t unreferenced_vertex_count = 0;
+};
+
+/// How much of MeshTopology to compute: `orientation` leaves out the fans (non-manifold
+/// vertices) and duplicate faces, which orientation_report does not need.
+enum class TopologyDetail { orientation, statistics };
+
+/// Defined in mesh_statistics.cpp. F must already be validated against vertex_count.
+MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F,
+                           TopologyDetail detail = TopologyDetail::statistics);
+
+/// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
+/// Defined in mesh_statistics.cpp; F must already be validated against V.
+int degenerate_face_count(PositionsRef V, FacesRef F);
+
+/// orientation_report from a topology already computed for (V, F). Defined in normals.cpp.
+OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t);
+
+/// vertex_normals from an incidence already computed for F. Defined in normals.cpp.
+RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
+                                 NormalWeighting weighting);
+
+/// True when every index of F lies in [0, vertex_count), checked in parallel; callers then call
+/// validate_mesh_arrays only to produce its message for the first bad face.
+inline bool face_indices_in_range(std::int64_t vertex_count, FacesRef F) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
+  std::vector<std::uint8_t> bad(static_cast<std::size_t>(blocks), 0);
+  parallel_for(blocks, 0, [&](std::int64_t b) {
+    bool any = false;
+    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+      for (int c = 0; c < 3; ++c) any |= F(f, c) < 0 || F(f, c) >= vertex_count;
+    }
+    bad[static_cast<std::size_t>(b)] = any;
+  });
+  return std::find(bad.begin(), bad.end(), 1) == bad.end();
 }
 
 }  // namespace focal::detail

@@ -10,8 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -496,6 +501,110 @@ TEST(Robustness, SingleTriangleAndEmptyMeshHaveNoProblems) {
   const MeshFindings p = check_mesh(m.V, RowMatrixX3i(0, 3), RowMatrixX3d(0, 3));
   EXPECT_EQ(p.summary(), "3 unreferenced vertices");
   EXPECT_THROW((void)check_mesh(m.V, m.F, RowMatrixX3d::Zero(2, 3)), InvalidInput);
+}
+
+// ---- The parallel topology pass (check stage) against a serial reference ----------------------
+
+// Three grids of 150 x 150 vertices: the second turned over and joined to the first at one
+// corner by a face that also makes a diagonal of the second non-manifold, one face of the third
+// flipped, a duplicate face, two faces with repeated indices and an unreferenced vertex; faces
+// shuffled so that components interleave. About 133K faces: enough for the parallel incidence
+// to split them into chunks.
+Mesh messy_big_mesh() {
+  constexpr int n = 150;
+  Mesh m = join(join(test::flat_grid(n), test::flat_grid(n), Eigen::RowVector3d(300, 0, 0)),
+                test::flat_grid(n), Eigen::RowVector3d(0, 300, 0));
+  const Eigen::Index per_grid = m.F.rows() / 3;
+  for (Eigen::Index f = per_grid; f < 2 * per_grid; ++f) std::swap(m.F(f, 1), m.F(f, 2));
+  std::swap(m.F(2 * per_grid, 1), m.F(2 * per_grid, 2));  // one face of the third grid
+  RowMatrixX3i extra(4, 3);
+  extra << m.F.row(7), 5, 5, 9, 0, n * n + n + 1, n * n + 2 * n + 2, 3, 3, 3;
+  m.F.conservativeResize(m.F.rows() + extra.rows(), 3);
+  m.F.bottomRows(extra.rows()) = extra;
+  m.V.conservativeResize(m.V.rows() + 1, 3);  // unreferenced
+  m.V.bottomRows(1) << 1e3, 1e3, 1e3;
+  m.N.conservativeResize(m.V.rows(), 3);
+  m.N.bottomRows(1) << 0, 0, 1;
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(m.F.rows()));
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Eigen::Index>(i);
+  std::mt19937 random(5);
+  std::shuffle(order.begin(), order.end(), random);
+  const RowMatrixX3i faces = m.F;
+  for (std::size_t i = 0; i < order.size(); ++i)
+    m.F.row(static_cast<Eigen::Index>(i)) = faces.row(order[i]);
+  return m;
+}
+
+// Components of faces by a plain serial union-find, numbered by first face.
+std::vector<int> reference_face_components(const Mesh& m) {
+  std::vector<int> parent(static_cast<std::size_t>(m.V.rows()));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int x) {
+    while (parent[static_cast<std::size_t>(x)] != x) {
+      x = parent[static_cast<std::size_t>(x)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    }
+    return x;
+  };
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    for (int c = 1; c < 3; ++c) parent[static_cast<std::size_t>(root(m.F(f, c)))] = root(m.F(f, 0));
+  }
+  std::map<int, int> label;
+  std::vector<int> out;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    out.push_back(label.try_emplace(root(m.F(f, 0)), static_cast<int>(label.size())).first->second);
+  }
+  return out;
+}
+
+TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
+  const Mesh m = messy_big_mesh();
+  // Reference edge counts: incident faces per undirected edge, each face once per edge.
+  std::map<std::pair<int, int>, int> faces_of_edge;
+  std::set<std::array<int, 3>> triples;
+  int duplicates = 0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    std::array<int, 3> t{m.F(f, 0), m.F(f, 1), m.F(f, 2)};
+    std::sort(t.begin(), t.end());
+    duplicates += triples.insert(t).second ? 0 : 1;
+    std::set<std::pair<int, int>> edges;
+    for (int c = 0; c < 3; ++c) {
+      const int a = m.F(f, c), b = m.F(f, (c + 1) % 3);
+      if (a != b) edges.insert({std::min(a, b), std::max(a, b)});
+    }
+    for (const auto& e : edges) ++faces_of_edge[e];
+  }
+  int boundary = 0, non_manifold = 0;
+  for (const auto& [edge, count] : faces_of_edge) {
+    boundary += count == 1 ? 1 : 0;
+    non_manifold += count >= 3 ? 1 : 0;
+  }
+  const std::vector<int> components = reference_face_components(m);
+
+  for (const int threads : {1, 2, 3}) {
+    const test::ScopedThreads scoped(threads);
+    const MeshStatistics s = mesh_statistics(m.V, m.F);
+    EXPECT_EQ(s.edge_count, static_cast<int>(faces_of_edge.size()));
+    EXPECT_EQ(s.boundary_edge_count, boundary);
+    EXPECT_EQ(s.non_manifold_edge_count, non_manifold);
+    EXPECT_EQ(s.duplicate_face_count, duplicates);
+    EXPECT_EQ(s.duplicate_face_count, 1);
+    EXPECT_EQ(s.unreferenced_vertex_count, 1);
+    EXPECT_EQ(s.non_manifold_vertex_count, 1);  // vertex 0: its grid fan and the joining face
+    EXPECT_EQ(s.component_count, 2);            // the joining face makes one of the first two
+    const OrientationReport r = orientation_report(m.V, m.F);
+    ASSERT_EQ(r.face_component.size(), static_cast<Eigen::Index>(components.size()));
+    for (std::size_t f = 0; f < components.size(); ++f) {
+      ASSERT_EQ(r.face_component[static_cast<Eigen::Index>(f)], components[f]) << "face " << f;
+    }
+    const MeshFindings findings = check_mesh(m.V, m.F, m.N);
+    EXPECT_EQ(findings.component_count, 2);
+    EXPECT_EQ(findings.duplicate_face_count, 1);
+    EXPECT_EQ(findings.repeated_index_face_count, 2);
+    EXPECT_EQ(findings.unreferenced_vertex_count, 1);
+    EXPECT_EQ(findings.inconsistent_component_count, 1);  // the third grid's flipped face
+    EXPECT_EQ(findings.non_manifold_vertex_count, 1);
+  }
 }
 
 }  // namespace

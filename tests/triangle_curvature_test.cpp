@@ -141,5 +141,36 @@ TEST(TriangleCurvature, InvalidArgumentsThrow) {
   EXPECT_THROW((void)triangle_curvature(m.V, bad, m.N), InvalidInput);
 }
 
+// Asking for fewer fields leaves the others empty and changes none of the asked values, also
+// for undefined faces (NaN where all fields are asked), and any thread count gives the same.
+TEST(TriangleCurvature, FieldSelectionFillsOnlyTheAskedFieldsWithTheSameValues) {
+  const AnalyticSurface s = surface(SurfaceKind::ellipsoid, Triangulation::irregular, 3000);
+  Mesh m = s.mesh;
+  m.N.row(0).setZero();  // its faces come out undefined
+  const TriangleCurvatureResult all = triangle_curvature(m.V, m.F, m.N);
+  TriangleFields few;
+  few.coefficients = few.focal_depths = few.slits = few.face_normal = false;
+  CurvatureOptions o;
+  for (const int threads : {1, 3}) {
+    o.threads = threads;
+    const TriangleCurvatureResult t = triangle_curvature(m.V, m.F, m.N, o, few);
+    for (const Eigen::VectorXd* v : {&t.A, &t.B, &t.C, &t.lambda1, &t.lambda2}) {
+      EXPECT_EQ(v->size(), 0);
+    }
+    EXPECT_EQ(t.slit1.rows(), 0);
+    EXPECT_EQ(t.face_normal.rows(), 0);
+    const auto same = [](const auto& a, const auto& b) {
+      return a.rows() == b.rows() && a.cols() == b.cols() &&
+             ((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all();
+    };
+    EXPECT_TRUE(same(t.K, all.K) && same(t.H, all.H) && same(t.k1, all.k1) && same(t.k2, all.k2));
+    EXPECT_TRUE(same(t.d1, all.d1) && same(t.d2, all.d2));
+    EXPECT_TRUE(same(t.shape_operator, all.shape_operator));
+    EXPECT_TRUE((t.point_class.array() == all.point_class.array()).all());
+  }
+  const auto undefined = static_cast<std::uint8_t>(PointClass::undefined);
+  EXPECT_GT((all.point_class.array() == undefined).count(), 0);  // the faces at vertex 0
+}
+
 }  // namespace
 }  // namespace focal

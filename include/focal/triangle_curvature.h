@@ -32,11 +32,30 @@ struct TriangleCurvatureResult {
   VectorXu8 point_class;     ///< PointClass codes from A, B and the discriminant
 };
 
+/// Which fields of TriangleCurvatureResult triangle_curvature fills. A field not asked for is
+/// left with 0 rows and its computation is skipped where no asked field needs it (the slits are
+/// the costliest); point_class is always filled. Every field is asked for by default.
+struct TriangleFields {
+  bool coefficients = true;    ///< A, B, C
+  bool curvatures = true;      ///< K, H, k1, k2
+  bool focal_depths = true;    ///< lambda1, lambda2
+  bool directions = true;      ///< d1, d2
+  bool slits = true;           ///< slit1, slit2
+  bool face_normal = true;     ///< face_normal
+  bool shape_operator = true;  ///< shape_operator
+};
+
 /// Solves the characteristic equation on every face. Faces with zero area in the ray frame
 /// (C = 0), a vertex normal outside the face normal's hemisphere or non-finite input are
 /// `undefined` with NaN values.
 /// \throw InvalidInput when shapes differ or F indexes outside V.
 [[nodiscard]] TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                          const CurvatureOptions& options = {});
+
+/// triangle_curvature filling only `fields` (same values in the fields it fills). Each face's
+/// row is written once, by the thread that computes it.
+[[nodiscard]] TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                                         const CurvatureOptions& options,
+                                                         const TriangleFields& fields);
 
 }  // namespace focal
