@@ -204,7 +204,7 @@ SCANS
       echo
       cat "$work/timing.md"
       echo
-      echo "Other engineers share this machine's cores: absolute times are noisy, the ratios come"
+      echo "Absolute times depend on the machine and its load (see docs/PERFORMANCE.md for quiet runs); the ratios come"
       echo "from one run."
     fi
   fi
