@@ -27,7 +27,7 @@ demo: deps-demo build
 	@bash scripts/demo.sh $(BUILD_DIR)/cli/focal
 
 # Benchmarks (bench/, docs/PERFORMANCE.md): the stages with Google Benchmark, then whole runs
-# of the focal command from 10K to 10M vertices. About 10 minutes on 2 cores.
+# of the focal command from 10K to 10M vertices, and the peers. About 15 minutes on 2 cores.
 bench:
 	@bash scripts/install-deps.sh bench
 	@cmake --preset bench >/dev/null
