@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "curvature_detail.h"
 #include "focal/error.h"
 #include "focal/neighbourhood.h"
 #include "focal/normals.h"
@@ -217,15 +218,6 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
       classify(r.k1[i], r.k2[i], zero_tolerance, defaults.umbilic_tolerance));
 }
 
-void store_undefined(int i, CurvatureResult& r) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  r.k1[i] = r.k2[i] = r.H[i] = r.K[i] = r.residual[i] = nan;
-  r.d1.row(i).setConstant(nan);
-  r.d2.row(i).setConstant(nan);
-  r.rays_used[i] = r.rays_excluded[i] = 0;
-  r.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
-}
-
 }  // namespace
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const JetOptions& options) {
@@ -254,18 +246,15 @@ JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_rin
 CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   const auto n = V.rows();
-  CurvatureResult r;
-  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) v->resize(n);
-  r.d1.resize(n, 3);
-  r.d2.resize(n, 3);
-  r.point_class.resize(n);
-  r.rays_used.resize(n);
-  r.rays_excluded.resize(n);
+  CurvatureResult r = detail::unwritten_result(n);
   const double zero = CurvatureOptions{}.zero_tolerance / mean_edge_length(V, F);
   validate(V, F, options);
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(V.rows()), F);
   for_each_jet(V, F, one, options, [&](int i, const LocalJet& jet) {
-    if (jet.degree < 2) return store_undefined(i, r);
+    if (jet.degree < 2) {
+      r.rays_used[i] = r.rays_excluded[i] = 0;
+      return detail::store_undefined(r, i);
+    }
     store_jet_curvature(jet, i, zero, r);
   });
   return r;
