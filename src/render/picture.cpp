@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -185,7 +186,11 @@ std::vector<float> direction_glyphs(PositionsRef V, FacesRef F, NormalsRef N,
   std::vector<float> lines;
   if (directions.rows() == 0 || V.rows() == 0) return lines;
   const double fraction = std::min(1.0, static_cast<double>(count) / static_cast<double>(V.rows()));
-  const auto threshold = static_cast<std::uint64_t>(fraction * 18446744073709551615.0);
+  // fraction * 2^64 as an integer; at fraction 1 that is out of range (undefined behaviour,
+  // which gave threshold 0 and no glyphs in the sanitizer build), so all vertices are taken.
+  const std::uint64_t threshold = fraction >= 1.0
+                                      ? std::numeric_limits<std::uint64_t>::max()
+                                      : static_cast<std::uint64_t>(std::ldexp(fraction, 64));
   const double spacing = std::sqrt(surface_area(V, F) / (fraction * static_cast<double>(V.rows())));
   const double h = 0.4 * spacing;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
