@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "io_detail.h"
+
 namespace focal {
 namespace {
 
@@ -53,14 +55,33 @@ void write_curvature_csv(const std::filesystem::path& path, const CurvatureResul
 
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
                          const CurvatureResult& fields, const PlyWriteOptions& options) {
-  std::vector<VertexProperty> properties;
-  for (auto& [name, values] : numeric_fields(fields)) {
-    properties.push_back({name, std::move(values), PropertyType::float32});
+  // Columns read in place: copying the eleven fields into VertexProperty vectors would cost
+  // more than formatting them.
+  const auto& names = curvature_field_names();
+  const auto column = [&](std::size_t name, const double* values, Eigen::Index size,
+                          Eigen::Index stride) {
+    return io_detail::PlyColumn{names[name], PropertyType::float32, values, nullptr, size, stride};
+  };
+  // Column c of an n x 3 row-major matrix (no offset on the null data of an empty one).
+  const auto column_of = [](const RowMatrixX3d& m, int c) {
+    return m.size() > 0 ? m.data() + c : nullptr;
+  };
+  std::vector<io_detail::PlyColumn> columns = {column(0, fields.k1.data(), fields.k1.size(), 1),
+                                               column(1, fields.k2.data(), fields.k2.size(), 1),
+                                               column(2, fields.H.data(), fields.H.size(), 1),
+                                               column(3, fields.K.data(), fields.K.size(), 1)};
+  for (int c = 0; c < 3; ++c) {
+    columns.push_back(column(4 + c, column_of(fields.d1, c), fields.d1.rows(), 3));
   }
-  properties.push_back({"class", fields.point_class.cast<double>(), PropertyType::uint8});
+  for (int c = 0; c < 3; ++c) {
+    columns.push_back(column(7 + c, column_of(fields.d2, c), fields.d2.rows(), 3));
+  }
+  columns.push_back(column(10, fields.residual.data(), fields.residual.size(), 1));
+  columns.push_back({names[11], PropertyType::uint8, nullptr, fields.point_class.data(),
+                     fields.point_class.size(), 1});
   PlyWriteOptions o = options;
   o.comments.push_back("focal curvature fields; " + class_codes_comment());
-  write_ply(path, mesh, properties, o);
+  io_detail::write_ply_columns(path, mesh, columns, o);
 }
 
 void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,

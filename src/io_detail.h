@@ -4,11 +4,14 @@
 /// that name the file and the place, text scanning with line numbers, fan triangulation, number
 /// formatting and the atomic (temporary file + rename) writer.
 
+#include <cerrno>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -114,6 +117,14 @@ class OutputSink {
   }
   /// Writes the buffer out. \throw IoError naming the target on failure.
   void flush();
+  /// Writes the buffer out, then `bytes` bytes from `data` without copying them into the buffer
+  /// (for writers that format large blocks themselves). \throw IoError as flush().
+  void write(const char* data, std::size_t bytes) {
+    flush();
+    if (std::fwrite(data, 1, bytes, file_) != bytes) {
+      fail(target_, std::string("write failed: ") + std::strerror(errno));
+    }
+  }
 
  private:
   static constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
@@ -127,6 +138,26 @@ class OutputSink {
 /// \throw IoError naming `path` when the file cannot be created, written or renamed.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(OutputSink&)>& body);
+
+/// One per-vertex column for write_ply_columns(): value i is f64[i * stride] or u8[i * stride],
+/// read in place, so that callers holding the values in other arrays (a matrix column, a uint8
+/// code vector) need not copy them into a VertexProperty first.
+struct PlyColumn {
+  std::string_view name;
+  PropertyType type = PropertyType::float32;
+  const double* f64 = nullptr;       ///< the values when they are doubles, else null
+  const std::uint8_t* u8 = nullptr;  ///< the values when they are uint8 codes, else null
+  Eigen::Index size = 0;             ///< number of values
+  Eigen::Index stride = 1;           ///< distance between consecutive values, in elements
+
+  [[nodiscard]] double value(Eigen::Index i) const {
+    return f64 != nullptr ? f64[i * stride] : static_cast<double>(u8[i * stride]);
+  }
+};
+
+/// write_ply() on columns: same file, same validation and exceptions.
+void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
+                       std::span<const PlyColumn> columns, const PlyWriteOptions& options);
 
 // The per-format readers, dispatched by read_mesh().
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <type_traits>
 
 #include "focal/error.h"
 #include "focal/mesh_io.h"
 #include "io_detail.h"
+#include "parallel.h"
 
 namespace focal {
 namespace {
@@ -282,6 +284,10 @@ class BinaryBody {
   }
 
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
+    if (e.fixed_size()) {
+      read_fixed_vertices(e, roles, V, N);
+      return;
+    }
     for (std::uint64_t i = 0; i < e.count; ++i) {
       const unsigned char* start = p_;
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
@@ -303,6 +309,84 @@ class BinaryBody {
         p_ += scalar_size(prop.type);
       }
     }
+  }
+
+  /// Reads the face element straight into mesh.F and mesh.face_source, in parallel, when every
+  /// face is a triangle stored at a fixed stride (no other list property) and every index is in
+  /// range. Returns false, having read and changed nothing, otherwise: read_faces() then gives
+  /// the exact results and error messages of the serial reader.
+  bool read_triangle_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
+                           Mesh& mesh) {
+    std::size_t count_offset = 0;
+    std::size_t stride = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const auto& prop = e.properties[k];
+      if (k == list_prop) {
+        count_offset = stride;
+        stride += scalar_size(prop.count_type) + 3 * scalar_size(prop.type);
+      } else if (prop.is_list) {
+        return false;
+      } else {
+        stride += scalar_size(prop.type);
+      }
+    }
+    const auto remaining = static_cast<std::uint64_t>(end_ - p_);
+    if (e.count == 0 || e.count > remaining / stride ||
+        e.count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
+      return false;
+    }
+    const PlyProperty& list = e.properties[list_prop];
+    const std::size_t count_bytes = scalar_size(list.count_type);
+    const std::size_t item = scalar_size(list.type);
+    // `list uchar int` (or uint) in the host's byte order, as focal and most writers store it.
+    const bool common = !swap_ && list.count_type == Scalar::uint8 &&
+                        (list.type == Scalar::int32 || list.type == Scalar::uint32);
+    const auto faces = static_cast<std::int64_t>(e.count);
+    RowMatrixX3i F(faces, 3);
+    Eigen::VectorXi source(faces);
+    detail::advise_huge_pages(F.data(), sizeof(std::int32_t) * F.size());
+    detail::advise_huge_pages(source.data(), sizeof(std::int32_t) * source.size());
+    std::int32_t* corners = F.data();
+    const unsigned char* first = p_ + count_offset;
+    // One flag per block of faces (blocks independent of the thread count): the first pass
+    // both checks and converts, so a valid file is read once.
+    constexpr std::int64_t kBlock = 1 << 14;
+    std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
+    detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+      bool ok = true;
+      if (common) {
+        for (std::int64_t f = begin; f < end; ++f) {
+          const unsigned char* rec = first + static_cast<std::size_t>(f) * stride;
+          ok &= rec[0] == 3;
+          for (int c = 0; c < 3; ++c) {
+            const std::int64_t v = list.type == Scalar::int32
+                                       ? std::int64_t{load<std::int32_t>(rec + 1 + 4 * c, false)}
+                                       : std::int64_t{load<std::uint32_t>(rec + 1 + 4 * c, false)};
+            ok &= v >= 0 && v < vertex_count;
+            corners[3 * f + c] = static_cast<std::int32_t>(v);
+          }
+          source[f] = static_cast<std::int32_t>(f);
+        }
+      } else {
+        for (std::int64_t f = begin; f < end; ++f) {
+          const unsigned char* rec = first + static_cast<std::size_t>(f) * stride;
+          ok &= load_as<std::int64_t>(rec, list.count_type, swap_) == 3;
+          rec += count_bytes;
+          for (int c = 0; c < 3; ++c) {
+            const std::int64_t v = load_as<std::int64_t>(rec + c * item, list.type, swap_);
+            ok &= v >= 0 && v < vertex_count;
+            corners[3 * f + c] = static_cast<std::int32_t>(v);
+          }
+          source[f] = static_cast<std::int32_t>(f);
+        }
+      }
+      if (!ok) bad[static_cast<std::size_t>(begin / kBlock)] = 1;
+    });
+    if (std::find(bad.begin(), bad.end(), 1) != bad.end()) return false;
+    mesh.F = std::move(F);
+    mesh.face_source = std::move(source);
+    p_ += e.count * stride;
+    return true;
   }
 
   void read_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
@@ -366,6 +450,59 @@ class BinaryBody {
   [[nodiscard]] std::uint64_t offset() const { return offset_of(p_); }
 
  private:
+  /// Fixed-size records: check_fits() made sure all of them are in the file, so no record can
+  /// fail and they are converted in parallel blocks.
+  void read_fixed_vertices(const PlyElement& e, const std::vector<int>& roles, double* V,
+                           double* N) {
+    if (e.count == 0) return;  // V and N may be null: no column pointers to form
+    struct Field {
+      std::size_t offset;
+      Scalar type;
+      double* out;  ///< column base: out[3 * i]
+    };
+    Field fields[6];
+    int used = 0;
+    std::size_t offset = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const int role = roles[k];
+      if (role >= 0) {
+        fields[used++] = {offset, e.properties[k].type, role < 3 ? V + role : N + role - 3};
+      }
+      offset += scalar_size(e.properties[k].type);
+    }
+    const std::size_t stride = offset;
+    const unsigned char* first = p_;
+    detail::parallel_for_blocks(
+        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, 0,
+        [&](std::int64_t begin, std::int64_t end) {
+          // Field by field, so that the type switch is decided once per block and field.
+          for (int k = 0; k < used; ++k) {
+            const Field& field = fields[k];
+            const unsigned char* rec = first + field.offset;
+            switch (field.type) {
+              case Scalar::float64:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] =
+                      load<double>(rec + static_cast<std::size_t>(i) * stride, swap_);
+                }
+                break;
+              case Scalar::float32:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] = load<float>(rec + static_cast<std::size_t>(i) * stride, swap_);
+                }
+                break;
+              default:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] = load_as<double>(rec + static_cast<std::size_t>(i) * stride,
+                                                     field.type, swap_);
+                }
+                break;
+            }
+          }
+        });
+    p_ += e.count * stride;
+  }
+
   [[nodiscard]] std::uint64_t offset_of(const unsigned char* p) const {
     return static_cast<std::uint64_t>(p - begin_);
   }
@@ -590,23 +727,33 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body&
   io_detail::TriangleCollector triangles;
   bool vertices_done = false;
   bool faces_done = false;
+  bool faces_direct = false;  // read_triangle_faces() filled mesh.F and mesh.face_source
   for (const PlyElement& e : header.elements) {
     body.check_fits(e);
     if (e.name == "vertex" && !vertices_done) {
       mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
-      if (has_normals) mesh.N.resize(static_cast<Eigen::Index>(e.count), 3);
+      detail::advise_huge_pages(mesh.V.data(), sizeof(double) * mesh.V.size());
+      if (has_normals) {
+        mesh.N.resize(static_cast<Eigen::Index>(e.count), 3);
+        detail::advise_huge_pages(mesh.N.data(), sizeof(double) * mesh.N.size());
+      }
       body.read_vertices(e, roles, mesh.V.data(), has_normals ? mesh.N.data() : nullptr);
       vertices_done = true;
     } else if (e.name == "face" && !faces_done) {
       const std::size_t list_prop = face_list_property(path, e);
-      triangles.reserve(static_cast<std::size_t>(e.count));
-      body.read_faces(e, list_prop, vertex_count, triangles);
+      if constexpr (std::is_same_v<Body, BinaryBody>) {
+        faces_direct = body.read_triangle_faces(e, list_prop, vertex_count, mesh);
+      }
+      if (!faces_direct) {
+        triangles.reserve(static_cast<std::size_t>(e.count));
+        body.read_faces(e, list_prop, vertex_count, triangles);
+      }
       faces_done = true;
     } else {
       body.skip_element(e);
     }
   }
-  triangles.move_into(mesh);
+  if (!faces_direct) triangles.move_into(mesh);
   return mesh;
 }
 
@@ -633,35 +780,38 @@ bool valid_property_name(std::string_view name) {
                      [](char c) { return static_cast<unsigned char>(c) > ' ' && c != 127; });
 }
 
+using io_detail::PlyColumn;
+
 /// Throws InvalidInput for anything the file could not represent faithfully.
 void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
-                      std::span<const VertexProperty> properties, const PlyWriteOptions& options) {
+                      std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   const std::string what = "write_ply: " + path.string();
   validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
-  std::vector<std::string> names = {"x", "y", "z"};
+  std::vector<std::string_view> names = {"x", "y", "z"};
   if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
-  for (const auto& prop : properties) {
-    if (!valid_property_name(prop.name)) {
-      throw InvalidInput(what + ": property name '" + prop.name + "' is empty or contains blanks");
+  for (const auto& column : columns) {
+    const std::string name(column.name);
+    if (!valid_property_name(name)) {
+      throw InvalidInput(what + ": property name '" + name + "' is empty or contains blanks");
     }
-    if (std::find(names.begin(), names.end(), prop.name) != names.end()) {
-      throw InvalidInput(what + ": property name '" + prop.name + "' is used twice");
+    if (std::find(names.begin(), names.end(), column.name) != names.end()) {
+      throw InvalidInput(what + ": property name '" + name + "' is used twice");
     }
-    names.push_back(prop.name);
-    if (prop.values.size() != mesh.V.rows()) {
-      throw InvalidInput(what + ": property '" + prop.name + "' has " +
-                         std::to_string(prop.values.size()) + " values but the mesh has " +
-                         std::to_string(mesh.V.rows()) + " vertices");
+    names.push_back(column.name);
+    if (column.size != mesh.V.rows()) {
+      throw InvalidInput(what + ": property '" + name + "' has " + std::to_string(column.size) +
+                         " values but the mesh has " + std::to_string(mesh.V.rows()) + " vertices");
     }
-    const bool is_int = prop.type == PropertyType::uint8 || prop.type == PropertyType::int32;
-    const double lo = prop.type == PropertyType::uint8 ? 0.0 : -2147483648.0;
-    const double hi = prop.type == PropertyType::uint8 ? 255.0 : 2147483647.0;
-    for (Eigen::Index i = 0; is_int && i < prop.values.size(); ++i) {
-      const double v = prop.values[i];
+    // uint8 codes fit both integer types; only doubles need checking.
+    const bool is_int = column.type == PropertyType::uint8 || column.type == PropertyType::int32;
+    const double lo = column.type == PropertyType::uint8 ? 0.0 : -2147483648.0;
+    const double hi = column.type == PropertyType::uint8 ? 255.0 : 2147483647.0;
+    for (Eigen::Index i = 0; is_int && column.f64 != nullptr && i < column.size; ++i) {
+      const double v = column.value(i);
       if (!(v >= lo && v <= hi && v == std::floor(v))) {
-        throw InvalidInput(what + ": property '" + prop.name + "' value " + std::to_string(v) +
+        throw InvalidInput(what + ": property '" + name + "' value " + std::to_string(v) +
                            " at vertex " + std::to_string(i) + " is not representable as " +
-                           std::string(ply_type_name(prop.type)));
+                           std::string(ply_type_name(column.type)));
       }
     }
   }
@@ -672,7 +822,7 @@ void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
   }
 }
 
-std::string ply_header(const Mesh& mesh, std::span<const VertexProperty> properties,
+std::string ply_header(const Mesh& mesh, std::span<const PlyColumn> columns,
                        const PlyWriteOptions& options) {
   std::string h = "ply\nformat ";
   h += options.binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
@@ -680,37 +830,37 @@ std::string ply_header(const Mesh& mesh, std::span<const VertexProperty> propert
   h += "element vertex " + std::to_string(mesh.V.rows()) + "\n";
   h += "property double x\nproperty double y\nproperty double z\n";
   if (mesh.has_normals()) h += "property double nx\nproperty double ny\nproperty double nz\n";
-  for (const auto& prop : properties) {
-    h += "property " + std::string(ply_type_name(prop.type)) + " " + prop.name + "\n";
+  for (const auto& column : columns) {
+    h += "property ";
+    h += ply_type_name(column.type);
+    h += ' ';
+    h += column.name;
+    h += '\n';
   }
   h += "element face " + std::to_string(mesh.F.rows()) + "\n";
   h += "property list uchar int vertex_indices\nend_header\n";
   return h;
 }
 
-template <class T>
-void append_little_endian(std::string& out, T value) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(bytes, bytes + sizeof(T));
-  out.append(bytes, sizeof(T));
-}
-
-void append_property_binary(std::string& out, PropertyType t, double v) {
+std::size_t property_bytes(PropertyType t) {
   switch (t) {
     case PropertyType::float32:
-      append_little_endian(out, static_cast<float>(v));
-      break;
-    case PropertyType::float64:
-      append_little_endian(out, v);
-      break;
-    case PropertyType::uint8:
-      append_little_endian(out, static_cast<std::uint8_t>(v));
-      break;
     case PropertyType::int32:
-      append_little_endian(out, static_cast<std::int32_t>(v));
-      break;
+      return 4;
+    case PropertyType::float64:
+      return 8;
+    case PropertyType::uint8:
+      return 1;
   }
+  return 8;
+}
+
+/// Stores `value` little endian at p; returns the byte after it.
+template <class T>
+char* put_little_endian(char* p, T value) {
+  std::memcpy(p, &value, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(p, p + sizeof(T));
+  return p + sizeof(T);
 }
 
 void append_property_ascii(std::string& out, PropertyType t, double v) {
@@ -728,40 +878,123 @@ void append_property_ascii(std::string& out, PropertyType t, double v) {
   }
 }
 
-void write_ply_body(io_detail::OutputSink& sink, const Mesh& mesh,
-                    std::span<const VertexProperty> properties, bool binary) {
+void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
+                          std::span<const PlyColumn> columns) {
   std::string& out = sink.buffer();
   const bool normals = mesh.has_normals();
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     for (int c = 0; c < (normals ? 6 : 3); ++c) {
-      const double v = c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3);
-      if (binary) {
-        append_little_endian(out, v);
-      } else {
-        if (c > 0) out += ' ';
-        io_detail::append_number(out, v);
-      }
+      if (c > 0) out += ' ';
+      io_detail::append_number(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3));
     }
-    for (const auto& prop : properties) {
-      if (binary) {
-        append_property_binary(out, prop.type, prop.values[i]);
-      } else {
-        out += ' ';
-        append_property_ascii(out, prop.type, prop.values[i]);
-      }
+    for (const auto& column : columns) {
+      out += ' ';
+      append_property_ascii(out, column.type, column.value(i));
     }
-    if (!binary) out += '\n';
+    out += '\n';
     sink.maybe_flush();
   }
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    if (binary) {
-      out += static_cast<char>(3);
-      for (int c = 0; c < 3; ++c) append_little_endian(out, mesh.F(f, c));
-    } else {
-      io_detail::append_ascii_triangle(out, mesh.F, f);
-    }
+    io_detail::append_ascii_triangle(out, mesh.F, f);
     sink.maybe_flush();
   }
+}
+
+/// Writes `count` fixed-size records of `record` bytes in batches of about 8 MiB, each filled in
+/// parallel blocks by put(begin, end, out) (records [begin, end) stored from `out` on) and then
+/// written. Every record has its own place in the batch, so the bytes do not depend on the
+/// thread count.
+template <class Put>
+void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::size_t record,
+                         const Put& put) {
+  if (count == 0) return;
+  constexpr std::int64_t kBlock = 1 << 12;
+  const std::int64_t per_batch =
+      std::max<std::int64_t>(1,
+                             static_cast<std::int64_t>((std::size_t{8} << 20) / record / kBlock)) *
+      kBlock;
+  const std::int64_t batch = std::min(count, per_batch);
+  const std::unique_ptr<char[]> buffer(new char[static_cast<std::size_t>(batch) * record]);
+  for (std::int64_t first = 0; first < count; first += batch) {
+    const std::int64_t n = std::min(batch, count - first);
+    detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+      put(first + begin, first + end, buffer.get() + static_cast<std::size_t>(begin) * record);
+    });
+    sink.write(buffer.get(), static_cast<std::size_t>(n) * record);
+  }
+}
+
+/// Stores column values for records [begin, end) at `offset` in each record of `out`.
+template <class T, class Source>
+void put_column(char* out, std::size_t record, std::int64_t begin, std::int64_t end,
+                const Source* values, Eigen::Index stride) {
+  for (std::int64_t i = begin; i < end; ++i) {
+    put_little_endian(out + static_cast<std::size_t>(i - begin) * record,
+                      static_cast<T>(static_cast<double>(values[i * stride])));
+  }
+}
+
+void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
+                           std::span<const PlyColumn> columns) {
+  const bool normals = mesh.has_normals();
+  std::size_t record = (normals ? 6 : 3) * sizeof(double);
+  for (const auto& column : columns) record += property_bytes(column.type);
+  // Column by column within a block, so that each type is dispatched once per block.
+  write_fixed_records(sink, mesh.V.rows(), record,
+                      [&](std::int64_t begin, std::int64_t end, char* out) {
+                        for (std::int64_t i = begin; i < end; ++i) {
+                          char* p = out + static_cast<std::size_t>(i - begin) * record;
+                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.V(i, c));
+                          if (normals) {
+                            for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.N(i, c));
+                          }
+                        }
+                        std::size_t offset = (normals ? 6 : 3) * sizeof(double);
+                        for (const auto& column : columns) {
+                          char* at = out + offset;
+                          const Eigen::Index s = column.stride;
+                          if (column.f64 != nullptr) {
+                            switch (column.type) {
+                              case PropertyType::float32:
+                                put_column<float>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::float64:
+                                put_column<double>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::uint8:
+                                put_column<std::uint8_t>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::int32:
+                                put_column<std::int32_t>(at, record, begin, end, column.f64, s);
+                                break;
+                            }
+                          } else {
+                            switch (column.type) {
+                              case PropertyType::float32:
+                                put_column<float>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::float64:
+                                put_column<double>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::uint8:
+                                put_column<std::uint8_t>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::int32:
+                                put_column<std::int32_t>(at, record, begin, end, column.u8, s);
+                                break;
+                            }
+                          }
+                          offset += property_bytes(column.type);
+                        }
+                      });
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t),
+                      [&](std::int64_t begin, std::int64_t end, char* out) {
+                        char* p = out;
+                        for (std::int64_t f = begin; f < end; ++f) {
+                          *p++ = static_cast<char>(3);
+                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.F(f, c));
+                        }
+                      });
 }
 
 }  // namespace
@@ -784,13 +1017,31 @@ Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
 
 }  // namespace io_detail
 
+namespace io_detail {
+
+void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
+                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
+  validate_for_ply(path, mesh, columns, options);
+  write_atomically(path, [&](OutputSink& sink) {
+    sink.buffer() += ply_header(mesh, columns, options);
+    if (options.binary) {
+      write_ply_body_binary(sink, mesh, columns);
+    } else {
+      write_ply_body_ascii(sink, mesh, columns);
+    }
+  });
+}
+
+}  // namespace io_detail
+
 void write_ply(const std::filesystem::path& path, const Mesh& mesh,
                std::span<const VertexProperty> properties, const PlyWriteOptions& options) {
-  validate_for_ply(path, mesh, properties, options);
-  io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    sink.buffer() += ply_header(mesh, properties, options);
-    write_ply_body(sink, mesh, properties, options.binary);
-  });
+  std::vector<PlyColumn> columns;
+  columns.reserve(properties.size());
+  for (const auto& prop : properties) {
+    columns.push_back({prop.name, prop.type, prop.values.data(), nullptr, prop.values.size(), 1});
+  }
+  io_detail::write_ply_columns(path, mesh, columns, options);
 }
 
 }  // namespace focal

@@ -5,6 +5,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "focal/error.h"
+#include "focal/fields_io.h"
 
 namespace fs = std::filesystem;
 using focal::Mesh;
@@ -1169,6 +1171,305 @@ TEST_F(MeshIo, BytesThatAreNotUtf8) {
       focal::read_mesh(write("bom.obj", "\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
   EXPECT_EQ(bom.V.rows(), 3);
   expect_faces(bom, {{0, 1, 2}}, {0});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parallel binary reading and writing: the same bytes and meshes for any thread count
+
+/// Sets FOCAL_NUM_THREADS for the life of the object, then restores it.
+class ScopedThreads {
+ public:
+  explicit ScopedThreads(int threads) {
+    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+  }
+  ~ScopedThreads() {
+    if (old_.empty()) {
+      unsetenv("FOCAL_NUM_THREADS");
+    } else {
+      setenv("FOCAL_NUM_THREADS", old_.c_str(), 1);
+    }
+  }
+  ScopedThreads(const ScopedThreads&) = delete;
+  ScopedThreads& operator=(const ScopedThreads&) = delete;
+
+ private:
+  std::string old_;
+};
+
+/// The read_mesh() message for p, or "" when it reads.
+std::string read_error(const fs::path& p) {
+  try {
+    (void)focal::read_mesh(p);
+  } catch (const focal::IoError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// A binary PLY big enough for many parallel blocks, with every scalar type among the vertex
+/// properties (the roles in different types) and extra scalars around the face list.
+struct BigPly {
+  std::string data;
+  Mesh expected;
+  std::vector<std::size_t> face_offsets;  ///< byte offset of each face record
+};
+
+BigPly big_binary_ply(bool big_endian, Eigen::Index nv, Eigen::Index nf, bool wide_lists) {
+  BigPly out;
+  const std::string list = wide_lists ? "ushort uint" : "uchar int";
+  Bytes b(big_endian);
+  b.text(std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+         " 1.0\nelement vertex " + std::to_string(nv) +
+         "\nproperty char a\nproperty float x\nproperty double y\nproperty short s\n"
+         "property int z\nproperty uchar c\nproperty double nx\nproperty float ny\n"
+         "property ushort nz\nproperty uint u\nelement face " +
+         std::to_string(nf) + "\nproperty uchar flag\nproperty list " + list +
+         " vertex_indices\nproperty float q\nelement tail 1\nproperty int t\nend_header\n");
+  Mesh& m = out.expected;
+  m.V.resize(nv, 3);
+  m.N.resize(nv, 3);
+  std::mt19937 rng(7);
+  for (Eigen::Index i = 0; i < nv; ++i) {
+    const float x = static_cast<float>(rng()) / 4096.0f - 5e5f;
+    const double y = static_cast<double>(rng()) * 1e-7 - 200.0;
+    const auto z = static_cast<std::int32_t>(rng());
+    const double nx = static_cast<double>(rng()) / 3.0;
+    const float ny = -static_cast<float>(rng() % 1000) / 7.0f;
+    const auto nz = static_cast<std::uint16_t>(rng());
+    b.put(static_cast<std::int8_t>(rng())).put(x).put(y).put(static_cast<std::int16_t>(rng()));
+    b.put(z)
+        .put(static_cast<std::uint8_t>(rng()))
+        .put(nx)
+        .put(ny)
+        .put(nz)
+        .put(static_cast<std::uint32_t>(rng()));
+    m.V.row(i) << x, y, z;
+    m.N.row(i) << nx, ny, nz;
+  }
+  m.F.resize(nf, 3);
+  m.face_source = Eigen::VectorXi::LinSpaced(nf, 0, static_cast<int>(nf - 1));
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    out.face_offsets.push_back(b.data.size());
+    b.put(std::uint8_t{1});
+    if (wide_lists) {
+      b.put(std::uint16_t{3});
+    } else {
+      b.put(std::uint8_t{3});
+    }
+    for (int c = 0; c < 3; ++c) {
+      m.F(f, c) = static_cast<std::int32_t>(rng() % static_cast<std::uint32_t>(nv));
+      if (wide_lists) {
+        b.put(static_cast<std::uint32_t>(m.F(f, c)));
+      } else {
+        b.put(m.F(f, c));
+      }
+    }
+    b.put(0.5f);
+  }
+  b.put(std::int32_t{42});
+  out.data = b.data;
+  return out;
+}
+
+TEST_F(MeshIo, PlyBinaryReadIsTheSameForAnyThreadCount) {
+  // Empty elements take the fixed-size paths too (a fuzzer find: no offsets on null arrays).
+  const Mesh empty = focal::read_mesh(write("empty.ply", binary_header(0, 0)));
+  EXPECT_EQ(empty.V.rows(), 0);
+  EXPECT_EQ(empty.F.rows(), 0);
+  for (const bool big_endian : {false, true}) {
+    const BigPly ply = big_binary_ply(big_endian, 50000, 90000, big_endian);
+    const fs::path p = write("big.ply", ply.data);
+    for (const int threads : {1, 2, 3}) {
+      SCOPED_TRACE("big endian " + std::to_string(big_endian) + ", threads " +
+                   std::to_string(threads));
+      const ScopedThreads scoped(threads);
+      expect_same_mesh(ply.expected, focal::read_mesh(p));
+    }
+  }
+}
+
+TEST_F(MeshIo, PlyBinaryParallelReadFallsBackWithTheSameResultsAndErrors) {
+  const BigPly ply = big_binary_ply(false, 50000, 90000, false);
+  const std::size_t list_at = 1;  // the count byte follows the uchar flag
+  // Face 70000 refers to vertex 50000: the error names that face and its offset.
+  std::string range = ply.data;
+  const std::size_t bad = ply.face_offsets[70000];
+  const std::int32_t too_big = 50000;
+  std::memcpy(&range[bad + list_at + 1 + 4], &too_big, 4);  // little endian hosts only
+  // Face 30000 has 2 vertices: the second index becomes the float q.
+  std::string two = ply.data;
+  two[ply.face_offsets[30000] + list_at] = 2;
+  // File cut inside face 89999.
+  const std::string cut = ply.data.substr(0, ply.face_offsets[89999] + 5);
+  if (std::endian::native != std::endian::little) GTEST_SKIP() << "patches little endian bytes";
+  const fs::path pr = write("range.ply", range);
+  const fs::path pt = write("two.ply", two);
+  const fs::path pc = write("cut.ply", cut);
+  std::vector<std::string> first;
+  for (const int threads : {1, 2}) {
+    const ScopedThreads scoped(threads);
+    const std::vector<std::string> messages = {read_error(pr), read_error(pt), read_error(pc)};
+    EXPECT_NE(messages[0].find("byte offset " + std::to_string(bad) +
+                               ": face 70000 refers to vertex 50000 but there are 50000 vertices"),
+              std::string::npos)
+        << messages[0];
+    EXPECT_NE(messages[1].find("byte offset " + std::to_string(ply.face_offsets[30000]) +
+                               ": face 30000 has 2 vertices"),
+              std::string::npos)
+        << messages[1];
+    EXPECT_NE(messages[2].find("byte offset " + std::to_string(ply.face_offsets[89999]) +
+                               ": file ends inside face 89999 of 90000"),
+              std::string::npos)
+        << messages[2];
+    if (first.empty()) {
+      first = messages;
+    } else {
+      EXPECT_EQ(first, messages);
+    }
+  }
+
+  // A quad among the triangles: read serially, fanned, with its face index.
+  Bytes q;
+  q.text(binary_header(4, 2));
+  for (int i = 0; i < 12; ++i) q.put(static_cast<float>(i));
+  q.put(std::uint8_t{4}).put(0).put(1).put(2).put(3);
+  q.put(std::uint8_t{3}).put(3).put(2).put(1);
+  for (const int threads : {1, 2}) {
+    const ScopedThreads scoped(threads);
+    expect_faces(focal::read_mesh(write("quad.ply", q.data)), {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}},
+                 {0, 0, 1});
+  }
+}
+
+/// The bytes the serial writer produced: each vertex x y z (nx ny nz) double then each property
+/// in its type, little endian; faces as uchar 3 and three ints.
+std::string reference_ply_body(const Mesh& m, const std::vector<focal::VertexProperty>& props) {
+  Bytes b;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    for (int c = 0; c < 3; ++c) b.put(m.V(i, c));
+    for (int c = 0; c < 3 && m.has_normals(); ++c) b.put(m.N(i, c));
+    for (const auto& prop : props) {
+      const double v = prop.values[i];
+      switch (prop.type) {
+        case focal::PropertyType::float32:
+          b.put(static_cast<float>(v));
+          break;
+        case focal::PropertyType::float64:
+          b.put(v);
+          break;
+        case focal::PropertyType::uint8:
+          b.put(static_cast<std::uint8_t>(v));
+          break;
+        case focal::PropertyType::int32:
+          b.put(static_cast<std::int32_t>(v));
+          break;
+      }
+    }
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    b.put(std::uint8_t{3}).put(m.F(f, 0)).put(m.F(f, 1)).put(m.F(f, 2));
+  }
+  return b.data;
+}
+
+std::string body_of(const std::string& ply) {
+  const std::string end = "end_header\n";
+  return ply.substr(ply.find(end) + end.size());
+}
+
+TEST_F(MeshIo, PlyBinaryWriteIsTheSameForAnyThreadCount) {
+  // More vertices than one 8 MiB batch of the writer, so batches and blocks both vary.
+  const Eigen::Index nv = 150000;
+  const Eigen::Index nf = 290000;
+  Mesh m;
+  m.V = RowMatrixX3d::Random(nv, 3);
+  m.V(5, 0) = kNaN;
+  m.V(6, 1) = -kInf;
+  m.V(7, 2) = -0.0;
+  m.N = RowMatrixX3d::Random(nv, 3);
+  m.F.resize(nf, 3);
+  std::mt19937 rng(3);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    for (int c = 0; c < 3; ++c) m.F(f, c) = static_cast<std::int32_t>(rng() % nv);
+  }
+  m.face_source = Eigen::VectorXi::LinSpaced(nf, 0, static_cast<int>(nf - 1));
+  std::vector<focal::VertexProperty> props = {
+      {"f", Eigen::VectorXd::Random(nv) * 1e3, focal::PropertyType::float32},
+      {"d", Eigen::VectorXd::Random(nv), focal::PropertyType::float64},
+      {"u", Eigen::VectorXd::LinSpaced(nv, 0, 255).array().floor(), focal::PropertyType::uint8},
+      {"i", Eigen::VectorXd::LinSpaced(nv, -1e6, 2e9).array().floor(), focal::PropertyType::int32}};
+  const std::string expected = reference_ply_body(m, props);
+  for (const bool normals : {true, false}) {
+    if (!normals) m.N.resize(0, 3);
+    const std::string reference = normals ? expected : reference_ply_body(m, props);
+    std::string first;
+    for (const int threads : {1, 2, 3}) {
+      SCOPED_TRACE("threads " + std::to_string(threads));
+      const ScopedThreads scoped(threads);
+      const fs::path p = file("out.ply");
+      focal::write_ply(p, m, props);
+      const std::string bytes = slurp(p);
+      EXPECT_TRUE(body_of(bytes) == reference);
+      if (first.empty()) {
+        first = bytes;
+      } else {
+        EXPECT_TRUE(bytes == first);
+      }
+    }
+  }
+}
+
+TEST_F(MeshIo, CurvaturePlyIsWritePlyOfTheFields) {
+  const Eigen::Index nv = 20000;
+  Mesh m = sample_mesh(true);
+  m.V = RowMatrixX3d::Random(nv, 3);
+  m.N = RowMatrixX3d::Random(nv, 3);
+  focal::CurvatureResult r;
+  r.k1 = Eigen::VectorXd::Random(nv);
+  r.k2 = Eigen::VectorXd::Random(nv);
+  r.H = Eigen::VectorXd::Random(nv);
+  r.K = Eigen::VectorXd::Random(nv);
+  r.K[3] = kNaN;
+  r.d1 = RowMatrixX3d::Random(nv, 3);
+  r.d2 = RowMatrixX3d::Random(nv, 3);
+  r.residual = Eigen::VectorXd::Random(nv);
+  r.point_class = focal::VectorXu8::LinSpaced(nv, 0, 5);
+  std::vector<focal::VertexProperty> props;
+  const auto& names = focal::curvature_field_names();
+  props.push_back({names[0], r.k1, focal::PropertyType::float32});
+  props.push_back({names[1], r.k2, focal::PropertyType::float32});
+  props.push_back({names[2], r.H, focal::PropertyType::float32});
+  props.push_back({names[3], r.K, focal::PropertyType::float32});
+  for (int c = 0; c < 3; ++c) {
+    props.push_back({names[4 + c], r.d1.col(c), focal::PropertyType::float32});
+  }
+  for (int c = 0; c < 3; ++c) {
+    props.push_back({names[7 + c], r.d2.col(c), focal::PropertyType::float32});
+  }
+  props.push_back({names[10], r.residual, focal::PropertyType::float32});
+  props.push_back({names[11], r.point_class.cast<double>(), focal::PropertyType::uint8});
+  std::string comment = "focal curvature fields; class codes:";
+  for (int c = 0; c <= static_cast<int>(focal::PointClass::undefined); ++c) {
+    comment += " " + std::to_string(c) + "=" +
+               std::string(focal::class_name(static_cast<focal::PointClass>(c)));
+  }
+  focal::write_ply(file("plain.ply"), m, props, {.binary = true, .comments = {comment}});
+  const std::string expected = slurp(file("plain.ply"));
+  for (const bool binary : {true, false}) {
+    if (!binary) {
+      focal::write_ply(file("plain.ply"), m, props, {.binary = false, .comments = {comment}});
+    }
+    for (const int threads : {1, 2}) {
+      const ScopedThreads scoped(threads);
+      focal::write_curvature_ply(file("fields.ply"), m, r, {.binary = binary, .comments = {}});
+      EXPECT_TRUE(slurp(file("fields.ply")) == slurp(file("plain.ply"))) << binary << threads;
+    }
+  }
+  EXPECT_TRUE(body_of(expected) == reference_ply_body(m, props));
+  r.H.resize(3);
+  expect_error<focal::InvalidInput>([&] { focal::write_curvature_ply(file("bad.ply"), m, r); },
+                                    {"property 'H' has 3 values but the mesh has 20000 vertices"});
 }
 
 // ---------------------------------------------------------------------------------------------

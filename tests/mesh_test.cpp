@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <limits>
+#include <string>
+
+#include "focal/error.h"
 
 namespace focal {
 namespace {
@@ -37,6 +42,72 @@ TEST(MeanEdgeLength, NonFiniteEdgesAreLeftOut) {
   Square all;
   all.V.topRows(4).setConstant(kNaN);
   EXPECT_EQ(mean_edge_length(all.V, all.F), 0.0);
+}
+
+TEST(MeanEdgeLength, IsTheSameForAnyThreadCount) {
+  // 100000 faces: several blocks of the parallel sum, one vertex broken.
+  const Eigen::Index nv = 30000;
+  const Eigen::Index nf = 100000;
+  RowMatrixX3d V = RowMatrixX3d::Random(nv, 3);
+  V(17, 1) = kNaN;
+  RowMatrixX3i F(nf, 3);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    for (int c = 0; c < 3; ++c) F(f, c) = static_cast<std::int32_t>((f * 7919 + c * 104729) % nv);
+  }
+  long double sum = 0.0L;
+  std::int64_t count = 0;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const double length = (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+      if (std::isfinite(length)) {
+        sum += length;
+        ++count;
+      }
+    }
+  }
+  const auto expected = static_cast<double>(sum / static_cast<long double>(count));
+  const char* env = std::getenv("FOCAL_NUM_THREADS");
+  const std::string saved = env != nullptr ? env : "";
+  double first = 0.0;
+  for (const int threads : {1, 2, 3}) {
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    const double mean = mean_edge_length(V, F);
+    EXPECT_NEAR(mean, expected, 1e-12 * expected) << threads;
+    if (threads == 1) first = mean;
+    EXPECT_EQ(mean, first) << threads;  // bit for bit
+  }
+  if (saved.empty()) {
+    unsetenv("FOCAL_NUM_THREADS");
+  } else {
+    setenv("FOCAL_NUM_THREADS", saved.c_str(), 1);
+  }
+}
+
+TEST(ValidateMeshArrays, NamesTheFirstBadFaceForAnyThreadCount) {
+  // Bad faces in two parallel blocks: the message names the first in face order.
+  const RowMatrixX3d V = RowMatrixX3d::Zero(10, 3);
+  RowMatrixX3i F = RowMatrixX3i::Zero(100000, 3);
+  F(90000, 0) = -1;
+  F(70000, 2) = 10;
+  const char* env = std::getenv("FOCAL_NUM_THREADS");
+  const std::string saved = env != nullptr ? env : "";
+  for (const int threads : {1, 2, 3}) {
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    try {
+      validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test");
+      ADD_FAILURE() << "no exception";
+    } catch (const InvalidInput& e) {
+      EXPECT_STREQ(e.what(), "test: face 70000 refers to vertex 10, but there are 10 vertices");
+    }
+  }
+  F(70000, 2) = 9;
+  F(90000, 0) = 9;
+  EXPECT_NO_THROW(validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test"));
+  if (saved.empty()) {
+    unsetenv("FOCAL_NUM_THREADS");
+  } else {
+    setenv("FOCAL_NUM_THREADS", saved.c_str(), 1);
+  }
 }
 
 TEST(BoundingBoxDiagonal, NonFiniteRowsAreLeftOut) {
