@@ -18,6 +18,7 @@
 
 #include "focal/error.h"
 #include "focal/fields_io.h"
+#include "test_meshes.h"
 
 namespace fs = std::filesystem;
 using focal::Mesh;
@@ -1176,26 +1177,7 @@ TEST_F(MeshIo, BytesThatAreNotUtf8) {
 // ---------------------------------------------------------------------------------------------
 // Parallel binary reading and writing: the same bytes and meshes for any thread count
 
-/// Sets FOCAL_NUM_THREADS for the life of the object, then restores it.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int threads) {
-    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
-  }
-  ~ScopedThreads() {
-    if (old_.empty()) {
-      unsetenv("FOCAL_NUM_THREADS");
-    } else {
-      setenv("FOCAL_NUM_THREADS", old_.c_str(), 1);
-    }
-  }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  std::string old_;
-};
+using focal::test::ScopedThreads;
 
 /// The read_mesh() message for p, or "" when it reads.
 std::string read_error(const fs::path& p) {
