@@ -268,11 +268,7 @@ def cmd_accuracy(args):
                      boundary_rel_H=b["rel_H"])
             rows.append(m)
         print(f"  {case['slug']}", file=sys.stderr)
-    with open(args.csv, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(COLUMNS)
-        for r in rows:
-            w.writerow([fmt(r[c]) for c in COLUMNS])
+    write_csv(args.csv, COLUMNS, rows)
     for name, s in seconds.items():
         print(f"  {name}: {s:.1f} s over all cases", file=sys.stderr)
 
@@ -360,11 +356,15 @@ def cmd_scan(args):
                 os.makedirs(args.fields, exist_ok=True)
                 np.save(os.path.join(args.fields, f"{name}.{slug(method)}.npy"), H)
         print(f"  {name}", file=sys.stderr)
-    with open(args.csv, "w", newline="") as f:
+    write_csv(args.csv, SCAN_COLUMNS, rows)
+
+
+def write_csv(path, columns, rows):
+    with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(SCAN_COLUMNS)
+        w.writerow(columns)
         for r in rows:
-            w.writerow([fmt(r[c]) for c in SCAN_COLUMNS])
+            w.writerow([fmt(r[c]) for c in columns])
 
 
 def slug(name):

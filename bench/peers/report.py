@@ -100,6 +100,20 @@ def wins(by_case, name, cases_, rivals):
     return won, lost
 
 
+def loss_table(by_case, rows, caption, rival_header):
+    """A Markdown table of (case, focal default column, best rival) with the error factor; empty
+    when there are no rows."""
+    if not rows:
+        return ""
+    text = (f"{caption}\n\n| case | focal default | its rel. H | {rival_header} | its rel. H | "
+            f"factor |\n|---|---|---|---|---|---|\n")
+    for k, name, best in rows:
+        mine, theirs = value(by_case[k][name]), value(by_case[k][best])
+        text += (f"| {label(k)} | {name.split(' / ')[1]} | {number(mine)} | {best} | "
+                 f"{number(theirs)} | {mine / theirs:.3g} |\n")
+    return text + "\n"
+
+
 def count_target(by_case, methods):
     """Issue 4 point 5: how often focal default has the lowest relative H error."""
     file_cases = [k for k in by_case if irregular_or_noisy(k)]
@@ -123,27 +137,16 @@ def count_target(by_case, methods):
             f"exact up to rounding and tie). Against the other libraries "
             f"only (MDSB03, CSM03 and the peers, no other focal variant): {xo} of {y} with file "
             f"normals, {zo} of {w} without.\n\n")
-    rows = [(k, DEFAULT_FILE, best) for k, best in file_losses] + \
-           [(k, DEFAULT_NONE, best) for k, best in none_losses]
-    if rows:
-        text += ("Losses to other libraries (counted by the script): the best of them and the "
-                 "factor by which focal default's error is larger.\n\n| case | focal default | "
-                 "its rel. H | best other library | its rel. H | factor |\n"
-                 "|---|---|---|---|---|---|\n")
-        for k, name, best in rows:
-            mine, theirs = value(by_case[k][name]), value(by_case[k][best])
-            text += (f"| {label(k)} | {name.split(' / ')[1]} | {number(mine)} | {best} | "
-                     f"{number(theirs)} | {mine / theirs:.3g} |\n")
-    focal_rows = [(k, DEFAULT_FILE, best) for k, best in file_all_losses if is_focal(best)] + \
-                 [(k, DEFAULT_NONE, best) for k, best in none_all_losses if is_focal(best)]
-    if focal_rows:
-        text += ("\nLosses to another focal setting (the best of them; a setting a user can pick, "
-                 "but not the default):\n\n| case | focal default | its rel. H | best focal "
-                 "setting | its rel. H | factor |\n|---|---|---|---|---|---|\n")
-        for k, name, best in focal_rows:
-            mine, theirs = value(by_case[k][name]), value(by_case[k][best])
-            text += (f"| {label(k)} | {name.split(' / ')[1]} | {number(mine)} | {best} | "
-                     f"{number(theirs)} | {mine / theirs:.3g} |\n")
+    text += loss_table(
+        by_case, [(k, DEFAULT_FILE, b) for k, b in file_losses] +
+        [(k, DEFAULT_NONE, b) for k, b in none_losses],
+        "Losses to other libraries (counted by the script): the best of them and the factor by "
+        "which focal default's error is larger.", "best other library")
+    text += loss_table(
+        by_case, [(k, DEFAULT_FILE, b) for k, b in file_all_losses if is_focal(b)] +
+        [(k, DEFAULT_NONE, b) for k, b in none_all_losses if is_focal(b)],
+        "Losses to another focal setting (the best of them; a setting a user can pick, but not "
+        "the default):", "best focal setting")
     return text
 
 
