@@ -185,9 +185,16 @@ Estimate run_recommended(Mesh& mesh, const std::string& mesh_name, const Estimat
     Stage stage(log, "curvature");
     r = estimate_curvature_recommended_full(mesh.V, mesh.F, file_normals, flags.options.threads);
   }
+  if (mesh.has_normals() && !r.file_normals_used) {
+    log.warning("the file's normals disagree with the positions (median angle " +
+                std::to_string(r.file_disagreement) +
+                " rad to jet normals): using normals estimated from the positions on the "
+                "file normals' side");
+  }
   std::ostringstream plan;
-  plan << "  recommended estimator: " << (mesh.has_normals() ? "file" : "Max")
-       << " normals, jet normals where smoother"
+  plan << "  recommended estimator: "
+       << (r.file_normals_used ? "file normals, jet normals at outliers"
+                               : "jet or Max normals, whichever is smoother")
        << ", position noise " << r.plan.noise << " x edge length, " << r.plan.rings << "-ring "
        << (r.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
   log.info(plan.str());
