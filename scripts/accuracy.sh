@@ -156,6 +156,22 @@ vertex noise away and blur real detail alike. With noisy normals in
 the file, every positions-only method sees clean positions, so those rows measure how much the
 normal noise costs a method that trusts normals.
 
+Why focal default still loses where it does (the tables above; measured, see docs/ESTIMATOR.md):
+
+- **Regular grids, normal noise**: the default finds the file's normals noisy and ignores them,
+  so it works from clean positions only, on a regular grid. There the cotangent formula of
+  MDSB03 (and VTK's, the same) is second order with a smaller constant on symmetric stencils;
+  focal's jet normals and per-triangle step are second order too, with a larger constant. On
+  irregular meshes the cotangent formula does not converge, and focal wins every such case.
+- **Vertex noise without normals on the regular sphere and pear**: libigl's quadric fit over 5
+  rings (about 90 vertices) averages more noise away than focal's 4-ring quadratic jets and
+  3-ring fit; on the irregular meshes and the other surfaces focal's is the lower error.
+- **Vertex noise with file normals, helix tube (regular) and pear (irregular)**: focal's own
+  2-ring uniform fit beats the default's 3-ring Gaussian fit. The ring count is chosen for the
+  whole mesh from the noise level; where the curvature is high for the neighbourhood (the thin
+  tube, the pear's neck) the wider fit's bias outweighs the noise it averages. A per-vertex
+  choice of the neighbourhood would be the fix; it is not built.
+
 READING
     echo "## Relative RMS error of H, focal and peers"
     echo
