@@ -67,7 +67,8 @@ BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
 
 // The fit step alone (issue 5 target: 20 M vertices/s on 2 threads, closed form, 1-ring):
 // rays, normal equations, solve, eigen-decomposition, residual and the result arrays.
-void fit_step(benchmark::State& state, CurvatureOptions o) {
+void fit_step(benchmark::State& state, CurvatureOptions o,
+              detail::SimdIsa isa = detail::SimdIsa::best) {
   const Mesh& m = setup(state);
   o.threads = static_cast<int>(state.range(1));
   std::vector<char> ok;
@@ -75,7 +76,7 @@ void fit_step(benchmark::State& state, CurvatureOptions o) {
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
   const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings);
   const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F)};
-  for (auto _ : state) benchmark::DoNotOptimize(detail::fit_vertices(in, o));
+  for (auto _ : state) benchmark::DoNotOptimize(detail::fit_vertices(in, o, isa));
   per_vertex(state, m);
 }
 
@@ -87,6 +88,19 @@ CurvatureOptions with_rings(int rings) {
 
 void BM_FitClosedForm(benchmark::State& state) { fit_step(state, {}); }
 BENCHMARK(BM_FitClosedForm)->Apply(sizes_and_threads);
+
+// The lane kernel compiled for each instruction set ({vertices, threads, isa}: 1 AVX-512,
+// 2 AVX2, 3 baseline x86-64; same bits, see tests/simd_kernels_test.cpp).
+void BM_FitClosedFormByIsa(benchmark::State& state) {
+  const auto isa = static_cast<detail::SimdIsa>(state.range(2));
+  if (!detail::simd_isa_available(isa)) return state.SkipWithError("not on this CPU");
+  fit_step(state, {}, isa);
+}
+BENCHMARK(BM_FitClosedFormByIsa)
+    ->ArgsProduct({{1'000'000}, {1}, {1, 2, 3}})
+    ->ArgNames({"vertices", "threads", "isa"})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 void BM_FitClosedForm2Ring(benchmark::State& state) { fit_step(state, with_rings(2)); }
 BENCHMARK(BM_FitClosedForm2Ring)->Apply(sizes_and_threads);

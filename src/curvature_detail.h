@@ -10,7 +10,9 @@
 #include "focal/curvature.h"
 #include "focal/neighbourhood.h"
 #include "focal/normal_rays.h"
+#include "focal/triangle_curvature.h"
 #include "parallel.h"
+#include "simd_lanes.h"
 
 namespace focal::detail {
 
@@ -125,7 +127,16 @@ struct VertexFitInput {
   double mean_edge_length;  ///< scale of the Gaussian weights and the class tolerances
 };
 
-/// The per-vertex two-slit fit of every vertex (Method::vertex); defined in curvature.cpp.
-CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options);
+/// The per-vertex two-slit fit of every vertex (Method::vertex); defined in curvature.cpp. The
+/// closed form runs one vertex per lane, compiled for `isa` (simd_lanes.h; tests compare the
+/// instruction sets, which give the same bits).
+CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
+                             SimdIsa isa = SimdIsa::best);
+
+/// focal::triangle_curvature with the faces solved by the lane kernel compiled for `isa`
+/// (tests compare the instruction sets); defined in triangle_curvature.cpp.
+TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options,
+                                           const TriangleFields& fields, SimdIsa isa);
 
 }  // namespace focal::detail

@@ -1,6 +1,7 @@
 #include "focal/triangle_curvature.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -11,139 +12,289 @@
 #include "curvature_detail.h"
 #include "focal/error.h"
 #include "focal/normal_rays.h"
+#include "lane_curvature.h"
 #include "normal_rays_detail.h"
 #include "parallel.h"
+#include "simd_lanes.h"
 #include "topology_incidence.h"
 
 namespace focal {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A result of m faces with the asked fields allocated but not written: each face's row is then
 /// written once (values or NaN) by the thread that computes it, so nothing is filled twice and
 /// the pages are first touched in parallel.
 TriangleCurvatureResult unwritten_faces(Eigen::Index m, const TriangleFields& want) {
   TriangleCurvatureResult r;
+  // Huge pages where the kernel grants them: at 2M faces the asked fields are up to 450 MB,
+  // otherwise first-touched 4 KiB at a time (see detail::advise_huge_pages).
   const auto scalars = [&](bool asked, std::initializer_list<Eigen::VectorXd*> fields) {
-    for (Eigen::VectorXd* v : fields) v->resize(asked ? m : 0);
+    for (Eigen::VectorXd* v : fields) {
+      v->resize(asked ? m : 0);
+      detail::advise_huge_pages(v->data(), sizeof(double) * static_cast<std::size_t>(v->size()));
+    }
   };
   scalars(want.coefficients, {&r.A, &r.B, &r.C});
   scalars(want.curvatures, {&r.K, &r.H, &r.k1, &r.k2});
   scalars(want.focal_depths, {&r.lambda1, &r.lambda2});
   const auto vectors = [&](bool asked, std::initializer_list<RowMatrixX3d*> fields) {
-    for (RowMatrixX3d* d : fields) d->resize(asked ? m : 0, 3);
+    for (RowMatrixX3d* d : fields) {
+      d->resize(asked ? m : 0, 3);
+      detail::advise_huge_pages(d->data(), sizeof(double) * static_cast<std::size_t>(d->size()));
+    }
   };
   vectors(want.directions, {&r.d1, &r.d2});
   vectors(want.slits, {&r.slit1, &r.slit2});
   vectors(want.face_normal, {&r.face_normal});
   r.shape_operator.resize(want.shape_operator ? m : 0, 4);
+  detail::advise_huge_pages(r.shape_operator.data(),
+                            sizeof(double) * static_cast<std::size_t>(r.shape_operator.size()));
   r.point_class.resize(m);
   return r;
 }
 
-/// Face i `undefined`: NaN in every asked field.
-void store_undefined_face(TriangleCurvatureResult& r, Eigen::Index i, const TriangleFields& want) {
-  if (want.coefficients) r.A[i] = r.B[i] = r.C[i] = kNaN;
-  if (want.curvatures) r.K[i] = r.H[i] = r.k1[i] = r.k2[i] = kNaN;
-  if (want.focal_depths) r.lambda1[i] = r.lambda2[i] = kNaN;
-  if (want.directions) r.d1.row(i).setConstant(kNaN), r.d2.row(i).setConstant(kNaN);
-  if (want.slits) r.slit1.row(i).setConstant(kNaN), r.slit2.row(i).setConstant(kNaN);
-  if (want.face_normal) r.face_normal.row(i).setConstant(kNaN);
-  if (want.shape_operator) r.shape_operator.row(i).setConstant(kNaN);
-  r.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
-}
+// ---- The per-face solve, one face per lane.
+//
+// Faces in groups of the lane width (simd_lanes.h): the three vertex rays in the frame of the
+// face's mean normal (face_rays of version 3: inline frame_of and ray_of), the characteristic
+// equation with the sagitta shift, the curvatures and, where asked, directions, slits and the
+// shape operator, all as selects per lane; faces without a solution get NaN and `undefined`. No
+// lane reads another, so every instruction set and thread count gives the same bits.
 
-/// The three vertex rays of a face in the frame of its mean normal, origin at its centroid.
-struct FaceRays {
-  TangentFrame frame;
-  NormalRay r[3];
-  Eigen::Vector2d offset[3];  ///< tangential position of each vertex relative to the centroid
+using detail::broadcast;
+using detail::finite;
+using detail::lane_abs;
+using detail::lane_count;
+using detail::lane_sqrt;
+using detail::lanes_of;
+using detail::MaskOf;
+
+/// What the face kernel reads.
+struct FaceInput {
+  PositionsRef V;
+  const RowMatrixX3d& N;        ///< unit normals (unit_rows)
+  const std::vector<char>& ok;  ///< normal flags (unit_rows)
+  FacesRef F;
+  detail::ClassTolerances tol;
+  const TriangleFields& want;
 };
 
-// The inline bodies of tangent_frame and normal_ray (same formulas, no std::optional).
-bool face_rays(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
-               const Eigen::Vector3i& f, FaceRays& out) {
-  if (!ok[f[0]] || !ok[f[1]] || !ok[f[2]]) return false;
-  const Eigen::Vector3d sum = N.row(f[0]) + N.row(f[1]) + N.row(f[2]);
-  const double len = sum.norm();
-  if (!(len > 0.0) || !std::isfinite(len)) return false;
-  out.frame = detail::frame_of(sum / len);
-  const Eigen::Vector3d centroid = (V.row(f[0]) + V.row(f[1]) + V.row(f[2])).transpose() / 3.0;
+/// A 2x2 matrix per lane, as in the file's scalar formulas: columns are the edges 0->1, 0->2.
+template <class L>
+struct alignas(sizeof(L)) Lanes2x2 {
+  L m00, m01, m10, m11;
+  [[nodiscard]] L determinant() const { return m00 * m11 - m10 * m01; }
+  [[nodiscard]] L squared_norm() const { return (m00 * m00 + m10 * m10) + (m01 * m01 + m11 * m11); }
+};
+
+/// G X^-1 (Eigen's 2x2 inverse: one reciprocal of the determinant).
+template <class L>
+FOCAL_LANE_INLINE Lanes2x2<L> times_inverse(const Lanes2x2<L>& G, const Lanes2x2<L>& X) {
+  const L inv = 1.0 / X.determinant();
+  const L i00 = X.m11 * inv, i01 = -X.m01 * inv, i10 = -X.m10 * inv, i11 = X.m00 * inv;
+  return {G.m00 * i00 + G.m01 * i10, G.m00 * i01 + G.m01 * i11, G.m10 * i00 + G.m11 * i10,
+          G.m10 * i01 + G.m11 * i11};
+}
+
+/// slit_direction per lane: the unit slit in the face plane at depth lambda, zero where both
+/// candidate vectors vanish.
+template <class L>
+FOCAL_LANE_INLINE void slit_lanes(const Lanes2x2<L>& X, const Lanes2x2<L>& G, L lambda, L& sx,
+                                  L& sy) {
+  const auto infinite = lane_abs(lambda) == std::numeric_limits<double>::infinity();
+  const L ax = infinite ? G.m00 : X.m00 + lambda * G.m00;
+  const L ay = infinite ? G.m10 : X.m10 + lambda * G.m10;
+  const L bx = infinite ? G.m01 : X.m01 + lambda * G.m01;
+  const L by = infinite ? G.m11 : X.m11 + lambda * G.m11;
+  const L a2 = ax * ax + ay * ay, b2 = bx * bx + by * by;
+  const auto a_longer = a2 >= b2;
+  const L lx = a_longer ? ax : bx, ly = a_longer ? ay : by, l2 = a_longer ? a2 : b2;
+  const L g = lane_sqrt(G.squared_norm());
+  const L scale = lane_sqrt(X.squared_norm()) + (infinite ? g : lane_abs(lambda) * g);
+  const L length = lane_sqrt(l2);
+  const auto nonzero = length > 1e-9 * scale;
+  const L zero{};
+  sx = nonzero ? lx / length : zero;
+  sy = nonzero ? ly / length : zero;
+}
+
+/// Stores lanes [0, active) of x at rows first... of v (one vector store for a whole group).
+template <class L>
+FOCAL_LANE_INLINE void store_scalars(Eigen::VectorXd& v, std::int64_t first, int active, L x) {
+  if (active == lane_count<L>) return detail::store_lanes(v.data() + first, x);
+  for (int l = 0; l < active; ++l) v[first + l] = x[l];
+}
+
+template <class L>
+FOCAL_LANE_INLINE void store_rows(RowMatrixX3d& m, std::int64_t first, int active, L x, L y, L z) {
+  double* row = m.data() + 3 * first;
+  for (int l = 0; l < active; ++l) row[3 * l] = x[l], row[3 * l + 1] = y[l], row[3 * l + 2] = z[l];
+}
+
+/// Solves faces [first, first + active) and writes their asked fields.
+template <class L>
+FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first, int active,
+                                        TriangleCurvatureResult& r) {
+  constexpr int W = lane_count<L>;
+  int corner[3][W];
+  for (int l = 0; l < W; ++l) {
+    const std::int64_t f = first + std::min(l, active - 1);
+    for (int c = 0; c < 3; ++c) corner[c][l] = in.F(f, c);
+  }
+  const auto column = [&](const auto& matrix, int c, int col) {
+    return lanes_of<L>([&](int l) { return matrix(corner[c][l], col); });
+  };
+  L px[3], py[3], pz[3], mx[3], my[3], mz[3];
+  auto valid = lanes_of<L>([](int l) { return static_cast<double>(l); }) < active;
   for (int c = 0; c < 3; ++c) {
-    if (!detail::ray_of(out.frame, centroid, V.row(f[c]).transpose(), N.row(f[c]).transpose(),
-                        out.r[c])) {
-      return false;
-    }
-    out.offset[c] = out.frame.to_plane(V.row(f[c]).transpose() - centroid);
+    px[c] = column(in.V, c, 0), py[c] = column(in.V, c, 1), pz[c] = column(in.V, c, 2);
+    mx[c] = column(in.N, c, 0), my[c] = column(in.N, c, 1), mz[c] = column(in.N, c, 2);
+    valid &= lanes_of<MaskOf<L>>([&](int l) {
+      return in.ok[static_cast<std::size_t>(corner[c][l])] ? std::int64_t{-1} : std::int64_t{0};
+    });
   }
-  return true;
+  // The frame of the mean normal; the centroid as origin.
+  const L sx = mx[0] + mx[1] + mx[2], sy = my[0] + my[1] + my[2], sz = mz[0] + mz[1] + mz[2];
+  const L length = lane_sqrt(sx * sx + sy * sy + sz * sz);
+  valid &= (length > 0.0) & finite(length);
+  const L one = broadcast<L>(1.0), zero{};
+  // Reciprocals times, not divisions: the divider is the kernel's narrowest port (17 divisions
+  // per group became 7; each result moves by at most an ulp).
+  const L inv_length = 1.0 / length;
+  const L nx = valid ? sx * inv_length : zero, ny = valid ? sy * inv_length : zero,
+          nz = valid ? sz * inv_length : one;
+  L xx, xy, xz, yx, yy, yz;
+  detail::frame_lanes(nx, ny, nz, xx, xy, xz, yx, yy, yz);
+  const double third = 1.0 / 3.0;
+  const L cx = (px[0] + px[1] + px[2]) * third, cy = (py[0] + py[1] + py[2]) * third,
+          cz = (pz[0] + pz[1] + pz[2]) * third;
+  L u[3], v[3], sigma[3], tau[3], ox[3], oy[3];
+  for (int c = 0; c < 3; ++c) {  // ray_of, and the vertex's tangential offset
+    const L qx = px[c] - cx, qy = py[c] - cy, qz = pz[c] - cz;
+    const L m_n = nx * mx[c] + ny * my[c] + nz * mz[c];
+    const L q_n = nx * qx + ny * qy + nz * qz;
+    const L inv_m_n = 1.0 / m_n;
+    sigma[c] = (xx * mx[c] + xy * my[c] + xz * mz[c]) * inv_m_n;
+    tau[c] = (yx * mx[c] + yy * my[c] + yz * mz[c]) * inv_m_n;
+    ox[c] = xx * qx + xy * qy + xz * qz;
+    oy[c] = yx * qx + yy * qy + yz * qz;
+    u[c] = ox[c] - q_n * sigma[c];
+    v[c] = oy[c] - q_n * tau[c];
+    valid &= (m_n > 0.0) & finite(sigma[c] + tau[c] + u[c] + v[c]);
+  }
+  Lanes2x2<L> X{u[1] - u[0], u[2] - u[0], v[1] - v[0], v[2] - v[0]};
+  const Lanes2x2<L> G{sigma[1] - sigma[0], sigma[2] - sigma[0], tau[1] - tau[0], tau[2] - tau[0]};
+  valid &= lane_abs(X.determinant()) > 1e-14 * X.squared_norm();  // area in the ray frame
+  // The centroid lies below the surface by the sagitta s = (1/6) sum x^T M x (second order,
+  // x the vertices' tangential offsets). Depths measured from the centroid's plane would carry
+  // that O(h^2) bias into K and H, so the rays are re-parametrised on the plane z = s, the
+  // tangent plane at the surface point above the centroid: (u, v) += s (sigma, tau).
+  const Lanes2x2<L> M0 = times_inverse(G, X);
+  const L s01 = 0.5 * (M0.m01 + M0.m10);
+  L sagitta{};
+  for (int c = 0; c < 3; ++c) {
+    sagitta += ox[c] * (M0.m00 * ox[c] + s01 * oy[c]) + oy[c] * (s01 * ox[c] + M0.m11 * oy[c]);
+  }
+  sagitta *= 1.0 / 6.0;
+  X.m00 += sagitta * G.m00, X.m01 += sagitta * G.m01;
+  X.m10 += sagitta * G.m10, X.m11 += sagitta * G.m11;
+  const L A = G.determinant();
+  const L B = G.m00 * X.m11 - G.m01 * X.m10 - G.m10 * X.m01 + G.m11 * X.m00;
+  const L C = X.determinant();
+  valid &= lane_abs(C) > 1e-14 * X.squared_norm();
+  const L inv_C = 1.0 / C;
+  const L K = A * inv_C, H = 0.5 * (B * inv_C);
+  // H^2 < K only through rounding or a non-symmetric M (noise): the double root H.
+  const L root = lane_sqrt(detail::lane_max(H * H - K, zero));
+  const L k1 = H + root, k2 = H - root;
+  const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
+  const auto or_nan = [&](L x) { return valid ? x : nan; };
+  const TriangleFields& want = in.want;
+  if (want.coefficients) {
+    store_scalars(r.A, first, active, or_nan(A)), store_scalars(r.B, first, active, or_nan(B));
+    store_scalars(r.C, first, active, or_nan(C));
+  }
+  if (want.curvatures) {
+    store_scalars(r.K, first, active, or_nan(K)), store_scalars(r.H, first, active, or_nan(H));
+    store_scalars(r.k1, first, active, or_nan(k1)), store_scalars(r.k2, first, active, or_nan(k2));
+  }
+  const L lambda1 = -1.0 / k1, lambda2 = -1.0 / k2;
+  if (want.focal_depths) {
+    store_scalars(r.lambda1, first, active, or_nan(lambda1));
+    store_scalars(r.lambda2, first, active, or_nan(lambda2));
+  }
+  if (want.directions || want.slits || want.shape_operator) {
+    const Lanes2x2<L> M = times_inverse(G, X);  // M on the shifted X
+    if (want.shape_operator) {
+      double* row = r.shape_operator.data() + 4 * first;
+      const L m00 = or_nan(M.m00), m01 = or_nan(M.m01), m10 = or_nan(M.m10), m11 = or_nan(M.m11);
+      for (int l = 0; l < active; ++l) {
+        row[4 * l] = m00[l], row[4 * l + 1] = m01[l], row[4 * l + 2] = m10[l];
+        row[4 * l + 3] = m11[l];
+      }
+    }
+    if (want.directions || want.slits) {
+      const detail::PrincipalLanes<L> p =
+          detail::principal_lanes(M.m00, 0.5 * (M.m01 + M.m10), M.m11);
+      // frame.from_plane of d1 and of d2 = d1 turned by +90 degrees.
+      const auto to_3d = [&](L a, L b, RowMatrixX3d& m) {
+        store_rows(m, first, active, or_nan(a * xx + b * yx), or_nan(a * xy + b * yy),
+                   or_nan(a * xz + b * yz));
+      };
+      if (want.directions) to_3d(p.d1x, p.d1y, r.d1), to_3d(-p.d1y, p.d1x, r.d2);
+      if (want.slits) {
+        // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
+        L s1x, s1y, s2x, s2y;
+        slit_lanes(X, G, lambda1, s1x, s1y);
+        slit_lanes(X, G, lambda2, s2x, s2y);
+        const auto empty1 = s1x * s1x + s1y * s1y == 0.0, empty2 = s2x * s2x + s2y * s2y == 0.0;
+        to_3d(empty1 ? -p.d1y : s1x, empty1 ? p.d1x : s1y, r.slit1);
+        to_3d(empty2 ? p.d1x : s2x, empty2 ? p.d1y : s2y, r.slit2);
+      }
+    }
+  }
+  if (want.face_normal)
+    store_rows(r.face_normal, first, active, or_nan(nx), or_nan(ny), or_nan(nz));
+  const auto point_class = valid ? detail::classify_lanes(k1, k2, in.tol)
+                                 : MaskOf<L>{} + static_cast<std::int64_t>(PointClass::undefined);
+  for (int l = 0; l < active; ++l) {
+    r.point_class[first + l] = static_cast<std::uint8_t>(point_class[l]);
+  }
 }
 
-/// Unit slit direction at focal depth lambda from eq. 18, using whichever edge gives the longer
-/// vector (Appendix B: the edge along which the two intersection points do not coincide).
-/// Empty (zero) when both vanish, as at umbilics where all three rays meet in one point.
-Eigen::Vector2d slit_direction(const Eigen::Matrix2d& X, const Eigen::Matrix2d& G, double lambda) {
-  Eigen::Vector2d a = X.col(0) + lambda * G.col(0), b = X.col(1) + lambda * G.col(1);
-  if (std::isinf(lambda)) a = G.col(0), b = G.col(1);  // limit of the direction as lambda -> inf
-  const Eigen::Vector2d& longer = a.squaredNorm() >= b.squaredNorm() ? a : b;
-  const double scale = X.norm() + (std::isinf(lambda) ? G.norm() : std::abs(lambda) * G.norm());
-  return longer.norm() > 1e-9 * scale ? Eigen::Vector2d(longer.normalized())
-                                      : Eigen::Vector2d::Zero();
+template <class L>
+FOCAL_LANE_INLINE void solve_face_block_lanes(const FaceInput& in, std::int64_t begin,
+                                              std::int64_t end, TriangleCurvatureResult& r) {
+  constexpr int W = lane_count<L>;
+  for (std::int64_t first = begin; first < end; first += W) {
+    solve_face_group<L>(in, first, static_cast<int>(std::min<std::int64_t>(W, end - first)), r);
+  }
 }
 
-/// Solves face i and writes its asked fields; false (nothing written) where it has no solution.
-bool solve_face(const FaceRays& fr, Eigen::Index i, const detail::ClassTolerances& tol,
-                const TriangleFields& want, TriangleCurvatureResult& r) {
-  Eigen::Matrix2d X, G;  // columns: differences along the edges 0->1 and 0->2
-  X << fr.r[1].u - fr.r[0].u, fr.r[2].u - fr.r[0].u, fr.r[1].v - fr.r[0].v, fr.r[2].v - fr.r[0].v;
-  G << fr.r[1].sigma - fr.r[0].sigma, fr.r[2].sigma - fr.r[0].sigma, fr.r[1].tau - fr.r[0].tau,
-      fr.r[2].tau - fr.r[0].tau;
-  if (!(std::abs(X.determinant()) > 1e-14 * X.squaredNorm()))
-    return false;  // no area in the ray frame
-  // The centroid lies below the surface by the sagitta s = (1/6) sum x_i^T M x_i (second order,
-  // x_i the vertices' tangential offsets). Depths measured from the centroid's plane would
-  // carry that O(h^2) bias into K and H, so the rays are re-parametrised on the plane z = s,
-  // the tangent plane at the surface point above the centroid: (u, v) += s (sigma, tau).
-  const Eigen::Matrix2d M0 = G * X.inverse();
-  const Eigen::Matrix2d S0 = 0.5 * (M0 + M0.transpose());
-  double sagitta = 0.0;
-  for (const Eigen::Vector2d& x : fr.offset) sagitta += x.dot(S0 * x);
-  sagitta /= 6.0;
-  X += sagitta * G;
-  const double A = G.determinant();
-  const double B = G(0, 0) * X(1, 1) - G(0, 1) * X(1, 0) - G(1, 0) * X(0, 1) + G(1, 1) * X(0, 0);
-  const double C = X.determinant();
-  if (!(std::abs(C) > 1e-14 * X.squaredNorm())) return false;
-  const double K = A / C, H = B / (2.0 * C);
-  // H^2 < K only through rounding or a non-symmetric M (noise): treat as the double root H.
-  const double root = std::sqrt(std::max(H * H - K, 0.0));
-  const double k1 = H + root, k2 = H - root;
-  if (want.coefficients) r.A[i] = A, r.B[i] = B, r.C[i] = C;
-  if (want.curvatures) r.K[i] = K, r.H[i] = H, r.k1[i] = k1, r.k2[i] = k2;
-  const double lambda1 = -1.0 / k1, lambda2 = -1.0 / k2;
-  if (want.focal_depths) r.lambda1[i] = lambda1, r.lambda2[i] = lambda2;
-  // M again on the shifted X, only where an asked field needs it (two divisions saved).
-  const bool need_operator = want.directions || want.slits || want.shape_operator;
-  const Eigen::Matrix2d M = need_operator ? Eigen::Matrix2d(G * X.inverse()) : Eigen::Matrix2d();
-  if (want.directions || want.slits) {
-    const detail::Principal2 p =
-        detail::principal_from_symmetric(M(0, 0), 0.5 * (M(0, 1) + M(1, 0)), M(1, 1));
-    if (want.directions) {
-      r.d1.row(i) = fr.frame.from_plane(p.d1);
-      r.d2.row(i) = fr.frame.from_plane(p.d2);
-    }
-    if (want.slits) {
-      // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
-      const Eigen::Vector2d s1 = slit_direction(X, G, lambda1), s2 = slit_direction(X, G, lambda2);
-      r.slit1.row(i) = fr.frame.from_plane(s1.squaredNorm() > 0 ? s1 : p.d2);
-      r.slit2.row(i) = fr.frame.from_plane(s2.squaredNorm() > 0 ? s2 : p.d1);
-    }
+FOCAL_TARGET_AVX512 void solve_face_block_avx512(const FaceInput& in, std::int64_t begin,
+                                                 std::int64_t end, TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes8>(in, begin, end, r);
+}
+FOCAL_TARGET_AVX2 void solve_face_block_avx2(const FaceInput& in, std::int64_t begin,
+                                             std::int64_t end, TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes4>(in, begin, end, r);
+}
+void solve_face_block_baseline(const FaceInput& in, std::int64_t begin, std::int64_t end,
+                               TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes2>(in, begin, end, r);
+}
+
+using FaceBlock = void (*)(const FaceInput&, std::int64_t, std::int64_t, TriangleCurvatureResult&);
+
+FaceBlock solve_face_block_for(detail::SimdIsa isa) {
+  switch (detail::simd_isa(isa)) {
+    case detail::SimdIsa::avx512:
+      return solve_face_block_avx512;
+    case detail::SimdIsa::avx2:
+      return solve_face_block_avx2;
+    default:
+      return solve_face_block_baseline;
   }
-  if (want.face_normal) r.face_normal.row(i) = fr.frame.n;
-  if (want.shape_operator) r.shape_operator.row(i) << M(0, 0), M(0, 1), M(1, 0), M(1, 1);
-  r.point_class[i] = static_cast<std::uint8_t>(classify(k1, k2, tol.zero, tol.umbilic));
-  return true;
 }
 
 /// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
@@ -185,6 +336,12 @@ TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRe
 TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                            const CurvatureOptions& options,
                                            const TriangleFields& fields) {
+  return detail::triangle_curvature(V, F, N, options, fields, detail::SimdIsa::best);
+}
+
+TriangleCurvatureResult detail::triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                                   const CurvatureOptions& options,
+                                                   const TriangleFields& fields, SimdIsa isa) {
   if (N.rows() != V.rows()) {
     throw InvalidInput("triangle curvature: " + std::to_string(N.rows()) + " normals for " +
                        std::to_string(V.rows()) + " vertices");
@@ -194,12 +351,12 @@ TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRe
   const RowMatrixX3d unit = detail::unit_rows(N, ok, options.threads);
   const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
   TriangleCurvatureResult r = unwritten_faces(F.rows(), fields);
-  detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
-    FaceRays fr;
-    if (!face_rays(V, unit, ok, F.row(f).transpose(), fr) || !solve_face(fr, f, tol, fields, r)) {
-      store_undefined_face(r, f, fields);
-    }
-  });
+  const FaceInput in{V, unit, ok, F, tol, fields};
+  const FaceBlock solve_block = solve_face_block_for(isa);
+  // Blocks are whole groups of every lane width, so each face's row is written by one thread.
+  detail::parallel_for_blocks(
+      F.rows(), 1024, options.threads,
+      [&](std::int64_t begin, std::int64_t end) { solve_block(in, begin, end, r); });
   return r;
 }
 

@@ -1,0 +1,167 @@
+// The lane kernels of the closed-form fit and of the per-triangle solve (src/simd_lanes.h): the
+// same bits for every instruction set they are compiled for and every thread count, and the
+// same values as the scalar formulas, including the lanes that the vector code handles by select
+// (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "curvature_detail.h"
+#include "focal/neighbourhood.h"
+#include "focal/normal_rays.h"
+#include "focal/surfaces.h"
+#include "focal/triangle_curvature.h"
+#include "focal/two_slit_fit.h"
+#include "simd_lanes.h"
+#include "test_meshes.h"
+
+namespace focal {
+namespace {
+
+using detail::SimdIsa;
+
+/// An irregular torus (valences 4 to 9) with #V not a multiple of 8, some normals invalid
+/// (zero, NaN) and one vertex with a single usable neighbour ray (all other neighbour normals
+/// flipped), so that lanes of one group take every branch of the fit.
+Mesh awkward_mesh() {
+  Mesh m = test::analytic_surface(SurfaceKind::torus, Triangulation::irregular, 3001, 0, 7).mesh;
+  EXPECT_NE(m.V.rows() % 8, 0);
+  m.N.row(3).setZero();
+  m.N(17, 1) = std::nan("");
+  m.N.row(18) *= -1.0;  // outside its neighbours' hemispheres: excluded from their fits
+  const Neighbourhoods ring = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  const int lonely = 40;
+  for (const int* j = ring.begin(lonely) + 1; j != ring.end(lonely); ++j) m.N.row(*j) *= -1.0;
+  return m;
+}
+
+std::vector<SimdIsa> available_isas() {
+  std::vector<SimdIsa> isas;
+  for (SimdIsa isa : {SimdIsa::baseline, SimdIsa::avx2, SimdIsa::avx512}) {
+    if (detail::simd_isa_available(isa)) isas.push_back(isa);
+  }
+  return isas;
+}
+
+/// Same bits, NaN where the other has NaN.
+template <class A>
+bool identical(const A& a, const A& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         ((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all();
+}
+
+bool identical(const CurvatureResult& a, const CurvatureResult& b) {
+  return identical(a.k1, b.k1) && identical(a.k2, b.k2) && identical(a.H, b.H) &&
+         identical(a.K, b.K) && identical(a.d1, b.d1) && identical(a.d2, b.d2) &&
+         identical(a.residual, b.residual) &&
+         (a.point_class.array() == b.point_class.array()).all() &&
+         (a.rays_used.array() == b.rays_used.array()).all() &&
+         (a.rays_excluded.array() == b.rays_excluded.array()).all();
+}
+
+struct FitCase {
+  int rings;
+  RayWeighting weighting;
+};
+
+CurvatureResult fit(const Mesh& m, const FitCase& c, int threads, SimdIsa isa) {
+  CurvatureOptions o;
+  o.rings = c.rings;
+  o.weighting = c.weighting;
+  o.threads = threads;
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  const Neighbourhoods rings = c.rings == 1 ? one : k_ring(one, c.rings);
+  return detail::fit_vertices({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, isa);
+}
+
+TEST(SimdKernels, FitIsBitIdenticalForEveryInstructionSetAndThreadCount) {
+  const Mesh m = awkward_mesh();
+  for (const FitCase c : {FitCase{1, RayWeighting::uniform}, FitCase{2, RayWeighting::gaussian}}) {
+    const CurvatureResult reference = fit(m, c, 1, SimdIsa::baseline);
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        EXPECT_TRUE(identical(fit(m, c, threads, isa), reference))
+            << "rings " << c.rings << " isa " << static_cast<int>(isa) << " threads " << threads;
+      }
+    }
+  }
+}
+
+// The scalar formulas (tangent_frame, normal_ray, fit_two_slits_closed_form) vertex by vertex:
+// the lane kernel solves the same normal equations by cofactors, so values agree to rounding.
+TEST(SimdKernels, FitMatchesTheScalarClosedFormVertexByVertex) {
+  const Mesh m = awkward_mesh();
+  const CurvatureResult r = fit(m, {1, RayWeighting::uniform}, 0, SimdIsa::best);
+  const Neighbourhoods ring = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  int undefined = 0;
+  for (int i = 0; i < m.V.rows(); ++i) {
+    const Eigen::Vector3d n = m.N.row(i).transpose();
+    const bool normal_ok = std::isfinite(n.norm()) && n.norm() > 0.0;
+    std::vector<NormalRay> rays;
+    if (normal_ok) {
+      const TangentFrame frame = tangent_frame(n.normalized());
+      for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
+        const Eigen::Vector3d nj = m.N.row(*j).transpose();
+        if (!std::isfinite(nj.norm()) || !(nj.norm() > 0.0)) continue;
+        if (auto ray = normal_ray(frame, m.V.row(i).transpose(), m.V.row(*j).transpose(),
+                                  nj.normalized())) {
+          rays.push_back(*ray);
+        }
+      }
+    }
+    ASSERT_EQ(r.rays_used[i], static_cast<int>(rays.size())) << "vertex " << i;
+    ASSERT_EQ(r.rays_excluded[i], normal_ok ? ring.size(i) - r.rays_used[i] : 0);
+    const SlitFit f = normal_ok ? fit_two_slits_closed_form(rays) : SlitFit{};
+    if (!f.valid) {
+      ++undefined;
+      ASSERT_EQ(r.class_of(i), PointClass::undefined) << "vertex " << i;
+      ASSERT_TRUE(std::isnan(r.k1[i]) && std::isnan(r.d1(i, 0)) && std::isnan(r.residual[i]));
+      continue;
+    }
+    const double scale = std::max(std::abs(f.k1), std::abs(f.k2));
+    ASSERT_NEAR(r.k1[i], f.k1, 1e-12 * scale) << "vertex " << i;
+    ASSERT_NEAR(r.k2[i], f.k2, 1e-12 * scale) << "vertex " << i;
+    ASSERT_NEAR(r.residual[i], std::sqrt(f.energy / static_cast<double>(rays.size())),
+                1e-9 * scale);
+  }
+  EXPECT_GE(undefined, 3);  // vertices 3, 17 (invalid normals) and 40 (one ray)
+}
+
+TEST(SimdKernels, TriangleIsBitIdenticalForEveryInstructionSetAndThreadCount) {
+  const Mesh m = awkward_mesh();
+  const TriangleFields all;
+  TriangleFields curvatures;
+  curvatures.coefficients = curvatures.focal_depths = curvatures.directions = false;
+  curvatures.slits = curvatures.face_normal = curvatures.shape_operator = false;
+  for (const TriangleFields& fields : {all, curvatures}) {
+    CurvatureOptions o;
+    o.threads = 1;
+    const TriangleCurvatureResult reference =
+        detail::triangle_curvature(m.V, m.F, m.N, o, fields, SimdIsa::baseline);
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        o.threads = threads;
+        const TriangleCurvatureResult t = detail::triangle_curvature(m.V, m.F, m.N, o, fields, isa);
+        EXPECT_TRUE(identical(t.A, reference.A) && identical(t.B, reference.B) &&
+                    identical(t.C, reference.C) && identical(t.K, reference.K) &&
+                    identical(t.H, reference.H) && identical(t.k1, reference.k1) &&
+                    identical(t.k2, reference.k2) && identical(t.lambda1, reference.lambda1) &&
+                    identical(t.lambda2, reference.lambda2) && identical(t.d1, reference.d1) &&
+                    identical(t.d2, reference.d2) && identical(t.slit1, reference.slit1) &&
+                    identical(t.slit2, reference.slit2) &&
+                    identical(t.face_normal, reference.face_normal) &&
+                    identical(t.shape_operator, reference.shape_operator) &&
+                    (t.point_class.array() == reference.point_class.array()).all())
+            << "isa " << static_cast<int>(isa) << " threads " << threads;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace focal
