@@ -31,8 +31,9 @@ struct FocalMeshFlags {
 };
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
-  Mesh mesh = read_input(f.input, f.estimator, log);
-  Estimate e = estimate(mesh, f.input, f.estimator, log);
+  Input input = read_input(f.input, f.estimator, log);
+  Estimate e = estimate(input, f.input, f.estimator, log);
+  Mesh& mesh = input.mesh;
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
     write_curvature_csv(f.output, e.fields);
@@ -43,8 +44,9 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
 }
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
-  Mesh mesh = read_input(f.input, f.estimator, log);
-  const Estimate e = estimate(mesh, f.input, f.estimator, log);
+  Input input = read_input(f.input, f.estimator, log);
+  const Estimate e = estimate(input, f.input, f.estimator, log);
+  const Mesh& mesh = input.mesh;
   FocalMeshes meshes;
   {
     Stage stage(log, "focal meshes");

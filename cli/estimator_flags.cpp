@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <sstream>
 
@@ -19,8 +20,11 @@ namespace {
 /// sphere and second-order accurate on smooth surfaces, also on irregular meshes.
 constexpr NormalWeighting kDefaultWeighting = NormalWeighting::max;
 
-/// Normals estimated from faces take their side from the faces' orientation.
-void orient_faces_outward(Mesh& mesh, const Log& log) {
+/// Normals estimated from faces take their side from the faces' orientation. The check stage
+/// has counted the inward components of this very F; only when there are some is the report
+/// (a pass over the whole topology) computed again, for the faces to reverse.
+void orient_faces_outward(Mesh& mesh, const MeshFindings& findings, const Log& log) {
+  if (findings.inward_component_count == 0) return;
   const OrientationReport report = orientation_report(mesh.V, mesh.F);
   if (const int inward = report.inward_count(); inward > 0) {
     log.warning(std::to_string(inward) +
@@ -30,37 +34,52 @@ void orient_faces_outward(Mesh& mesh, const Log& log) {
   }
 }
 
-RowMatrixX3d estimated_normals(Mesh& mesh, NormalWeighting weighting, const Log& log) {
-  orient_faces_outward(mesh, log);
+RowMatrixX3d estimated_normals(Mesh& mesh, const MeshFindings& findings, NormalWeighting weighting,
+                               const Log& log) {
+  orient_faces_outward(mesh, findings, log);
   return vertex_normals(mesh.V, mesh.F, weighting);
 }
 
 /// Rows of the file's normals that are missing (NaN) or zero are filled from the faces.
-void fill_missing_rows(Mesh& mesh, RowMatrixX3d& normals, const Log& log) {
+void fill_missing_rows(Mesh& mesh, const Log& log) {
   std::vector<Eigen::Index> missing;
-  for (Eigen::Index i = 0; i < normals.rows(); ++i) {
-    const double len = normals.row(i).norm();
+  for (Eigen::Index i = 0; i < mesh.N.rows(); ++i) {
+    const double len = mesh.N.row(i).norm();
     if (!std::isfinite(len) || len == 0.0) missing.push_back(i);
   }
   if (missing.empty()) return;
   const RowMatrixX3d estimated = vertex_normals(mesh.V, mesh.F, kDefaultWeighting);
-  for (Eigen::Index i : missing) normals.row(i) = estimated.row(i);
+  for (Eigen::Index i : missing) mesh.N.row(i) = estimated.row(i);
   log.warning(std::to_string(missing.size()) +
               " vertices have no usable normal in the file; estimated them from the faces");
 }
 
-void check_file_normals(const Mesh& mesh, RowMatrixX3d& normals, const Log& log) {
+void normalise_rows(Mesh& mesh, const Log& log) {
   int rescaled = 0;
-  for (Eigen::Index i = 0; i < normals.rows(); ++i) {
-    const double len = normals.row(i).norm();
+  for (Eigen::Index i = 0; i < mesh.N.rows(); ++i) {
+    const double len = mesh.N.row(i).norm();
     if (std::isfinite(len) && len > 0.0 && std::abs(len - 1.0) > 1e-6) {
-      normals.row(i) /= len;
+      mesh.N.row(i) /= len;
       ++rescaled;
     }
   }
   if (rescaled > 0)
     log.warning(std::to_string(rescaled) + " normals were not of unit length; normalised");
-  if (mesh.F.rows() > 0 && fraction_against_faces(mesh.V, mesh.F, normals) > 0.5) {
+}
+
+/// Makes the file's normals (mesh.N) usable in place, warning about what it fixed or suspects.
+/// The findings (check_mesh of these normals) say whether any row needs fixing, so the usual
+/// file of unit normals is not scanned again, and how many normals point against their faces:
+/// that count covers the rows as given, so the filled rows (which follow the faces) are not in
+/// it, and rescaling does not change a sign.
+void prepare_file_normals(Mesh& mesh, const MeshFindings& findings, const Log& log) {
+  if (findings.non_finite_normal_count + findings.zero_normal_count +
+          findings.non_unit_normal_count >
+      0) {
+    fill_missing_rows(mesh, log);
+    normalise_rows(mesh, log);
+  }
+  if (2 * findings.normals_against_faces_count > findings.normals_compared_count) {
     log.warning(
         "most file normals point against the face orientation (inward?); curvature signs "
         "follow the normals");
@@ -78,6 +97,7 @@ std::string range_of(const Eigen::VectorXd& v) {
 }
 
 void print_summary(const CurvatureResult& r, const Log& log) {
+  if (!log.verbose()) return;  // three passes over #V for lines nobody sees
   std::array<int, 6> counts{};
   for (auto c : r.point_class) ++counts[c];
   std::string line = "  classes:";
@@ -149,79 +169,101 @@ bool EstimatorFlags::uses_file_normals(const Mesh& mesh) const {
          (normals == NormalsSource::file || normals == NormalsSource::automatic);
 }
 
-RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name, NormalsSource source,
-                             const Log& log) {
+RowMatrixX3d prepare_normals(Mesh& mesh, const MeshFindings& findings, const std::string& mesh_name,
+                             NormalsSource source, const Log& log) {
   Stage stage(log, "normals");
   if (source == NormalsSource::file && !mesh.has_normals()) {
     throw InvalidInput("--normals file: " + mesh_name + " has no vertex normals");
   }
   if (source == NormalsSource::file || (source == NormalsSource::automatic && mesh.has_normals())) {
-    RowMatrixX3d normals = mesh.N;
-    fill_missing_rows(mesh, normals, log);
-    check_file_normals(mesh, normals, log);
-    return normals;
+    prepare_file_normals(mesh, findings, log);
+    return std::move(mesh.N);  // the caller writes the normals it used, not a copy of them
   }
   const NormalWeighting weighting = source == NormalsSource::automatic ? kDefaultWeighting
                                     : source == NormalsSource::area    ? NormalWeighting::area
                                     : source == NormalsSource::angle   ? NormalWeighting::angle
                                                                        : NormalWeighting::max;
-  return estimated_normals(mesh, weighting, log);
+  return estimated_normals(mesh, findings, weighting, log);
 }
 
 namespace {
 
-/// The recommended estimator (recommended.h) on the file's normals when it has them.
-Estimate run_recommended(Mesh& mesh, const std::string& mesh_name, const EstimatorFlags& flags,
-                         const Log& log) {
-  RowMatrixX3d file_normals(0, 3);
-  if (mesh.has_normals()) {
-    file_normals = prepare_normals(mesh, mesh_name, NormalsSource::file, log);
-  } else {
+/// Which normals the recommended estimator fitted (recommended.h, step 3).
+std::string normals_used(const RecommendedResult& r) {
+  if (r.file_normals_used) return "file normals (jet normals at outliers)";
+  if (r.plan.rings > 1) {
+    return "normals of degree-" + std::to_string(r.plan.jet_degree) + " jets over " +
+           std::to_string(r.plan.jet_rings) + " rings";
+  }
+  return "jet or Max normals, whichever is smoother";
+}
+
+/// The recommended estimator (recommended.h) on the file's normals when it has them, used in
+/// place in mesh.N (the estimator returns the normals it chose).
+Estimate run_recommended(Input& input, const EstimatorFlags& flags, const Log& log) {
+  Mesh& mesh = input.mesh;
+  const bool file_normals = mesh.has_normals();
+  {
     Stage stage(log, "normals");
-    orient_faces_outward(mesh, log);  // the jets' normals take their side from the faces
+    if (file_normals) {
+      prepare_file_normals(mesh, input.findings, log);
+    } else {
+      // The jets' normals take their side from the faces.
+      orient_faces_outward(mesh, input.findings, log);
+    }
   }
   RecommendedResult r;
   {
     Stage stage(log, "curvature");
-    r = estimate_curvature_recommended_full(mesh.V, mesh.F, file_normals, flags.options.threads);
+    const RowMatrixX3d none(0, 3);
+    // References, not `file_normals ? mesh.N : none`, whose value would be a copy.
+    const NormalsRef normals = file_normals ? NormalsRef(mesh.N) : NormalsRef(none);
+    r = estimate_curvature_recommended_full(mesh.V, mesh.F, normals, flags.options.threads);
   }
-  if (mesh.has_normals() && !r.file_normals_used) {
+  if (file_normals && !r.file_normals_used) {
     log.warning("the file's normals disagree with the positions (median angle " +
                 std::to_string(r.file_disagreement) +
                 " rad to jet normals): using normals estimated from the positions on the "
                 "file normals' side");
   }
+  mesh.N.resize(0, 3);  // the file's normals are no longer needed: r.N replaces them
   std::ostringstream plan;
-  plan << "  recommended estimator: "
-       << (r.file_normals_used ? "file normals, jet normals at outliers"
-                               : "jet or Max normals, whichever is smoother")
-       << ", position noise " << r.plan.noise << " x edge length, " << r.plan.rings << "-ring "
+  plan << "  recommended estimator: " << normals_used(r) << ", position noise " << r.plan.noise
+       << " x edge length, " << r.plan.rings << "-ring "
        << (r.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
   log.info(plan.str());
   print_summary(r.curvature, log);
   return {std::move(r.N), std::move(r.curvature)};
 }
 
-}  // namespace
-
-Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
-  Mesh mesh;
-  {
-    Stage stage(log, "read");
-    mesh = read_mesh(path);
-    log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
-             " triangles");
-  }
-  const RowMatrixX3d no_normals(0, 3);
-  check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path, flags.strict, log);
-  return mesh;
+/// --threads also pins the stages outside the estimator (see read_input).
+void pin_threads(int threads) {
+  if (threads > 0) setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
 }
 
-Estimate estimate(Mesh& mesh, const std::string& mesh_name, const EstimatorFlags& flags,
+}  // namespace
+
+Input read_input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
+  pin_threads(flags.options.threads);
+  Input input;
+  {
+    Stage stage(log, "read");
+    input.mesh = read_mesh(path);
+    log.info("  " + std::to_string(input.mesh.V.rows()) + " vertices, " +
+             std::to_string(input.mesh.F.rows()) + " triangles");
+  }
+  const RowMatrixX3d no_normals(0, 3);
+  const Mesh& mesh = input.mesh;
+  input.findings = check_input(mesh, flags.uses_file_normals(mesh) ? mesh.N : no_normals, path,
+                               flags.strict, log);
+  return input;
+}
+
+Estimate estimate(Input& input, const std::string& mesh_name, const EstimatorFlags& flags,
                   const Log& log) {
-  if (flags.recommended()) return run_recommended(mesh, mesh_name, flags, log);
-  RowMatrixX3d normals = prepare_normals(mesh, mesh_name, flags.normals, log);
-  CurvatureResult fields = run_estimator(mesh, normals, flags, log);
+  if (flags.recommended()) return run_recommended(input, flags, log);
+  RowMatrixX3d normals = prepare_normals(input.mesh, input.findings, mesh_name, flags.normals, log);
+  CurvatureResult fields = run_estimator(input.mesh, normals, flags, log);
   return {std::move(normals), std::move(fields)};
 }
 

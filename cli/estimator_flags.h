@@ -7,6 +7,7 @@
 
 #include "focal/curvature.h"
 #include "focal/mesh.h"
+#include "focal/mesh_check.h"
 #include "log.h"
 
 namespace focal::cli {
@@ -29,9 +30,20 @@ struct EstimatorFlags {
   [[nodiscard]] bool uses_file_normals(const Mesh& mesh) const;
 };
 
+/// A mesh read for a run, and what check_mesh found in it.
+struct Input {
+  Mesh mesh;
+  /// Findings for mesh.V, mesh.F and the normals the run uses (the file's, else none). The
+  /// normals stage reuses them instead of recomputing the orientation and the face normals.
+  MeshFindings findings;
+};
+
+/// Pins every parallel stage of the run (reading, the check, normals, writing) to --threads:
+/// the library's functions without a `threads` option take theirs from FOCAL_NUM_THREADS.
 /// Reads the mesh and reports (or, with --strict, rejects) what is wrong with it.
 /// \throw InvalidInput / IoError for unreadable files or (with --strict) problems found.
-[[nodiscard]] Mesh read_input(const std::string& path, const EstimatorFlags& flags, const Log& log);
+[[nodiscard]] Input read_input(const std::string& path, const EstimatorFlags& flags,
+                               const Log& log);
 
 /// The normals and fields of a run.
 struct Estimate {
@@ -40,16 +52,20 @@ struct Estimate {
 };
 
 /// Prepares the normals and runs the estimator the flags select, with stage timings and, with -v,
-/// a summary. May re-orient inward closed components of mesh.F when normals are estimated.
+/// a summary. May re-orient inward closed components of input.mesh.F when normals are estimated;
+/// input.mesh.N is left empty when the estimate used the file's normals (they are in the
+/// result's `normals`, made unit; no copy of them is made).
 /// \throw InvalidInput when `--normals file` is asked for and the file has none.
-[[nodiscard]] Estimate estimate(Mesh& mesh, const std::string& mesh_name,
+[[nodiscard]] Estimate estimate(Input& input, const std::string& mesh_name,
                                 const EstimatorFlags& flags, const Log& log);
 
-/// The unit normals the estimator uses: the file's, or estimated from the faces (with inward
-/// closed components re-oriented). Warns about what it fixed or suspects.
+/// The unit normals the estimator uses: the file's (moved out of mesh.N), or estimated from the
+/// faces (with inward closed components re-oriented). Warns about what it fixed or suspects.
+/// `findings`: read_input's, for this mesh and these file normals.
 /// \throw InvalidInput when `--normals file` is asked for and the file has none.
-[[nodiscard]] RowMatrixX3d prepare_normals(Mesh& mesh, const std::string& mesh_name,
-                                           NormalsSource source, const Log& log);
+[[nodiscard]] RowMatrixX3d prepare_normals(Mesh& mesh, const MeshFindings& findings,
+                                           const std::string& mesh_name, NormalsSource source,
+                                           const Log& log);
 
 /// Runs the estimator with stage timings and, with -v, a summary of the result.
 [[nodiscard]] CurvatureResult run_estimator(const Mesh& mesh, const RowMatrixX3d& normals,

@@ -5,15 +5,16 @@
 
 namespace focal::cli {
 
-void check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name, bool strict,
-                 const Log& log) {
+MeshFindings check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name,
+                         bool strict, const Log& log) {
   Stage stage(log, "check");
   const MeshFindings findings = check_mesh(mesh.V, mesh.F, normals);
   log.info("  " + std::to_string(findings.component_count) + " component(s), " +
            std::to_string(findings.boundary_edge_count) + " boundary edge(s)");
-  if (!findings.has_problems()) return;
+  if (!findings.has_problems()) return findings;
   if (strict) throw InvalidInput(mesh_name + ": --strict: " + findings.summary());
   log.warning(mesh_name + ": found " + findings.summary() + " (--strict rejects such input)");
+  return findings;
 }
 
 }  // namespace focal::cli

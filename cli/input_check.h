@@ -5,14 +5,16 @@
 #include <string>
 
 #include "focal/mesh.h"
+#include "focal/mesh_check.h"
 #include "log.h"
 
 namespace focal::cli {
 
 /// Checks the mesh (and the normals the run will use, `normals` with 0 rows when they are
 /// estimated from the faces) and prints "Warning: <file>: <counts>" when anything was found.
+/// Returns the findings, which the normals stage reuses (orientation, the normals' direction).
 /// \throw InvalidInput naming the file and the counts when `strict` and anything was found.
-void check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name, bool strict,
-                 const Log& log);
+MeshFindings check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name,
+                         bool strict, const Log& log);
 
 }  // namespace focal::cli

@@ -106,8 +106,9 @@ Eigen::VectorXd field_values(const CurvatureResult& c, const std::string& field)
 }
 
 void run_render(RenderFlags& f, const Log& log) {
-  Mesh mesh = read_input(f.input, f.estimator, log);
-  const Estimate e = estimate(mesh, f.input, f.estimator, log);
+  Input input = read_input(f.input, f.estimator, log);
+  const Estimate e = estimate(input, f.input, f.estimator, log);
+  const Mesh& mesh = input.mesh;
   const RowMatrixX3d& normals = e.normals;
   const CurvatureResult& fields = e.fields;
   FieldPictureOptions& p = f.picture;

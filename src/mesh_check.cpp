@@ -1,6 +1,7 @@
 #include "focal/mesh_check.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -22,9 +23,9 @@ int parallel_count(std::int64_t n, Count&& count) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<int> sums(static_cast<std::size_t>(blocks), 0);
-  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
+  detail::parallel_blocks(n, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     int sum = 0;
-    for (auto i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) sum += count(i);
+    for (auto i = begin; i < end; ++i) sum += count(i);
     sums[static_cast<std::size_t>(b)] = sum;
   });
   int total = 0;
@@ -47,21 +48,35 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshT
   const RowMatrixX3d from_faces =
       detail::vertex_normals_from(V, F, topology.incidence, NormalWeighting::area);
   const std::vector<int>& component = topology.components.vertex_component;
-  std::vector<int> inward(report.components.size(), 0), counted(report.components.size(), 0);
-  for (Eigen::Index i = 0; i < N.rows(); ++i) {
-    const double dot = N.row(i).dot(from_faces.row(i));
-    if (!std::isfinite(dot)) continue;
-    out.normals_against_faces_count += dot < 0.0 ? 1 : 0;
-    const int c = component[static_cast<std::size_t>(i)];
-    const auto& info = report.components[static_cast<std::size_t>(c)];
-    if (!info.closed || !info.consistent || !std::isfinite(info.signed_volume)) continue;
-    // The faces of an inward component point inside, so a normal with them points inside too.
-    const bool inside = info.signed_volume < 0.0 ? dot > 0.0 : dot < 0.0;
-    inward[static_cast<std::size_t>(c)] += inside ? 1 : 0;
-    ++counted[static_cast<std::size_t>(c)];
-  }
-  for (std::size_t c = 0; c < inward.size(); ++c) {
-    out.inward_normal_component_count += 2 * inward[c] > counted[c] ? 1 : 0;
+  struct Tally {  // vertices with both normals, those against the faces, those pointing inside
+    int compared = 0, against = 0, inside = 0, judged = 0;
+    Tally& operator+=(const Tally& o) {
+      compared += o.compared, against += o.against, inside += o.inside, judged += o.judged;
+      return *this;
+    }
+  };
+  // Keyed by component; vertices in no face have no face normal and drop out with it.
+  std::vector<Tally> tally(report.components.size());
+  detail::add_by_key_runs(
+      N.rows(), [&](std::int64_t i) { return component[static_cast<std::size_t>(i)]; },
+      [&](Tally& t, std::int64_t i) {
+        const double dot = N.row(i).dot(from_faces.row(i));
+        if (!std::isfinite(dot)) return;
+        ++t.compared;
+        t.against += dot < 0.0 ? 1 : 0;
+        const auto& info =
+            report.components[static_cast<std::size_t>(component[static_cast<std::size_t>(i)])];
+        if (!info.closed || !info.consistent || !std::isfinite(info.signed_volume)) return;
+        // The faces of an inward component point inside, so a normal with them points inside.
+        const bool inside = info.signed_volume < 0.0 ? dot > 0.0 : dot < 0.0;
+        t.inside += inside ? 1 : 0;
+        ++t.judged;
+      },
+      tally);
+  for (const Tally& t : tally) {
+    out.normals_compared_count += t.compared;
+    out.normals_against_faces_count += t.against;
+    out.inward_normal_component_count += 2 * t.inside > t.judged ? 1 : 0;
   }
 }
 

@@ -99,10 +99,10 @@ MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F, TopologyDetail
   const std::int64_t blocks = (vertex_count + kBlock - 1) / kBlock;
   std::vector<std::array<std::int64_t, 6>> sums(static_cast<std::size_t>(blocks));
   PerThread<Scratch> scratch;
-  parallel_for(blocks, 0, [&](std::int64_t b) {
+  parallel_blocks(vertex_count, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     Scratch& s = scratch.local();
     std::array<std::int64_t, 6> sum{};
-    for (auto v = b * kBlock; v < std::min(vertex_count, (b + 1) * kBlock); ++v) {
+    for (auto v = begin; v < end; ++v) {
       const VertexCounts c = vertex_counts(F, t.incidence, v, statistics, s);
       t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
       sum[0] += c.edges;
@@ -129,9 +129,9 @@ int degenerate_face_count(PositionsRef V, FacesRef F) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
   std::vector<int> count(static_cast<std::size_t>(blocks), 0);
-  parallel_for(blocks, 0, [&](std::int64_t b) {
+  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     int n = 0;
-    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+    for (auto f = begin; f < end; ++f) {
       n += has_repeated_index(F, f) ||
            is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
                                   V.row(F(f, 2)).transpose());

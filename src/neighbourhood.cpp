@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -58,7 +59,10 @@ Eigen::VectorXi offsets_from_counts(const std::vector<int>& counts, const char* 
 }  // namespace
 
 Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F) {
-  detail::check_face_indices(vertex_count, F, "vertex_adjacency");
+  // The parallel test first; the serial one only to name the first bad face.
+  if (vertex_count < 0 || !detail::face_indices_in_range(vertex_count, F)) {
+    detail::check_face_indices(vertex_count, F, "vertex_adjacency");
+  }
   const auto inc = detail::vertex_face_incidence(vertex_count, F);
   // Each incident face adds at most two neighbours, so vertex v owns the slot starting at
   // 2 * inc.begin(v) of a scratch buffer: one pass fills it, a second compacts it.
@@ -75,7 +79,7 @@ Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F) {
         if (F(f, c) != v) *last++ = F(f, c);
       }
     }
-    std::sort(first, last);
+    detail::sort_small(first, last, std::less<>());  // a dozen entries: insertion sort
     counts[static_cast<std::size_t>(v)] = static_cast<int>(std::unique(first, last) - first);
   });
   Neighbourhoods result;

@@ -139,26 +139,34 @@ int OrientationReport::inward_count() const {
 
 namespace {
 
-// Signed volumes per component, each about its vertex centroid: for a surface far from the origin
-// the determinants would otherwise be large terms that cancel.
-void add_signed_volumes(PositionsRef V, FacesRef F, const detail::FaceComponents& comp,
-                        std::vector<ComponentOrientation>& components) {
-  std::vector<Eigen::Vector3d> centroid(components.size(), Eigen::Vector3d::Zero());
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    const int c = comp.vertex_component[static_cast<std::size_t>(v)];
-    if (c >= 0) centroid[static_cast<std::size_t>(c)] += V.row(v).transpose();
+// Per-component tallies over the vertices: count, open / inconsistent edges at them, and the sum
+// of their positions (for the centroid).
+struct VertexTally {
+  int count = 0;
+  bool open = false;
+  bool inconsistent = false;
+  Vec3 sum{0.0, 0.0, 0.0};
+
+  VertexTally& operator+=(const VertexTally& o) {
+    count += o.count;
+    open = open || o.open;
+    inconsistent = inconsistent || o.inconsistent;
+    sum = {sum.x + o.sum.x, sum.y + o.sum.y, sum.z + o.sum.z};
+    return *this;
   }
-  for (std::size_t c = 0; c < components.size(); ++c) {
-    centroid[c] /= static_cast<double>(components[c].vertex_count);
+};
+
+// Per-component tallies over the faces: count and signed volume about the component's centroid.
+struct FaceTally {
+  int count = 0;
+  double volume = 0.0;
+
+  FaceTally& operator+=(const FaceTally& o) {
+    count += o.count;
+    volume += o.volume;
+    return *this;
   }
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const auto c = static_cast<std::size_t>(comp.face_component[static_cast<std::size_t>(f)]);
-    const Eigen::Vector3d a = V.row(F(f, 0)).transpose() - centroid[c];
-    const Eigen::Vector3d b = V.row(F(f, 1)).transpose() - centroid[c];
-    const Eigen::Vector3d d = V.row(F(f, 2)).transpose() - centroid[c];
-    components[c].signed_volume += a.dot(b.cross(d)) / 6.0;
-  }
-}
+};
 
 }  // namespace
 
@@ -170,26 +178,53 @@ OrientationReport orientation_report(PositionsRef V, FacesRef F) {
       V, F, detail::mesh_topology(V.rows(), F, detail::TopologyDetail::orientation));
 }
 
+// Signed volumes are taken per component about its vertex centroid: for a surface far from the
+// origin the determinants would otherwise be large terms that cancel. Both passes are parallel
+// (detail::add_by_key_runs: per-block runs added in block order, the same for any thread count).
 OrientationReport detail::orientation_report_from(PositionsRef V, FacesRef F,
                                                   const MeshTopology& t) {
   const FaceComponents& comp = t.components;
+  const auto count = static_cast<std::size_t>(comp.count);
+  std::vector<VertexTally> vertices(count);
+  add_by_key_runs(
+      static_cast<std::int64_t>(t.edge_flags.size()),
+      [&](std::int64_t v) { return comp.vertex_component[static_cast<std::size_t>(v)]; },
+      [&](VertexTally& tally, std::int64_t v) {
+        const std::uint8_t flags = t.edge_flags[static_cast<std::size_t>(v)];
+        ++tally.count;
+        tally.open = tally.open || (flags & kOpenEdge) != 0;
+        tally.inconsistent = tally.inconsistent || (flags & kInconsistentEdge) != 0;
+        tally.sum = {tally.sum.x + V(v, 0), tally.sum.y + V(v, 1), tally.sum.z + V(v, 2)};
+      },
+      vertices);
+  std::vector<Vec3> centroid(count);
+  for (std::size_t c = 0; c < count; ++c) {
+    const double n = static_cast<double>(vertices[c].count);
+    centroid[c] = {vertices[c].sum.x / n, vertices[c].sum.y / n, vertices[c].sum.z / n};
+  }
+  std::vector<FaceTally> faces(count);
+  add_by_key_runs(
+      F.rows(), [&](std::int64_t f) { return comp.face_component[static_cast<std::size_t>(f)]; },
+      [&](FaceTally& tally, std::int64_t f) {
+        const Vec3& o =
+            centroid[static_cast<std::size_t>(comp.face_component[static_cast<std::size_t>(f)])];
+        const Vec3 a = row(V, F(f, 0)) - o, b = row(V, F(f, 1)) - o, d = row(V, F(f, 2)) - o;
+        ++tally.count;
+        tally.volume += dot(a, cross(b, d)) / 6.0;
+      },
+      faces);
   OrientationReport report;
   report.face_component = Eigen::Map<const Eigen::VectorXi>(comp.face_component.data(), F.rows());
-  report.components.assign(static_cast<std::size_t>(comp.count), ComponentOrientation{});
-  for (auto& c : report.components) c.closed = c.consistent = true;
-  for (const int c : comp.face_component) {
-    ++report.components[static_cast<std::size_t>(c)].face_count;
+  report.components.resize(count);
+  for (std::size_t c = 0; c < count; ++c) {
+    ComponentOrientation& out = report.components[c];
+    out.face_count = faces[c].count;
+    out.vertex_count = vertices[c].count;
+    out.closed = !vertices[c].open;
+    out.consistent = !vertices[c].inconsistent;
+    out.signed_volume = faces[c].volume;
+    out.inward = out.closed && out.consistent && out.signed_volume < 0.0;
   }
-  for (std::size_t v = 0; v < t.edge_flags.size(); ++v) {
-    const int c = comp.vertex_component[v];
-    if (c < 0) continue;
-    auto& component = report.components[static_cast<std::size_t>(c)];
-    ++component.vertex_count;
-    if (t.edge_flags[v] & kOpenEdge) component.closed = false;
-    if (t.edge_flags[v] & kInconsistentEdge) component.consistent = false;
-  }
-  add_signed_volumes(V, F, comp, report.components);
-  for (auto& c : report.components) c.inward = c.closed && c.consistent && c.signed_volume < 0.0;
   return report;
 }
 

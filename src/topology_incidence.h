@@ -28,6 +28,40 @@
 
 namespace focal::detail {
 
+/// Calls body(b, begin, end) for the blocks [begin, end) = [b block, min(n, (b + 1) block)) of
+/// [0, n), in parallel on all threads (thread_count(0)). For loops that keep a result per block:
+/// parallel_for(blocks, ...) sees only the block count, and its serial cutoff (1024 iterations)
+/// had every such loop run on one thread for meshes below 4M vertices.
+template <class Body>
+void parallel_blocks(std::int64_t n, std::int64_t block, Body&& body) {
+  parallel_for_blocks(
+      n, block, 0, [&](std::int64_t begin, std::int64_t end) { body(begin / block, begin, end); });
+}
+
+/// Per-key totals over [0, n) in parallel: totals[key(i)] += item i (add(total, i)), for the
+/// i with key(i) >= 0. Each block of 16384 items adds up its runs of equal keys from a zero
+/// Total, and the runs are added to `totals` in block order: the same result for any thread
+/// count, exact for integers. For per-component sums, since a mesh's vertices and faces mostly
+/// come in runs by component; a per-thread array per key would cost #threads x #keys.
+template <class Total, class Key, class Add>
+void add_by_key_runs(std::int64_t n, Key&& key, Add&& add, std::vector<Total>& totals) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  std::vector<std::vector<std::pair<int, Total>>> runs(
+      static_cast<std::size_t>((n + kBlock - 1) / kBlock));
+  parallel_blocks(n, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+    auto& block_runs = runs[static_cast<std::size_t>(b)];
+    for (auto i = begin; i < end; ++i) {
+      const int k = key(i);
+      if (k < 0) continue;
+      if (block_runs.empty() || block_runs.back().first != k) block_runs.emplace_back(k, Total{});
+      add(block_runs.back().second, i);
+    }
+  });
+  for (const auto& block_runs : runs) {
+    for (const auto& [k, run] : block_runs) totals[static_cast<std::size_t>(k)] += run;
+  }
+}
+
 /// Largest number of entries a CSR array with 32-bit offsets (Eigen::VectorXi) can hold.
 inline constexpr std::int64_t kMaxCsrEntries = std::numeric_limits<int>::max();
 
@@ -222,12 +256,12 @@ inline bool is_consistent_interior_edge(const EdgeSide* first, const EdgeSide* l
   return last - first == 2 && first[0].direction != 0 && first[0].direction == -first[1].direction;
 }
 
-/// One scratch object per thread of detail::parallel_for(n, 0, ...): both size the team with
-/// thread_count(0), so omp_get_thread_num() indexes a slot of its own.
+/// One scratch object per thread of detail::parallel_for(n, threads, ...) (or _blocks): both size
+/// the team with thread_count(threads), so omp_get_thread_num() indexes a slot of its own.
 template <class T>
 class PerThread {
  public:
-  PerThread() : slots_(static_cast<std::size_t>(thread_count(0))) {}
+  explicit PerThread(int threads = 0) : slots_(static_cast<std::size_t>(thread_count(threads))) {}
   T& local() { return slots_[static_cast<std::size_t>(omp_get_thread_num())]; }
 
  private:
@@ -313,18 +347,18 @@ inline int label_components_by_first_face(FacesRef F, const std::vector<int>& ro
     return first[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] == f;
   };
   std::vector<int> block_start(static_cast<std::size_t>(blocks) + 1, 0);
-  parallel_for(blocks, 0, [&](std::int64_t b) {
+  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     int n = 0;
-    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) n += starts_set(f);
+    for (auto f = begin; f < end; ++f) n += starts_set(f);
     block_start[static_cast<std::size_t>(b) + 1] = n;
   });
   for (std::size_t b = 0; b < static_cast<std::size_t>(blocks); ++b) {
     block_start[b + 1] += block_start[b];
   }
   label.assign(root.size(), -1);
-  parallel_for(blocks, 0, [&](std::int64_t b) {
+  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     int next = block_start[static_cast<std::size_t>(b)];
-    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+    for (auto f = begin; f < end; ++f) {
       if (starts_set(f))
         label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] = next++;
     }
@@ -410,9 +444,9 @@ inline bool face_indices_in_range(std::int64_t vertex_count, FacesRef F) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
   std::vector<std::uint8_t> bad(static_cast<std::size_t>(blocks), 0);
-  parallel_for(blocks, 0, [&](std::int64_t b) {
+  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     bool any = false;
-    for (auto f = b * kBlock; f < std::min(F.rows(), (b + 1) * kBlock); ++f) {
+    for (auto f = begin; f < end; ++f) {
       for (int c = 0; c < 3; ++c) any |= F(f, c) < 0 || F(f, c) >= vertex_count;
     }
     bad[static_cast<std::size_t>(b)] = any;

@@ -6,10 +6,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include "focal/error.h"
+#include "focal/neighbourhood.h"
 #include "focal/normals.h"
 #include "focal/surfaces.h"
 
@@ -106,6 +108,44 @@ TEST(JetNormals, OrientedLikeTheFacesAndDeterministic) {
   const JetNormals three = jet_normals(s.mesh.V, s.mesh.F, o);
   EXPECT_TRUE(one.N == three.N);
   EXPECT_TRUE(one.residual == three.residual);
+  for (Eigen::Index i = 0; i < s.mesh.V.rows(); ++i)
+    ASSERT_GT(one.N.row(i).dot(s.mesh.N.row(i)), 0.99);
+}
+
+TEST(JetNormals, GivenStartNormalsGiveTheSameResultAndAreValidated) {
+  const AnalyticSurface s = irregular(SurfaceKind::ellipsoid, 3000);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(s.mesh.V.rows()), s.mesh.F);
+  const RowMatrixX3d max = vertex_normals(s.mesh.V, s.mesh.F, NormalWeighting::max);
+  for (const JetOptions& o : {jet(3), jet(2, 3), jet(4, 1)}) {
+    const JetNormals a = jet_normals(s.mesh.V, s.mesh.F, one, o);
+    const JetNormals b = jet_normals(s.mesh.V, s.mesh.F, one, max, o);
+    EXPECT_TRUE(a.N == b.N);
+    EXPECT_TRUE(a.residual.cwiseEqual(b.residual).count() + a.residual.array().isNaN().count() ==
+                a.residual.size());
+    EXPECT_TRUE(a.degree == b.degree);
+  }
+  // Exact normals as the start: a different frame, the same surface to rounding of the fit.
+  const JetNormals exact = jet_normals(s.mesh.V, s.mesh.F, one, s.mesh.N, jet(3));
+  EXPECT_LT(rms_angle(exact.N, jet_normals(s.mesh.V, s.mesh.F, one, jet(3)).N), 1e-3);
+  EXPECT_THROW((void)jet_normals(s.mesh.V, s.mesh.F, one, max.topRows(10), jet(3)), InvalidInput);
+  RowMatrixX3d scaled = max;
+  scaled.row(7) *= 2.0;
+  EXPECT_THROW((void)jet_normals(s.mesh.V, s.mesh.F, one, scaled, jet(3)), InvalidInput);
+  scaled.row(7).setConstant(std::numeric_limits<double>::quiet_NaN());  // allowed: no jet there
+  const JetNormals nan_start = jet_normals(s.mesh.V, s.mesh.F, one, scaled, jet(3));
+  EXPECT_EQ(nan_start.degree[7], 0);
+  EXPECT_TRUE(std::isnan(nan_start.N(7, 0)));
+}
+
+TEST(JetNormals, WiderRingsAreDeterministicToo) {
+  const AnalyticSurface s = irregular(SurfaceKind::torus, 3000);
+  JetOptions o = jet(2, 4);
+  o.threads = 1;
+  const JetNormals one = jet_normals(s.mesh.V, s.mesh.F, o);
+  o.threads = 3;
+  const JetNormals three = jet_normals(s.mesh.V, s.mesh.F, o);
+  EXPECT_TRUE(one.N == three.N);
+  EXPECT_TRUE(one.degree == three.degree);
   for (Eigen::Index i = 0; i < s.mesh.V.rows(); ++i)
     ASSERT_GT(one.N.row(i).dot(s.mesh.N.row(i)), 0.99);
 }

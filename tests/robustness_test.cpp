@@ -448,6 +448,7 @@ TEST(Robustness, BadNormalRowsAreCountedByKind) {
   EXPECT_EQ(f.non_finite_normal_count, 2);
   EXPECT_EQ(f.non_unit_normal_count, 1);
   EXPECT_EQ(f.normals_against_faces_count, 1);
+  EXPECT_EQ(f.normals_compared_count, m.V.rows() - 2);  // all but the non-finite rows
   EXPECT_EQ(f.inward_normal_component_count, 0);
   EXPECT_EQ(f.summary(),
             "2 non-finite normals, 1 zero normal, 1 non-unit normal, 1 normal against its faces");
@@ -580,6 +581,17 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     non_manifold += count >= 3 ? 1 : 0;
   }
   const std::vector<int> components = reference_face_components(m);
+  // Reference normal counts against the faces' area-weighted normals (the second grid's faces
+  // are flipped, so its normals point against them).
+  const RowMatrixX3d area = vertex_normals(m.V, m.F, NormalWeighting::area);
+  int against = 0, compared = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    const double dot = m.N.row(i).dot(area.row(i));
+    if (!std::isfinite(dot)) continue;
+    ++compared;
+    against += dot < 0.0 ? 1 : 0;
+  }
+  ASSERT_GT(against, 10000);
 
   for (const int threads : {1, 2, 3}) {
     const test::ScopedThreads scoped(threads);
@@ -604,6 +616,31 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     EXPECT_EQ(findings.unreferenced_vertex_count, 1);
     EXPECT_EQ(findings.inconsistent_component_count, 1);  // the third grid's flipped face
     EXPECT_EQ(findings.non_manifold_vertex_count, 1);
+    EXPECT_EQ(findings.normals_against_faces_count, against);
+    EXPECT_EQ(findings.normals_compared_count, compared);
+  }
+}
+
+TEST(Robustness, InwardNormalComponentsAreCountedAlikeForAnyThreadCount) {
+  // Closed components larger than a block of check_mesh's parallel tally (16384 vertices), one
+  // after another, so that some blocks hold runs of two components.
+  SurfaceOptions o;
+  o.kind = SurfaceKind::torus;
+  o.triangulation = Triangulation::regular;
+  o.target_vertices = 30000;
+  const Mesh torus = make_surface(o).mesh;
+  Mesh m =
+      join(join(torus, torus, Eigen::RowVector3d(10, 0, 0)), torus, Eigen::RowVector3d(0, 10, 0));
+  const Eigen::Index n = torus.V.rows();
+  m.N.middleRows(n, n) *= -1.0;  // the second torus: most normals inward
+  m.N.topRows(n / 3) *= -1.0;    // a third of the first: a minority, still outward
+  for (const int threads : {1, 2, 3}) {
+    const test::ScopedThreads scoped(threads);
+    const MeshFindings f = check_mesh(m.V, m.F, m.N);
+    EXPECT_EQ(f.component_count, 3);
+    EXPECT_EQ(f.inward_normal_component_count, 1) << threads << " threads";
+    EXPECT_EQ(f.normals_against_faces_count, n + n / 3) << threads << " threads";
+    EXPECT_EQ(f.normals_compared_count, 3 * n) << threads << " threads";
   }
 }
 

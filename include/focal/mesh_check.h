@@ -36,6 +36,8 @@ struct MeshFindings {
   int non_unit_normal_count = 0;        ///< finite, non-zero rows whose length is not 1 within 1e-6
   int normals_against_faces_count = 0;  ///< vertices whose normal points against the
                                         ///< area-weighted normal of their faces (negative dot)
+  int normals_compared_count = 0;       ///< vertices where both that normal and their faces' exist:
+                                        ///< the base of normals_against_faces_count (not a problem)
   int inward_normal_component_count = 0;  ///< closed consistent components where most normals
                                           ///< point inside (against the outward face normals)
   // For information only.

@@ -15,11 +15,12 @@
 /// Per vertex P, with frame (x, y, n) (normal_rays.h) whose n is the previous estimate (first
 /// the Max-weighted normal): the k-ring and P itself, as offsets q = Q - P scaled by the
 /// neighbourhood radius, give heights z = q.n over (q.x, q.y); the full polynomial of degree d
-/// (constant term included, so P's own position is smoothed like the others) is fitted by
-/// pivoted QR. The normal is that of the graph at (0, 0): (-z_x, -z_y, 1) normalised in the
-/// frame. Each further iteration refits in the frame of the new normal. Where the k-ring has too
-/// few points for degree d (a valid fit needs full column rank), lower degrees are tried down to
-/// 1 (a plane); a vertex with no valid fit or no Max normal (in no face) gets NaN.
+/// (constant term included, so P's own position is smoothed like the others) is fitted by least
+/// squares (normal equations from the points' moments, LDL^T with diagonal pivoting). The normal is
+/// that of the graph at (0, 0): (-z_x, -z_y, 1) normalised in the frame. Each further iteration
+/// refits in the frame of the new normal. Where the k-ring has too few points for degree d (a valid
+/// fit needs full column rank), lower degrees are tried down to 1 (a plane); a vertex with no valid
+/// fit or no Max normal (in no face) gets NaN.
 ///
 /// Results are gathered per vertex in fixed order: identical for any thread count.
 
@@ -55,6 +56,15 @@ struct JetNormals {
 /// rebuild. \throw also InvalidInput when one_ring does not have #V vertices.
 [[nodiscard]] JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring,
                                      const JetOptions& options = {});
+
+/// The same with the starting normals at hand too: `start` (#V x 3) gives the frame of each
+/// vertex's first fit, vertex_normals(V, F, NormalWeighting::max) in the overloads above (pass
+/// those to get the same result without computing them twice, e.g. when the caller needs Max's
+/// normals itself). Non-finite rows give NaN (no jet).
+/// \throw also InvalidInput when start does not have #V rows or a finite row is not of unit
+/// length within 1e-6.
+[[nodiscard]] JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring,
+                                     NormalsRef start, const JetOptions& options = {});
 
 /// Curvature from the jets (a positions-only reference in the spirit of CGAL's jet fitting):
 /// the shape operator of the fitted graph at (0, 0) of the last fit, with focal's conventions

@@ -464,6 +464,38 @@ run curvature one.off -o one.csv --strict
 check "single triangle: exit 0 with --strict, no warning, 3 flat rows" \
   bash -c '[[ $1 -eq 0 && ! -s $2 && $3 == "flat=3 " ]]' _ "$rc" "$ERR" "$(classes one.csv)"
 
+# What the normals stage takes from the check stage (cli/estimator_flags.cpp reuses its findings
+# instead of recomputing the orientation and the face normals): each warning still appears.
+# The icosahedron with every face reversed: one closed inward component, turned outward, so the
+# output equals that of the outward icosahedron (default and --paper).
+ico off | awk 'NF == 4 && $1 == 3 { print 3, $2, $4, $3; next } { print }' >inward.off
+for estimator in default --paper; do
+  flag=${estimator/default/}
+  run curvature ico.off -o ico-out.csv ${flag:+"$flag"}
+  run curvature inward.off -o inward.csv ${flag:+"$flag"}
+  check "inward icosahedron ($estimator): warns that it reversed the faces, output as outward" \
+    bash -c 'grep -q "^Warning: 1 closed component(s) are oriented inward; their faces were reversed" "$1" &&
+             cmp -s "$2" ico-out.csv' _ "$ERR" inward.csv
+done
+# The sphere with its normals negated: counted against the faces, and the estimator warns.
+awk 'NR == 2 { nv = $1 } NR > 2 && nv > 0 { print $1, $2, $3, -$4, -$5, -$6; nv--; next } { print }' \
+  so.off >against.off 2>/dev/null || true
+for estimator in default --paper; do
+  flag=${estimator/default/}
+  run curvature against.off -o against.csv ${flag:+"$flag"}
+  check "normals against the faces ($estimator): counted, and the sign warning" \
+    bash -c '[[ $1 -eq 0 ]] && grep -q "normals against their faces" "$2" &&
+             grep -q "^Warning: most file normals point against the face orientation" "$2"' _ "$rc" "$ERR"
+done
+# A missing (NaN) normal row is filled from the faces; outward normals raise no sign warning.
+awk 'NR == 3 { print $1, $2, $3, "nan nan nan"; next } { print }' so.off >missing.off 2>/dev/null || true
+run curvature missing.off -o missing.csv --paper
+check "a NaN file normal: filled from the faces, no sign warning" \
+  bash -c '[[ $1 -eq 0 ]] && grep -q "1 vertices have no usable normal in the file" "$2" &&
+           ! grep -q "point against" "$2"' _ "$rc" "$ERR"
+check_within "a NaN file normal: k1, k2 = 1 within 1e-6 (Max normals are exact on the sphere)" \
+  "$(max_dev missing.csv "1 2" 1)" 1e-6
+
 # Unwritable output: a folder in the way; nothing is left behind.
 mkdir -p taken.csv
 expect_error "output path is a folder: exit 2" 2 "taken.csv" taken.csv/x curvature s.ply -o taken.csv
