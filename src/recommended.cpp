@@ -16,14 +16,25 @@
 namespace focal {
 namespace {
 
-/// Everything the steps share: the mesh, its 1-ring (built once) and its edge length.
+/// Everything the steps share: the mesh, its 1-ring (built once), its edge length and Max's
+/// normals (the jets' starting frames, and a candidate field of their own).
 struct Context {
   PositionsRef V;
   FacesRef F;
   Neighbourhoods one_ring;
   double edge_length;
   int threads;
+  RowMatrixX3d max;
 };
+
+Context make_context(PositionsRef V, FacesRef F, int threads) {
+  return {V,
+          F,
+          vertex_adjacency(static_cast<int>(V.rows()), F),
+          mean_edge_length(V, F),
+          threads,
+          vertex_normals(V, F, NormalWeighting::max)};
+}
 
 /// The paper's per-vertex closed-form two-slit fit of `normals` over `rings` rings, on the
 /// 1-ring built once (estimate_curvature would rebuild it per call).
@@ -73,7 +84,7 @@ JetNormals local_jets(const Context& c, int rings, int degree) {
   o.degree = degree;
   o.iterations = 1;
   o.threads = c.threads;
-  return jet_normals(c.V, c.F, c.one_ring, o);
+  return jet_normals(c.V, c.F, c.one_ring, c.max, o);
 }
 
 /// Per vertex, the primary normal unless the secondary field is clearly smoother there: its
@@ -194,6 +205,40 @@ void prefer_triangles(PositionsRef V, FacesRef F, NormalsRef N, int threads, Cur
   });
 }
 
+/// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
+/// normals are used, and the normals to fit, into `out`. N has 0 rows without file normals.
+void choose_normals(const Context& c, NormalsRef N, RecommendedResult& out) {
+  const bool has_normals = N.rows() > 0;
+  const JetNormals jets = local_jets(c, 2, 3);
+  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length);
+  // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
+  // normals from the positions take the side of the faces until turned.
+  const double side = has_normals ? majority_side(N, jets.N) : 1.0;
+  const Eigen::VectorXd disagreement =
+      has_normals ? angles_between(N, jets.N, side, c.threads) : Eigen::VectorXd();
+  out.file_disagreement = has_normals ? finite_median(disagreement) : NAN;
+  out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise);
+  Eigen::VectorXd roughness;
+  if (!out.file_normals_used && out.plan.rings > 1) {
+    // Noisy positions: normals from wider, lower-degree jets that average the noise.
+    out.N = local_jets(c, out.plan.jet_rings, out.plan.jet_degree).N;
+  } else {
+    // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
+    // first-order (rough) on irregular meshes.
+    const CurvatureResult with_max = two_slit_fit(c, c.max, 1, false);
+    const CurvatureResult with_jets = two_slit_fit(c, jets.N, 1, false);
+    out.N = select_normals(jets.N, roughness_of(with_jets), c.max, roughness_of(with_max),
+                           c.threads, roughness, [](std::int64_t) { return true; });
+  }
+  if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
+  if (out.file_normals_used) {
+    // The file's normals, except outliers where the positions' choice is clearly smoother.
+    const CurvatureResult with_file = two_slit_fit(c, N, 1, false);
+    out.N = replace_outliers(N, roughness_of(with_file), disagreement, out.N, roughness,
+                             kOutlierDisagreement * out.plan.noise, c.threads);
+  }
+}
+
 }  // namespace
 
 RecommendedPlan recommended_plan_for_noise(double noise) {
@@ -210,8 +255,7 @@ RecommendedPlan recommended_plan_for_noise(double noise) {
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, int threads) {
   validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "recommended_plan");
   if (threads < 0) throw InvalidInput("recommended_plan: threads must be >= 0");
-  const Context c{V, F, vertex_adjacency(static_cast<int>(V.rows()), F), mean_edge_length(V, F),
-                  threads};
+  const Context c = make_context(V, F, threads);
   const JetNormals jets = local_jets(c, 2, 3);
   return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length);
 }
@@ -224,40 +268,16 @@ RecommendedResult estimate_curvature_recommended_full(PositionsRef V, FacesRef F
                        " normals for " + std::to_string(V.rows()) + " vertices");
   validate_mesh_arrays(V, F, N, "estimate_curvature_recommended");
   if (threads < 0) throw InvalidInput("estimate_curvature_recommended: threads must be >= 0");
-  const Context c{V, F, vertex_adjacency(static_cast<int>(V.rows()), F), mean_edge_length(V, F),
-                  threads};
-  const JetNormals jets = local_jets(c, 2, 3);
+  Context c = make_context(V, F, threads);
   RecommendedResult out;
-  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length);
-  // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
-  // normals from the positions take the side of the faces until turned.
-  const double side = has_normals ? majority_side(N, jets.N) : 1.0;
-  const Eigen::VectorXd disagreement =
-      has_normals ? angles_between(N, jets.N, side, threads) : Eigen::VectorXd();
-  out.file_disagreement = has_normals ? finite_median(disagreement) : NAN;
-  out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise);
-  Eigen::VectorXd roughness;
-  if (!out.file_normals_used && out.plan.rings > 1) {
-    // Noisy positions: normals from wider, lower-degree jets that average the noise.
-    out.N = local_jets(c, out.plan.jet_rings, out.plan.jet_degree).N;
-  } else {
-    // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
-    // first-order (rough) on irregular meshes.
-    const RowMatrixX3d max = vertex_normals(V, F, NormalWeighting::max);
-    const CurvatureResult with_max = two_slit_fit(c, max, 1, false);
-    const CurvatureResult with_jets = two_slit_fit(c, jets.N, 1, false);
-    out.N = select_normals(jets.N, roughness_of(with_jets), max, roughness_of(with_max), threads,
-                           roughness, [](std::int64_t) { return true; });
-  }
-  if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
-  if (out.file_normals_used) {
-    // The file's normals, except outliers where the positions' choice is clearly smoother.
-    const CurvatureResult with_file = two_slit_fit(c, N, 1, false);
-    out.N = replace_outliers(N, roughness_of(with_file), disagreement, out.N, roughness,
-                             kOutlierDisagreement * out.plan.noise, threads);
-  }
+  choose_normals(c, N, out);
   out.curvature = two_slit_fit(c, out.N, out.plan.rings, out.plan.gaussian);
-  if (out.plan.rings == 1) prefer_triangles(V, F, out.N, threads, out.curvature);
+  if (out.plan.rings == 1) {
+    // Memory the per-triangle pass can use (the peak of a run is in it).
+    c.one_ring = Neighbourhoods{};
+    c.max.resize(0, 3);
+    prefer_triangles(V, F, out.N, threads, out.curvature);
+  }
   return out;
 }
 
