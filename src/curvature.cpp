@@ -351,14 +351,7 @@ void fit_block_baseline(const FitContext& c, std::int64_t begin, std::int64_t en
 using FitBlock = void (*)(const FitContext&, std::int64_t, std::int64_t, CurvatureResult&);
 
 FitBlock fit_block_for(detail::SimdIsa isa) {
-  switch (detail::simd_isa(isa)) {
-    case detail::SimdIsa::avx512:
-      return fit_block_avx512;
-    case detail::SimdIsa::avx2:
-      return fit_block_avx2;
-    default:
-      return fit_block_baseline;
-  }
+  return detail::kernel_for(isa, fit_block_avx512, fit_block_avx2, fit_block_baseline);
 }
 
 CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRef N,

@@ -62,6 +62,19 @@ inline SimdIsa simd_isa(SimdIsa requested = SimdIsa::best) {
   return SimdIsa::baseline;
 }
 
+/// The build of a kernel for `requested` (see simd_isa) among its three builds.
+template <class Kernel>
+Kernel kernel_for(SimdIsa requested, Kernel avx512, Kernel avx2, Kernel baseline) {
+  switch (simd_isa(requested)) {
+    case SimdIsa::avx512:
+      return avx512;
+    case SimdIsa::avx2:
+      return avx2;
+    default:
+      return baseline;
+  }
+}
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define FOCAL_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx512bw")))
 #define FOCAL_TARGET_AVX2 __attribute__((target("avx2")))

@@ -287,14 +287,8 @@ void solve_face_block_baseline(const FaceInput& in, std::int64_t begin, std::int
 using FaceBlock = void (*)(const FaceInput&, std::int64_t, std::int64_t, TriangleCurvatureResult&);
 
 FaceBlock solve_face_block_for(detail::SimdIsa isa) {
-  switch (detail::simd_isa(isa)) {
-    case detail::SimdIsa::avx512:
-      return solve_face_block_avx512;
-    case detail::SimdIsa::avx2:
-      return solve_face_block_avx2;
-    default:
-      return solve_face_block_baseline;
-  }
+  return detail::kernel_for(isa, solve_face_block_avx512, solve_face_block_avx2,
+                            solve_face_block_baseline);
 }
 
 /// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
