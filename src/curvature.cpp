@@ -306,7 +306,7 @@ template <class L>
                            ? sums.weight
                            : __builtin_convertvector(used, L);
   const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
-  const auto or_nan = [&](L x) { return valid ? x : nan; };
+  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
   GroupResult<L> x;
   x.k1 = or_nan(p.k1), x.k2 = or_nan(p.k2);
   x.H = or_nan(0.5 * (p.k1 + p.k2)), x.K = or_nan(p.k1 * p.k2);

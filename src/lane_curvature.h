@@ -52,7 +52,8 @@ FOCAL_LANE_INLINE PrincipalLanes<L> principal_lanes(L a, L b, L c) {
 /// classify() per lane, as codes.
 template <class L>
 FOCAL_LANE_INLINE MaskOf<L> classify_lanes(L k1, L k2, const ClassTolerances& tol) {
-  const auto code = [](PointClass p) { return MaskOf<L>{} + static_cast<std::int64_t>(p); };
+  const auto code = [](PointClass p)
+                        FOCAL_LANE_LAMBDA { return MaskOf<L>{} + static_cast<std::int64_t>(p); };
   const L a1 = lane_abs(k1), a2 = lane_abs(k2);
   const auto zero1 = a1 <= tol.zero, zero2 = a2 <= tol.zero;
   auto c = (k1 * k2 > 0.0) ? code(PointClass::elliptic) : code(PointClass::hyperbolic);

@@ -84,6 +84,10 @@ Kernel kernel_for(SimdIsa requested, Kernel avx512, Kernel avx2, Kernel baseline
 #endif
 
 #define FOCAL_LANE_INLINE [[gnu::always_inline]] inline
+// Lambdas that take or return vectors: a lambda does not inherit its enclosing function's
+// `target`, so one left out of line (as in unoptimised or sanitizer builds) would be compiled for
+// baseline x86-64 and pass 32- and 64-byte vectors with another ABI than its AVX caller expects.
+#define FOCAL_LANE_LAMBDA __attribute__((always_inline))
 
 template <class L>
 FOCAL_LANE_INLINE L broadcast(double x) {

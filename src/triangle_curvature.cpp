@@ -141,7 +141,7 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
     const std::int64_t f = first + std::min(l, active - 1);
     for (int c = 0; c < 3; ++c) corner[c][l] = in.F(f, c);
   }
-  const auto column = [&](const auto& matrix, int c, int col) {
+  const auto column = [&](const auto& matrix, int c, int col) FOCAL_LANE_LAMBDA {
     return lanes_of<L>([&](int l) { return matrix(corner[c][l], col); });
   };
   L px[3], py[3], pz[3], mx[3], my[3], mz[3];
@@ -208,7 +208,7 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
   const L root = lane_sqrt(detail::lane_max(H * H - K, zero));
   const L k1 = H + root, k2 = H - root;
   const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
-  const auto or_nan = [&](L x) { return valid ? x : nan; };
+  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
   const TriangleFields& want = in.want;
   if (want.coefficients) {
     store_scalars(r.A, first, active, or_nan(A)), store_scalars(r.B, first, active, or_nan(B));
@@ -237,7 +237,7 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
       const detail::PrincipalLanes<L> p =
           detail::principal_lanes(M.m00, 0.5 * (M.m01 + M.m10), M.m11);
       // frame.from_plane of d1 and of d2 = d1 turned by +90 degrees.
-      const auto to_3d = [&](L a, L b, RowMatrixX3d& m) {
+      const auto to_3d = [&](L a, L b, RowMatrixX3d& m) FOCAL_LANE_LAMBDA {
         store_rows(m, first, active, or_nan(a * xx + b * yx), or_nan(a * xy + b * yy),
                    or_nan(a * xz + b * yz));
       };
