@@ -5,8 +5,8 @@
 #include <map>
 #include <string>
 
-#include "focal/mesh_io.h"
-#include "focal/surfaces.h"
+#include "focal/io/mesh_io.h"
+#include "focal/surfaces/surfaces.h"
 
 namespace focal::bench {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "focal/mesh.h"
+#include "focal/core/mesh.h"
 
 namespace focal::bench {
 

@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <exception>
 
-#include "focal/mesh_io.h"
-#include "focal/neighbourhood.h"
+#include "focal/io/mesh_io.h"
+#include "focal/mesh/neighbourhood.h"
 
 namespace {
 

@@ -5,10 +5,10 @@
 
 #include "commands.h"
 #include "estimator_flags.h"
-#include "focal/error.h"
-#include "focal/fields_io.h"
-#include "focal/focal_mesh.h"
-#include "focal/mesh_io.h"
+#include "focal/core/error.h"
+#include "focal/io/fields_io.h"
+#include "focal/curvature/focal_mesh.h"
+#include "focal/io/mesh_io.h"
 #include "input_check.h"
 #include "paths.h"
 

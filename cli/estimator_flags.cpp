@@ -7,10 +7,10 @@
 #include <map>
 #include <sstream>
 
-#include "focal/error.h"
-#include "focal/mesh_io.h"
-#include "focal/normals.h"
-#include "focal/recommended.h"
+#include "focal/core/error.h"
+#include "focal/io/mesh_io.h"
+#include "focal/mesh/normals.h"
+#include "focal/curvature/recommended.h"
 #include "input_check.h"
 
 namespace focal::cli {

@@ -5,9 +5,9 @@
 #include <CLI/CLI.hpp>
 #include <vector>
 
-#include "focal/curvature.h"
-#include "focal/mesh.h"
-#include "focal/mesh_check.h"
+#include "focal/curvature/curvature.h"
+#include "focal/core/mesh.h"
+#include "focal/mesh/check.h"
 #include "log.h"
 
 namespace focal::cli {

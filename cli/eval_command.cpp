@@ -10,12 +10,12 @@
 #include <sstream>
 
 #include "commands.h"
-#include "focal/baselines.h"
-#include "focal/error.h"
-#include "focal/evaluation.h"
-#include "focal/mesh_io.h"
-#include "focal/normals.h"
-#include "focal/recommended.h"
+#include "focal/curvature/baselines.h"
+#include "focal/core/error.h"
+#include "focal/evaluation/evaluation.h"
+#include "focal/io/mesh_io.h"
+#include "focal/mesh/normals.h"
+#include "focal/curvature/recommended.h"
 #include "paths.h"
 
 namespace focal::cli {

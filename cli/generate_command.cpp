@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "focal/mesh_io.h"
-#include "focal/surfaces.h"
+#include "focal/io/mesh_io.h"
+#include "focal/surfaces/surfaces.h"
 #include "paths.h"
 
 namespace focal::cli {

@@ -2,9 +2,9 @@
 #include <memory>
 
 #include "commands.h"
-#include "focal/mesh_io.h"
-#include "focal/neighbourhood.h"
-#include "focal/normals.h"
+#include "focal/io/mesh_io.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/normals.h"
 
 namespace focal::cli {
 namespace {

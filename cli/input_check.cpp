@@ -1,7 +1,7 @@
 #include "input_check.h"
 
-#include "focal/error.h"
-#include "focal/mesh_check.h"
+#include "focal/core/error.h"
+#include "focal/mesh/check.h"
 
 namespace focal::cli {
 

@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "focal/mesh.h"
-#include "focal/mesh_check.h"
+#include "focal/core/mesh.h"
+#include "focal/mesh/check.h"
 #include "log.h"
 
 namespace focal::cli {

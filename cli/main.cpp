@@ -6,7 +6,7 @@
 #include <exception>
 
 #include "commands.h"
-#include "focal/error.h"
+#include "focal/core/error.h"
 #include "log.h"
 
 namespace {

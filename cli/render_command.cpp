@@ -10,9 +10,9 @@
 
 #include "commands.h"
 #include "estimator_flags.h"
-#include "focal/focal_mesh.h"
-#include "focal/mesh_io.h"
-#include "focal/render.h"
+#include "focal/curvature/focal_mesh.h"
+#include "focal/io/mesh_io.h"
+#include "focal/render/render.h"
 #include "input_check.h"
 #include "paths.h"
 

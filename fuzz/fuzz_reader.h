@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "focal/error.h"
-#include "io_detail.h"
+#include "focal/core/error.h"
+#include "io/detail.h"
 
 namespace focal::fuzz {
 

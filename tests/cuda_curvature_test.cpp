@@ -30,10 +30,10 @@
 #include <vector>
 
 #include "cuda/vertex_fit.h"
-#include "focal/cuda_curvature.h"
-#include "focal/device.h"
-#include "focal/error.h"
-#include "focal/surfaces.h"
+#include "focal/cuda/curvature.h"
+#include "focal/cuda/device.h"
+#include "focal/core/error.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

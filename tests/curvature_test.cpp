@@ -1,4 +1,4 @@
-#include "focal/curvature.h"
+#include "focal/curvature/curvature.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <iomanip>
 #include <sstream>
 
-#include "focal/error.h"
-#include "focal/normals.h"
-#include "focal/surfaces.h"
+#include "focal/core/error.h"
+#include "focal/mesh/normals.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

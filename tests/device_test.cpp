@@ -1,8 +1,8 @@
-#include "focal/device.h"
+#include "focal/cuda/device.h"
 
 #include <gtest/gtest.h>
 
-#include "focal/error.h"
+#include "focal/core/error.h"
 
 namespace focal {
 namespace {

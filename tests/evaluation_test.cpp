@@ -1,4 +1,4 @@
-#include "focal/evaluation.h"
+#include "focal/evaluation/evaluation.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "focal/error.h"
-#include "focal/mesh_io.h"
+#include "focal/core/error.h"
+#include "focal/io/mesh_io.h"
 
 namespace focal {
 namespace {

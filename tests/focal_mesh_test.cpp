@@ -1,4 +1,4 @@
-#include "focal/focal_mesh.h"
+#include "focal/curvature/focal_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <cmath>
 #include <vector>
 
-#include "focal/error.h"
-#include "focal/surfaces.h"
+#include "focal/core/error.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

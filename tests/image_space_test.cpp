@@ -3,7 +3,7 @@
 //
 // The accuracy table of docs/IMAGE_SPACE.md is printed (not asserted: the tests below assert) by
 //   build/release/tests/image_space_test --gtest_also_run_disabled_tests --gtest_filter='*Table'
-#include "focal/image_space.h"
+#include "focal/image_space/image_space.h"
 
 #include <gtest/gtest.h>
 
@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "../src/image_space/triangle_fields.h"
-#include "../src/image_space/triplet_kernel.h"
-#include "focal/cuda_curvature.h"
-#include "focal/device.h"
-#include "focal/error.h"
-#include "focal/normal_rays.h"
-#include "focal/triangle_curvature.h"
+#include "cuda/triangle_fit.h"
+#include "kernels/triplet.h"
+#include "focal/cuda/curvature.h"
+#include "focal/cuda/device.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/curvature/triangle_curvature.h"
 #include "test_meshes.h"
 
 namespace focal {

@@ -1,4 +1,4 @@
-#include "focal/mesh_io.h"
+#include "focal/io/mesh_io.h"
 
 #include <gtest/gtest.h>
 
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "focal/error.h"
-#include "focal/fields_io.h"
+#include "focal/core/error.h"
+#include "focal/io/fields_io.h"
 #include "test_meshes.h"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-#include "focal/mesh.h"
+#include "focal/core/mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <limits>
 #include <string>
 
-#include "focal/error.h"
+#include "focal/core/error.h"
 
 namespace focal {
 namespace {

@@ -1,4 +1,4 @@
-#include "focal/neighbourhood.h"
+#include "focal/mesh/neighbourhood.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "focal/error.h"
+#include "focal/core/error.h"
 #include "test_meshes.h"
 
 namespace focal {

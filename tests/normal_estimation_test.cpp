@@ -1,6 +1,6 @@
 // Jet normals and jet curvature (normal_estimation.h): exactness where the polynomial model is
 // exact, measured convergence orders on irregular meshes, noise estimate, determinism, errors.
-#include "focal/normal_estimation.h"
+#include "focal/normals/jets.h"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <random>
 #include <vector>
 
-#include "focal/error.h"
-#include "focal/neighbourhood.h"
-#include "focal/normals.h"
-#include "focal/surfaces.h"
+#include "focal/core/error.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/normals.h"
+#include "focal/surfaces/surfaces.h"
 
 namespace focal {
 namespace {

@@ -1,4 +1,4 @@
-#include "focal/normal_rays.h"
+#include "focal/curvature/normal_rays.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "focal/normals.h"
+#include "focal/mesh/normals.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "focal/error.h"
+#include "focal/core/error.h"
 #include "test_meshes.h"
 
 namespace focal {

@@ -2,7 +2,7 @@
 // irregular and noisy cases of the evaluation suite, exactness on spheres, the noise plan,
 // determinism, boundaries and undefined vertices. DISABLED_SuiteTable prints the table of
 // docs/ESTIMATOR.md ("The recommended estimator").
-#include "focal/recommended.h"
+#include "focal/curvature/recommended.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <limits>
 
-#include "focal/baselines.h"
-#include "focal/error.h"
-#include "focal/evaluation.h"
-#include "focal/normals.h"
-#include "focal/surfaces.h"
+#include "focal/curvature/baselines.h"
+#include "focal/core/error.h"
+#include "focal/evaluation/evaluation.h"
+#include "focal/mesh/normals.h"
+#include "focal/surfaces/surfaces.h"
 
 namespace focal {
 namespace {

@@ -1,7 +1,7 @@
 // Tests of focal::render: cameras, G-buffers of a sphere against exact geometry, pictures whose
 // colours are known (constant and split fields, classes, NaN), the colour bar, and PNG files.
 // OpenGL runs headless through EGL (Mesa's llvmpipe without a GPU, as in CI).
-#include "focal/render.h"
+#include "focal/render/render.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <numbers>
 #include <random>
 
-#include "focal/image_space.h"
-#include "focal/surfaces.h"
+#include "focal/image_space/image_space.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace fs = std::filesystem;

@@ -20,12 +20,12 @@
 #include <set>
 #include <vector>
 
-#include "focal/curvature.h"
-#include "focal/error.h"
-#include "focal/mesh_check.h"
-#include "focal/neighbourhood.h"
-#include "focal/normals.h"
-#include "focal/surfaces.h"
+#include "focal/curvature/curvature.h"
+#include "focal/core/error.h"
+#include "focal/mesh/check.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/normals.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

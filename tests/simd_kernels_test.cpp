@@ -9,13 +9,13 @@
 #include <span>
 #include <vector>
 
-#include "curvature_detail.h"
-#include "focal/neighbourhood.h"
-#include "focal/normal_rays.h"
-#include "focal/surfaces.h"
-#include "focal/triangle_curvature.h"
-#include "focal/two_slit_fit.h"
-#include "simd_lanes.h"
+#include "curvature/detail.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/surfaces/surfaces.h"
+#include "focal/curvature/triangle_curvature.h"
+#include "focal/curvature/two_slit_fit.h"
+#include "core/simd_lanes.h"
 #include "test_meshes.h"
 
 namespace focal {

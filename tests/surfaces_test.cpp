@@ -1,4 +1,4 @@
-#include "focal/surfaces.h"
+#include "focal/surfaces/surfaces.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "../src/planar_delaunay.h"
-#include "focal/error.h"
+#include "surfaces/planar_delaunay.h"
+#include "focal/core/error.h"
 
 namespace focal {
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "focal/mesh.h"
-#include "focal/neighbourhood.h"
-#include "focal/surfaces.h"
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/surfaces/surfaces.h"
 
 namespace focal::test {
 

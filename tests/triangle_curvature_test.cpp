@@ -1,4 +1,4 @@
-#include "focal/triangle_curvature.h"
+#include "focal/curvature/triangle_curvature.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "focal/error.h"
-#include "focal/surfaces.h"
+#include "focal/core/error.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

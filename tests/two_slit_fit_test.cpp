@@ -1,4 +1,4 @@
-#include "focal/two_slit_fit.h"
+#include "focal/curvature/two_slit_fit.h"
 
 #include <gtest/gtest.h>
 

@@ -20,12 +20,12 @@
 #include <vector>
 
 #include "cuda/vertex_fit.h"
-#include "focal/cuda_curvature.h"
-#include "focal/device.h"
-#include "focal/error.h"
-#include "focal/image_space.h"
-#include "focal/surfaces.h"
-#include "focal/triangle_curvature.h"
+#include "focal/cuda/curvature.h"
+#include "focal/cuda/device.h"
+#include "focal/core/error.h"
+#include "focal/image_space/image_space.h"
+#include "focal/surfaces/surfaces.h"
+#include "focal/curvature/triangle_curvature.h"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "focal/error.h"
+#include "focal/core/error.h"
 
 namespace focal::cuda {
 

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "focal/device.h"
-#include "focal/error.h"
+#include "focal/cuda/device.h"
+#include "focal/core/error.h"
 
 namespace focal {
 namespace {

@@ -7,9 +7,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "cuda_check.h"
-#include "image_space/device_launch.h"
-#include "image_space/pixel_kernel.h"
+#include "cuda/cuda_check.h"
+#include "cuda/launch.h"
+#include "kernels/pixel.h"
 
 namespace focal::detail {
 namespace {

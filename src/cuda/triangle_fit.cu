@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "cuda_check.h"
-#include "image_space/device_launch.h"
-#include "image_space/triangle_kernel.h"
+#include "cuda/cuda_check.h"
+#include "cuda/launch.h"
+#include "kernels/triangle.h"
 
 namespace focal::detail {
 namespace {

@@ -14,8 +14,8 @@
 
 #include "cuda/cuda_check.h"
 #include "cuda/vertex_fit.h"
-#include "focal/cuda_curvature.h"
-#include "focal/device.h"
+#include "focal/cuda/curvature.h"
+#include "focal/cuda/device.h"
 
 namespace focal {
 namespace cuda {

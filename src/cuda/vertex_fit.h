@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "cuda/vertex_fit_kernel.h"
-#include "focal/curvature.h"
-#include "focal/error.h"
-#include "focal/mesh.h"
-#include "focal/neighbourhood.h"
+#include "kernels/vertex_fit.h"
+#include "focal/curvature/curvature.h"
+#include "focal/core/error.h"
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
 
 namespace focal::cuda {
 

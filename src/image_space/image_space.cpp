@@ -1,18 +1,18 @@
 // The image-space estimator: the CPU reference (the per-pixel functions of pixel_kernel.h in a
 // parallel loop over pixels) and the CUDA entry point's host side (validation, allocation; the
 // kernels are in src/cuda/image_space.cu).
-#include "focal/image_space.h"
+#include "focal/image_space/image_space.h"
 
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <string>
 
-#include "device_launch.h"
-#include "focal/device.h"
-#include "focal/error.h"
-#include "image_space_detail.h"
-#include "parallel.h"
+#include "cuda/launch.h"
+#include "focal/cuda/device.h"
+#include "focal/core/error.h"
+#include "image_space/detail.h"
+#include "core/parallel.h"
 
 namespace focal {
 namespace detail {

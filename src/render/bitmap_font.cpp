@@ -1,6 +1,6 @@
 // The glyphs are drawn here by hand, one string per pixel row ('#' = ink), so that no font file
 // or font code needs to be vendored.
-#include "bitmap_font.h"
+#include "render/bitmap_font.h"
 
 #include <algorithm>
 #include <array>

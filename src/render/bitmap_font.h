@@ -4,7 +4,7 @@
 
 #include <string_view>
 
-#include "focal/render.h"
+#include "focal/render/render.h"
 
 namespace focal::render_detail {
 

@@ -5,7 +5,7 @@
 #include <numbers>
 #include <string>
 
-#include "focal/render.h"
+#include "focal/render/render.h"
 
 namespace focal {
 namespace {

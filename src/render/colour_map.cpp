@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "focal/curvature.h"
-#include "focal/render.h"
+#include "focal/curvature/curvature.h"
+#include "focal/render/render.h"
 
 namespace focal {
 namespace {

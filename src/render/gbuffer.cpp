@@ -2,9 +2,9 @@
 #include <algorithm>
 #include <string>
 
-#include "focal/render.h"
-#include "gl_context.h"
-#include "gl_mesh.h"
+#include "focal/render/render.h"
+#include "render/gl_context.h"
+#include "render/gl_mesh.h"
 
 namespace focal {
 namespace {

@@ -3,7 +3,7 @@
 //  2. EGL_MESA_platform_surfaceless (Mesa, also without /dev/dri),
 //  3. eglGetDisplay(EGL_DEFAULT_DISPLAY) (older drivers; may need a display server).
 // The first on which an OpenGL 3.3 core context can be created and made current wins.
-#include "gl_context.h"
+#include "render/gl_context.h"
 
 // Keep X11 headers (and their macros such as None and Status) out: nothing here needs them.
 #define EGL_NO_X11 1
@@ -15,7 +15,7 @@
 #include <mutex>
 #include <vector>
 
-#include "focal/render.h"
+#include "focal/render/render.h"
 
 namespace focal::render_detail {
 namespace {

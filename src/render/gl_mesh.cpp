@@ -1,4 +1,4 @@
-#include "gl_mesh.h"
+#include "render/gl_mesh.h"
 
 namespace focal::render_detail {
 namespace {

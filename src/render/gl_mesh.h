@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "focal/mesh.h"
-#include "gl_context.h"
+#include "focal/core/mesh.h"
+#include "render/gl_context.h"
 
 namespace focal::render_detail {
 

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "bitmap_font.h"
-#include "focal/curvature.h"
-#include "focal/render.h"
-#include "gl_context.h"
-#include "gl_mesh.h"
+#include "render/bitmap_font.h"
+#include "focal/curvature/curvature.h"
+#include "focal/render/render.h"
+#include "render/gl_context.h"
+#include "render/gl_mesh.h"
 
 namespace focal {
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 #include <system_error>
 
-#include "focal/render.h"
+#include "focal/render/render.h"
 
 namespace focal {
 namespace {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "planar_delaunay.h"
-#include "triangulation.h"
+#include "surfaces/planar_delaunay.h"
+#include "surfaces/triangulation.h"
 
 namespace focal::detail {
 namespace {

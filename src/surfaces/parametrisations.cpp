@@ -1,8 +1,8 @@
 // The analytic surfaces of surfaces.h: parametrisations and their closed-form truth.
 #include <functional>
 
-#include "focal/error.h"
-#include "surface_model.h"
+#include "focal/core/error.h"
+#include "surfaces/surface_model.h"
 
 namespace focal::detail {
 namespace {

@@ -1,8 +1,8 @@
 // Regular triangulations of a parameter domain, and the domain statistics both kinds use.
 #include <cmath>
 
-#include "focal/error.h"
-#include "triangulation.h"
+#include "focal/core/error.h"
+#include "surfaces/triangulation.h"
 
 namespace focal::detail {
 

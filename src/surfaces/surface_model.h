@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "focal/surfaces.h"
+#include "focal/surfaces/surfaces.h"
 
 namespace focal::detail {
 

@@ -1,4 +1,4 @@
-#include "focal/surfaces.h"
+#include "focal/surfaces/surfaces.h"
 
 #include <array>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <string_view>
 #include <utility>
 
-#include "focal/error.h"
-#include "triangulation.h"
+#include "focal/core/error.h"
+#include "surfaces/triangulation.h"
 
 namespace focal {
 namespace {

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "surface_model.h"
+#include "surfaces/surface_model.h"
 
 namespace focal::detail {
 

@@ -1,0 +1,95 @@
+#pragma once
+/// \file curvature.h
+/// Per-vertex curvature fields by focal surfaces (Yu et al., SGP 2007): principal curvatures
+/// k1 >= k2, principal directions d1, d2, mean and Gaussian curvature, fit residual and class.
+///
+/// Conventions: outward normals; curvature positive where the surface bends away from the normal
+/// (sphere of radius r: k1 = k2 = +1/r); d1 belongs to k1; d1, d2 are unit 3D vectors tangent to
+/// the vertex normal, and (d1, d2, N) is right-handed.
+
+#include <cstdint>
+#include <string_view>
+
+#include "focal/core/mesh.h"
+#include "focal/curvature/two_slit_fit.h"
+
+namespace focal {
+
+/// Classification of a vertex (or face) from its principal curvatures. The codes are stable:
+/// they are written to PLY files as a uchar property.
+enum class PointClass : std::uint8_t {
+  elliptic = 0,    ///< K > 0 and not umbilic
+  hyperbolic = 1,  ///< K < 0
+  parabolic = 2,   ///< exactly one principal curvature near zero
+  umbilic = 3,     ///< k1 ~ k2, not near zero (sphere-like)
+  flat = 4,        ///< both principal curvatures near zero
+  undefined = 5,   ///< no estimate: too few usable rays, singular fit or invalid input at the vertex
+};
+
+/// Lower-case name of a class (`elliptic`, ..., `undefined`).
+[[nodiscard]] std::string_view class_name(PointClass c);
+
+/// Classifies principal curvatures: |k| <= zero_tolerance counts as zero; k1 - k2 <=
+/// umbilic_tolerance * max(|k1|, |k2|) counts as umbilic. NaN gives `undefined`.
+[[nodiscard]] PointClass classify(double k1, double k2, double zero_tolerance,
+                                  double umbilic_tolerance);
+
+enum class Method {
+  vertex,    ///< per-vertex two-slit fit over a ring neighbourhood (paper section 5)
+  triangle,  ///< per-triangle characteristic equation, area-averaged to vertices (paper 4.3, 5.1)
+};
+enum class Solver {
+  closed_form,          ///< global minimum of the paper's objective in closed form (default)
+  levenberg_marquardt,  ///< the paper's sampled-angle Levenberg-Marquardt, for reproduction
+};
+enum class RayWeighting {
+  uniform,   ///< every neighbour ray counts the same (the paper)
+  gaussian,  ///< weight exp(-d^2 / (2 s^2)), d the distance to the vertex, s = gaussian_width
+};
+
+/// Options of estimate_curvature. Defaults reproduce the paper with the closed-form solver.
+struct CurvatureOptions {
+  Method method = Method::vertex;
+  Solver solver = Solver::closed_form;
+  int rings = 1;  ///< neighbourhood size in rings (1 = the paper's default, 2 = its Fig. 9c)
+  RayWeighting weighting = RayWeighting::uniform;
+  /// Width s of the Gaussian weights; 0 = the mesh's mean edge length times `rings`.
+  double gaussian_width = 0.0;
+  LevenbergMarquardtOptions levenberg_marquardt;
+  /// A principal curvature counts as zero for the classification when |k| x (mean edge length)
+  /// <= zero_tolerance: scale-free, so results do not depend on the units of the mesh. At the
+  /// default a curvature radius over 1000 edge lengths is "flat" in that direction.
+  double zero_tolerance = 1e-3;
+  /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
+  double umbilic_tolerance = 1e-2;
+  int threads = 0;  ///< 0: FOCAL_NUM_THREADS or all hardware threads
+};
+
+/// Per-vertex fields, #V rows each, row i for input vertex i. Vertices of class `undefined`
+/// have NaN in every numeric field (never zeros).
+struct CurvatureResult {
+  Eigen::VectorXd k1;  ///< larger principal curvature
+  Eigen::VectorXd k2;  ///< smaller principal curvature
+  Eigen::VectorXd H;   ///< mean curvature (k1 + k2) / 2
+  Eigen::VectorXd K;   ///< Gaussian curvature k1 k2
+  RowMatrixX3d d1;     ///< unit principal direction of k1
+  RowMatrixX3d d2;     ///< unit principal direction of k2
+  /// Root-mean-square residual of the fit, sqrt(E / sum of weights), in units of slope
+  /// (per-vertex method) or the spread of the incident faces' estimates (triangle method).
+  Eigen::VectorXd residual;
+  VectorXu8 point_class;        ///< PointClass codes
+  Eigen::VectorXi rays_used;     ///< neighbour rays that entered the fit
+  Eigen::VectorXi rays_excluded; ///< neighbours whose normal left the vertex normal's hemisphere
+
+  [[nodiscard]] PointClass class_of(int i) const { return static_cast<PointClass>(point_class[i]); }
+};
+
+/// Estimates the curvature fields of a triangle mesh from its vertex normals.
+/// \param V #V x 3 positions. \param F #F x 3 triangles. \param N #V x 3 unit outward normals
+///        (rows that are not finite or not of unit length within 1e-6 are normalised; zero or
+///        non-finite rows make their vertex `undefined`).
+/// \throw InvalidInput when shapes differ, F indexes outside V, or an option is out of range.
+[[nodiscard]] CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                                 const CurvatureOptions& options = {});
+
+}  // namespace focal

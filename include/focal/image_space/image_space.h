@@ -1,0 +1,98 @@
+#pragma once
+/// \file image_space.h
+/// The paper's image-space estimator (Yu et al., SGP 2007, section 5.1): positions and normals
+/// rasterised into float images (a G-buffer); every pixel solves the normal-ray characteristic
+/// equation (eqs. 5-9) of its pixel triplet (x, y), (x + 1, y), (x, y + 1), in the frame of the
+/// triplet's unit mean normal, exactly as triangle_curvature does for a mesh face (see
+/// docs/IMAGE_SPACE.md for the method, the invalid-pixel rules and measured accuracy).
+///
+/// Conventions as everywhere in focal: outward normals, curvature positive where the surface
+/// bends away from the normal (a sphere of radius r: k1 = k2 = +1/r), d1 belongs to k1 and
+/// (d1, d2, N) is right-handed with N the triplet's mean normal. The triplet's orientation (which
+/// way the image's y axis points) does not matter; the normals' direction does.
+///
+/// All arithmetic is float32, the G-buffer's precision and the GPU's; positions are taken
+/// relative to each triplet's centroid and size first, so results do not depend on the units or
+/// on where the surface lies. docs/IMAGE_SPACE.md states the measured accuracy.
+
+#include <cstdint>
+#include <vector>
+
+#include "focal/surfaces/surfaces.h"
+
+namespace focal {
+
+/// Float images of one view, row-major, pixel (x, y) at index y * width + x.
+struct GBuffer {
+  int width = 0;
+  int height = 0;
+  std::vector<float> position;  ///< 3 per pixel (x, y, z), world coordinates, any units
+  /// 3 per pixel, outward normal. Need not be unit length (rasterisers interpolate normals);
+  /// a zero or non-finite normal in a covered pixel invalidates the triplets that use it.
+  std::vector<float> normal;
+  std::vector<std::uint8_t> mask;  ///< non-zero where a surface covers the pixel
+};
+
+struct ImageSpaceOptions {
+  /// Depth discontinuities: a triplet whose edge along image x (or y) is longer than this many
+  /// times the local pixel footprint along x (or y) is invalid. The footprint is the median
+  /// length of the 15 parallel pixel edges around the triplet's edge (3 along it, 5 across), so
+  /// it follows perspective and anisotropic pixels, and the few edges a discontinuity crosses do
+  /// not move it. Must be > 1 (infinity disables the test); the default 4 passes smooth surfaces
+  /// (a footprint changes by O(h) from pixel to pixel) and catches any jump of 4 footprints.
+  double discontinuity_ratio = 4.0;
+  /// Triplet averaging against noise: the symmetrised shape operators M = G X^-1 of the valid
+  /// triplets in the (2 w + 1)^2 window around a pixel, each rotated into the pixel's frame, are
+  /// averaged (weighted by the triplets' relative area), and k1, k2, d1, d2 are the eigen-pairs
+  /// of the mean. 0 = none: the pixel's own characteristic equation. In [0, 16].
+  int window = 0;
+  int threads = 0;  ///< CPU threads; 0: FOCAL_NUM_THREADS or all hardware threads
+};
+
+/// Per-pixel fields, width * height each (3 per pixel for d1, d2), in the units of the
+/// G-buffer's positions. Invalid pixels (valid = 0) have NaN in every float field: pixels not
+/// covered, whose triplet leaves the mask or the image (the last column and row), crosses a depth
+/// discontinuity, has a normal outside the hemisphere of the triplet's mean normal, or has no
+/// area in the ray frame.
+struct ImageCurvature {
+  int width = 0;
+  int height = 0;
+  std::vector<float> k1, k2, H, K;  ///< k1 >= k2, H = (k1 + k2) / 2, K = k1 k2
+  std::vector<float> focal_depth1,
+      focal_depth2;                 ///< -1/k1, -1/k2 along the normal (+-inf at k = 0)
+  std::vector<float> d1, d2;        ///< 3 per pixel, unit principal directions
+  std::vector<std::uint8_t> valid;  ///< 1 where the fields hold an estimate
+};
+
+/// CPU reference, parallel over pixels; the same result for any thread count.
+/// \throw InvalidInput when width or height is negative, the arrays' sizes disagree with them
+///        (position and normal: 3 width height; mask: width height), or an option is out of range.
+[[nodiscard]] ImageCurvature estimate_image_curvature(const GBuffer& gbuffer,
+                                                      const ImageSpaceOptions& options = {});
+
+/// The same on CUDA device `device`, one thread per pixel, the same per-pixel function
+/// (options.threads is ignored). Agrees with the CPU reference up to float rounding (fused
+/// multiply-adds on the device).
+/// \throw DeviceError without the CUDA backend or the device, or on a CUDA error;
+///        InvalidInput as estimate_image_curvature.
+[[nodiscard]] ImageCurvature estimate_image_curvature_cuda(const GBuffer& gbuffer,
+                                                           const ImageSpaceOptions& options = {},
+                                                           int device = 0);
+
+/// A geometry image: an analytic surface sampled on a regular width x height grid of its
+/// parameter domain (see surfaces.h), with the exact truth per pixel alongside.
+struct GeometryImage {
+  GBuffer gbuffer;            ///< mask 0 (position and normal 0) outside a disc domain
+  std::vector<float> k1, k2;  ///< exact principal curvatures per pixel (NaN where mask is 0)
+  std::vector<float> d1, d2;  ///< 3 per pixel, exact unit principal directions (NaN where masked)
+};
+
+/// Samples `surface` at the cell centres u = u_min + (x + 1/2) (u_max - u_min) / width,
+/// v = v_min + (y + 1/2) (v_max - v_min) / height (so never at a pole). Image x follows u and y
+/// follows v, so the triplet (x, y), (x + 1, y), (x, y + 1) turns counter-clockwise seen from
+/// outside (X_u x X_v is outward). Periodic directions are not wrapped: the last column and row
+/// have no triplet. surface.target_vertices, triangulation and seed are ignored.
+/// \throw InvalidInput for width or height outside [2, 16384] or invalid shape parameters.
+[[nodiscard]] GeometryImage geometry_image(const SurfaceOptions& surface, int width, int height);
+
+}  // namespace focal

@@ -1,0 +1,29 @@
+#pragma once
+/// \file fields_io.h
+/// Files of curvature fields and focal meshes, in the layouts the `focal` command writes.
+
+#include <filesystem>
+
+#include "focal/curvature/curvature.h"
+#include "focal/curvature/focal_mesh.h"
+#include "focal/io/mesh_io.h"
+
+namespace focal {
+
+/// Column names of the per-vertex fields, in file order:
+/// k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class.
+[[nodiscard]] const std::vector<std::string>& curvature_field_names();
+
+/// One CSV row per vertex, in input order; class as a word, NaN as `nan`.
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields);
+
+/// The mesh with the fields as per-vertex PLY properties (floats; class as a uchar whose codes
+/// are listed in a header comment), so MeshLab and ParaView can colour by them.
+void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
+                         const CurvatureResult& fields, const PlyWriteOptions& options = {});
+
+/// A focal mesh with its per-vertex `focal_flag` (uchar; codes listed in a header comment).
+void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,
+                          const PlyWriteOptions& options = {});
+
+}  // namespace focal

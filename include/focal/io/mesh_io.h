@@ -1,0 +1,102 @@
+#pragma once
+/// \file mesh_io.h
+/// Reading and writing meshes and per-vertex tables.
+///
+/// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary).
+/// Vertex order and count of indexed formats (OBJ, PLY, OFF) are preserved exactly; polygons are
+/// fan-triangulated and Mesh::face_source maps each triangle to its input polygon. STL has no
+/// shared vertices: each facet's corners are three new vertices, in file order (nothing is merged).
+/// Nothing is dropped or repaired: non-manifold and duplicate faces are kept as they are, a face
+/// with fewer than 3 vertices or an index out of range is an IoError. NaN and infinite coordinates
+/// are read as they are (later stages flag them). Counts declared in a header are checked against
+/// the file size before anything is allocated. See docs/IO.md for the per-format details.
+///
+/// Writers go through a temporary file in the destination folder that is renamed at the end, so
+/// a failed write never leaves a half-written file behind (and an existing file stays as it was).
+/// Numbers are written in the shortest form that reads back exactly (doubles round-trip bit for
+/// bit through PLY, OBJ and OFF).
+
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "focal/core/mesh.h"
+
+namespace focal {
+
+enum class MeshFormat { obj, ply, off, stl };
+
+/// The format named by the file extension (case-insensitive .obj .ply .off .stl).
+/// \throw IoError for any other extension.
+[[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
+
+/// Reads a mesh; the format is taken from the extension.
+/// Vertex normals are read when the file has them (OBJ `vn` referenced by faces, PLY nx/ny/nz,
+/// OFF `NOFF`); otherwise Mesh::N is empty. They are kept as written (not renormalised), except
+/// for an OBJ vertex referenced with several different `vn`: it gets the normalised average of
+/// them (NaN if they cancel). In an OBJ file whose faces reference normals, a vertex never
+/// referenced with one gets a NaN row. STL facet normals are not vertex normals and are not read.
+/// OBJ: negative (relative) and forward indices are accepted; texture coordinates, groups,
+/// materials, lines (`l`, `p`) and free-form geometry are ignored.
+/// \throw IoError naming the file and the line, byte offset or element index of the problem,
+/// also for a missing file, a directory or an unreadable path.
+[[nodiscard]] Mesh read_mesh(const std::filesystem::path& path);
+
+/// Scalar type a per-vertex property is stored as in PLY.
+enum class PropertyType { float32, float64, uint8, int32 };
+
+/// A named per-vertex scalar property (one value per vertex) for PLY output.
+struct VertexProperty {
+  std::string name;
+  Eigen::VectorXd values;
+  PropertyType type = PropertyType::float32;
+};
+
+struct PlyWriteOptions {
+  bool binary = true;                 ///< binary little endian (default) or ascii
+  std::vector<std::string> comments;  ///< `comment` lines in the header
+};
+
+/// Writes V, F, the normals when present and any extra per-vertex properties as PLY:
+/// x y z (and nx ny nz) as `double` so that positions round-trip exactly, each property with its
+/// PropertyType, faces as `list uchar int vertex_indices`.
+/// \throw InvalidInput when F indexes outside V, N has neither 0 nor #V rows, a property has not
+/// one value per vertex, a property name is empty, has blanks or repeats another, a uint8/int32
+/// property value is not an integer in range, or a comment holds a line break;
+/// IoError naming the path on write failure.
+void write_ply(const std::filesystem::path& path, const Mesh& mesh,
+               std::span<const VertexProperty> properties = {},
+               const PlyWriteOptions& options = {});
+
+/// Writes V, F (and `vn` normals when present, faces as `v//vn`) as OBJ.
+/// \throw InvalidInput for invalid arrays (see write_ply); IoError naming the path on failure.
+void write_obj(const std::filesystem::path& path, const Mesh& mesh);
+
+/// Writes V, F as OFF (NOFF when normals are present).
+/// \throw InvalidInput for invalid arrays (see write_ply); IoError naming the path on failure.
+void write_off(const std::filesystem::path& path, const Mesh& mesh);
+
+/// Writes a mesh in the format named by the extension (.ply binary, .obj, .off).
+/// \throw IoError for .stl (it cannot keep shared vertices) and unknown extensions.
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh);
+
+/// One column of a CSV table: numbers (shortest round-trip form; NaN written as `nan`, infinities
+/// as `inf` / `-inf`) or words (written as they are; quoted only when they hold a comma, a quote
+/// or a line break, as RFC 4180 requires).
+struct CsvColumn {
+  std::string name;
+  std::variant<Eigen::VectorXd, std::vector<std::string>> values;
+};
+
+/// Writes a header line with the column names, then one row per element.
+/// \throw InvalidInput when the columns differ in length; IoError on write failure.
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns);
+
+/// Writes a text file (a report, a Markdown table) through the same temporary-file-and-rename
+/// path as the other writers. \throw IoError on write failure.
+void write_text_file(const std::filesystem::path& path, std::string_view text);
+
+}  // namespace focal

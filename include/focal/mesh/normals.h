@@ -1,0 +1,91 @@
+#pragma once
+/// \file normals.h
+/// Vertex normals estimated from faces, and orientation checks per connected component.
+///
+/// Conventions (shared with neighbourhood.h): faces are counter-clockwise seen from outside; an
+/// edge is a pair of distinct vertices of a common face, and its incident faces are the faces
+/// having both as corners. A face with a repeated vertex index has no orientation along its edges.
+/// A face is degenerate when it repeats an index or has numerically zero area:
+/// |(b - a) x (c - a)| <= 1e-14 L^2 with L its longest edge (scale invariant).
+
+#include <vector>
+
+#include "focal/core/mesh.h"
+
+namespace focal {
+
+/// How face normals are weighted into a vertex normal.
+enum class NormalWeighting {
+  area,   ///< by triangle area (sum of un-normalised face normals)
+  angle,  ///< by the triangle's interior angle at the vertex (Thuermer & Wuethrich 1998)
+  max,    ///< Max (1999): sin(angle) / (|e1| |e2|), exact for vertices on a sphere
+};
+
+/// Unit vertex normals, #V x 3, oriented like the faces (counter-clockwise = outward).
+/// At corner P of a face with counter-clockwise successors Q, R, let e1 = Q - P, e2 = R - P and
+/// n = e1 x e2. The face contributes n (area), angle(e1, e2) n / |n| (angle) or
+/// n / (|e1|^2 |e2|^2) (max; N. Max, "Weights for computing vertex normals from facet normals",
+/// J. Graphics Tools 4(2), 1999: exact when P and its neighbours lie on a sphere).
+/// Degenerate faces contribute nothing. Faces are summed in ascending order per vertex, so the
+/// result does not depend on the thread count.
+/// Vertices in no face, or whose sum vanishes (|sum| <= 1e-12 * sum of |contribution|, e.g. two
+/// opposite faces), get a NaN row (never a silent zero).
+/// \throw InvalidInput when F indexes outside V.
+[[nodiscard]] RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F,
+                                          NormalWeighting weighting = NormalWeighting::angle);
+
+/// Orientation of one connected component (faces sharing a vertex are connected, so two closed
+/// surfaces touching at one vertex form one component).
+struct ComponentOrientation {
+  int face_count = 0;
+  int vertex_count = 0;        ///< vertices in the component's faces
+  bool closed = false;         ///< every edge has exactly two incident faces
+  bool consistent = false;     ///< every interior (two-face) edge is traversed in opposite
+                               ///< directions; edges with one or 3+ faces are not checked
+  double signed_volume = 0.0;  ///< divergence-theorem volume sum det(v0, v1, v2) / 6 about the
+                               ///< component's vertex centroid; > 0 for outward closed surfaces
+  bool inward = false;         ///< closed, consistent and signed_volume < 0
+};
+
+struct OrientationReport {
+  Eigen::VectorXi face_component;  ///< #F component index of each face, numbered in order of
+                                   ///< each component's first face
+  std::vector<ComponentOrientation> components;
+  [[nodiscard]] int inward_count() const;
+};
+
+/// Connected components of the faces and the orientation of each.
+/// \throw InvalidInput when F indexes outside V.
+[[nodiscard]] OrientationReport orientation_report(PositionsRef V, FacesRef F);
+
+/// Returns F with the faces of every inward (closed, consistent, negative-volume) component
+/// reversed, so that vertex normals computed from it point outward. Other faces are unchanged.
+/// \throw InvalidInput when `report` was not computed for a mesh with F's face count.
+[[nodiscard]] RowMatrixX3i orient_outward(FacesRef F, const OrientationReport& report);
+
+/// Faces after orient_consistently, and what could not be made consistent.
+struct ConsistentFaces {
+  RowMatrixX3i F;                  ///< #F x 3, the input with some faces reversed
+  int flipped_face_count = 0;      ///< faces reversed
+  int conflicting_edge_count = 0;  ///< interior edges still traversed the same way by both faces:
+                                   ///< 0 unless a patch is non-orientable (a Moebius strip)
+};
+
+/// Reverses faces so that faces sharing an interior (two-face) edge traverse it in opposite
+/// directions wherever possible. Works per patch (faces connected through interior edges, by
+/// breadth-first search from each patch's lowest-index face) and keeps the orientation of the
+/// majority of each patch's faces (on a tie, that of the lowest-index face), so a mostly correct
+/// mesh changes little. Faces with a repeated index have no orientation and are left alone. Does
+/// not decide inside from outside: follow with orientation_report and orient_outward for that.
+/// Linear time (the search is serial; ~2 M faces take tens of ms).
+/// 	hrow InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
+[[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F);
+
+/// Fraction of vertices (in at least one face, with finite N) whose given normal points against
+/// the area-weighted face normal (negative dot product): near 1 means the normals are inward.
+/// Vertices whose area-weighted normal vanishes (see vertex_normals) are not counted. NaN when no
+/// vertex qualifies.
+/// \throw InvalidInput when F indexes outside V or N does not have #V rows.
+[[nodiscard]] double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N);
+
+}  // namespace focal

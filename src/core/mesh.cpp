@@ -1,0 +1,95 @@
+#include "focal/core/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "focal/core/error.h"
+#include "core/parallel.h"
+
+namespace focal {
+
+void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what) {
+  const auto n = V.rows();
+  // Checked in parallel blocks; only a mesh with a bad index is scanned again, in order, for the
+  // first one.
+  constexpr std::int64_t kBlock = 1 << 15;
+  const std::int64_t faces = F.rows();
+  std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
+  detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    bool ok = true;
+    for (std::int64_t f = begin; f < end; ++f) {
+      for (int c = 0; c < 3; ++c) ok &= F(f, c) >= 0 && F(f, c) < n;
+    }
+    if (!ok) bad[static_cast<std::size_t>(begin / kBlock)] = 1;
+  });
+  const bool any_bad = std::find(bad.begin(), bad.end(), 1) != bad.end();
+  for (Eigen::Index f = 0; any_bad && f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const auto idx = F(f, c);
+      if (idx < 0 || idx >= n) {
+        throw InvalidInput(std::string(what) + ": face " + std::to_string(f) +
+                           " refers to vertex " + std::to_string(idx) + ", but there are " +
+                           std::to_string(n) + " vertices");
+      }
+    }
+  }
+  if (N.rows() != 0 && N.rows() != n) {
+    throw InvalidInput(std::string(what) + ": " + std::to_string(N.rows()) + " normals for " +
+                       std::to_string(n) + " vertices");
+  }
+}
+
+double mean_edge_length(PositionsRef V, FacesRef F) {
+  // Edges with a NaN or infinite end are left out: one bad coordinate would otherwise make the
+  // tolerances derived from this length NaN for the whole mesh, not just near the bad vertex.
+  // Summed per block of faces, the blocks' sums then added in block order: blocks do not depend
+  // on the thread count, so neither does the result (and a mesh of one block sums as before).
+  constexpr std::int64_t kBlock = 1 << 15;
+  const std::int64_t faces = F.rows();
+  const std::int64_t blocks = (faces + kBlock - 1) / kBlock;
+  std::vector<double> sums(static_cast<std::size_t>(blocks), 0.0);
+  std::vector<std::int64_t> counts(static_cast<std::size_t>(blocks), 0);
+  detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    double sum = 0.0;
+    std::int64_t count = 0;
+    for (std::int64_t f = begin; f < end; ++f) {
+      for (int c = 0; c < 3; ++c) {
+        const double length = (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+        if (std::isfinite(length)) {
+          sum += length;
+          ++count;
+        }
+      }
+    }
+    sums[static_cast<std::size_t>(begin / kBlock)] = sum;
+    counts[static_cast<std::size_t>(begin / kBlock)] = count;
+  });
+  double sum = 0.0;
+  std::int64_t count = 0;
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    sum += sums[static_cast<std::size_t>(b)];
+    count += counts[static_cast<std::size_t>(b)];
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+double bounding_box_diagonal(PositionsRef V) {
+  // Rows with a NaN or infinite coordinate are left out (Eigen's min/max are unspecified for
+  // NaN), so that clamping distances stay finite when a few vertices are broken.
+  Eigen::RowVector3d lo = Eigen::RowVector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::RowVector3d hi = -lo;
+  bool any = false;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (!V.row(i).allFinite()) continue;
+    lo = lo.cwiseMin(V.row(i));
+    hi = hi.cwiseMax(V.row(i));
+    any = true;
+  }
+  return any ? (hi - lo).norm() : 0.0;
+}
+
+}  // namespace focal

@@ -1,0 +1,37 @@
+#pragma once
+// The CUDA backend's entry points in plain data (no Eigen, no C++20 headers), so that the .cu
+// files need neither: nvcc builds them as C++17 (src/CMakeLists.txt) while focal's public
+// headers use C++20, and Eigen in nvcc code is slow to compile and warns. The public functions
+// (estimate_image_curvature_cuda, triangle_curvature_cuda) validate their input on the host in
+// C++ and call these; src/cuda/ defines them, src/cpu_only/ throws DeviceError.
+
+#include <cstdint>
+#include <vector>
+
+#include "kernels/pixel.h"
+
+namespace focal::detail {
+
+/// Runs the image-space kernels on `device`: host G-buffer in, host fields out (every pixel
+/// written). `image` must have width, height >= 1; window >= 0.
+/// \throw DeviceError on any CUDA error, or in a build without the CUDA backend.
+void image_curvature_on_device(const image_kernel::ImageView& image, float discontinuity_ratio,
+                               int window, const image_kernel::ImageFields& out, int device);
+
+/// A mesh packed for triangle_kernel.h: contiguous V, N (double) and F, classification
+/// thresholds in float.
+struct TriangleInput {
+  std::vector<double> V, N;
+  std::vector<std::int32_t> F;
+  int faces = 0;
+  float zero_tolerance = 0.0f;
+  float umbilic_tolerance = 0.0f;
+};
+
+/// Runs triangle_kernel::triangle_face for every face on `device` (faces >= 1); `values` gets
+/// field::count x faces floats, `classes` faces codes.
+/// \throw DeviceError on any CUDA error, or in a build without the CUDA backend.
+void triangle_faces_on_device(const TriangleInput& in, std::vector<float>& values,
+                              std::vector<std::uint8_t>& classes, int device);
+
+}  // namespace focal::detail

@@ -1,0 +1,431 @@
+#include "focal/curvature/curvature.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "curvature/detail.h"
+#include "focal/core/error.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/curvature/normal_rays.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "core/parallel.h"
+#include "core/simd_lanes.h"
+#include "curvature/two_slit_detail.h"
+
+namespace focal {
+
+// Implemented in triangle_curvature.cpp: Method::triangle.
+CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
+                                                const CurvatureOptions& options);
+
+namespace {
+
+void validate_options(const CurvatureOptions& o) {
+  if (o.rings < 1)
+    throw InvalidInput("curvature: rings must be >= 1, got " + std::to_string(o.rings));
+  if (!(o.gaussian_width >= 0.0)) throw InvalidInput("curvature: gaussian_width must be >= 0");
+  if (!(o.zero_tolerance >= 0.0)) throw InvalidInput("curvature: zero_tolerance must be >= 0");
+  if (!(o.umbilic_tolerance >= 0.0))
+    throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
+  if (o.threads < 0) throw InvalidInput("curvature: threads must be >= 0");
+}
+
+/// Everything one vertex's fit reads, shared by all vertices.
+struct FitContext {
+  const detail::VertexFitInput& in;
+  const CurvatureOptions& options;
+  double inverse_two_width_squared;  // Gaussian weights: exp(-d^2 * this)
+  detail::ClassTolerances tolerances;
+};
+
+/// One vertex's rays and weights. Owned by a block of vertices, so that the loop over vertices
+/// never touches the heap once the vectors have grown to the largest ring.
+struct RayScratch {
+  std::vector<NormalRay> rays;
+  std::vector<double> weights;  // empty for uniform weights
+};
+
+SlitFit run_solver(const CurvatureOptions& o, std::span<const NormalRay> rays,
+                   std::span<const double> weights) {
+  return o.solver == Solver::closed_form
+             ? detail::closed_form_fit(rays, weights)
+             : fit_two_slits_levenberg_marquardt(rays, weights, o.levenberg_marquardt);
+}
+
+/// The rays of vertex i's neighbours in its tangent frame (paper 4.1); returns how many
+/// neighbours had none (normal outside the hemisphere, or invalid).
+int gather_rays(const FitContext& c, int i, const TangentFrame& frame, RayScratch& s) {
+  const detail::VertexFitInput& in = c.in;
+  const Eigen::Vector3d p = in.V.row(i).transpose();
+  int excluded = 0;
+  for (const int* j = in.rings.begin(i); j != in.rings.end(i); ++j) {
+    const Eigen::Vector3d q = in.V.row(*j).transpose();
+    // The ray is made in its slot: copying a just-written NormalRay into the vector stalled on
+    // store forwarding (a fifth of the fit's time).
+    NormalRay& ray = s.rays.emplace_back();
+    if (!in.normal_ok[static_cast<std::size_t>(*j)] ||
+        !detail::ray_of(frame, p, q, in.unit_normals.row(*j).transpose(), ray)) {
+      s.rays.pop_back();
+      ++excluded;
+      continue;
+    }
+    if (c.options.weighting == RayWeighting::gaussian) {
+      s.weights.push_back(std::exp(-(q - p).squaredNorm() * c.inverse_two_width_squared));
+    }
+  }
+  return excluded;
+}
+
+void fit_vertex(const FitContext& c, int i, RayScratch& s, CurvatureResult& r) {
+  s.rays.clear();
+  s.weights.clear();
+  r.rays_used[i] = r.rays_excluded[i] = 0;
+  if (!c.in.normal_ok[static_cast<std::size_t>(i)]) return detail::store_undefined(r, i);
+  const TangentFrame frame = detail::frame_of(c.in.unit_normals.row(i).transpose());
+  r.rays_excluded[i] = gather_rays(c, i, frame, s);
+  r.rays_used[i] = static_cast<int>(s.rays.size());
+  const SlitFit fit = run_solver(c.options, s.rays, s.weights);
+  if (!fit.valid) return detail::store_undefined(r, i);
+  double weight_sum = static_cast<double>(s.rays.size());
+  if (!s.weights.empty()) {
+    weight_sum = 0.0;
+    for (double w : s.weights) weight_sum += w;
+  }
+  detail::store_vertex(r, i, frame, {fit.k1, fit.k2, fit.d1, fit.d2},
+                       std::sqrt(fit.energy / weight_sum), c.tolerances);
+}
+
+// ---- The closed-form fit, one vertex per lane.
+//
+// Vertices in groups of the lane width (simd_lanes.h): their frames, then their neighbours slot
+// by slot (the k-th neighbour of every lane at once), the normal equations summed per lane in
+// neighbour order, the 3x3 solve, the eigen-decomposition and the classification as selects.
+// Lanes with fewer neighbours than the group's largest count are padded with rays of weight
+// -0.0, which add exactly nothing (x + -0.0 == x, signed zeros included), so a lane's sums do not
+// depend on its group: every instruction set, group width and thread count gives the same bits.
+// Lanes with a degenerate fit (too few rays, singular system, invalid normal) get NaN and
+// `undefined` by select, as store_undefined gives them in the scalar path.
+
+using detail::broadcast;
+using detail::finite;
+using detail::lane_count;
+using detail::lanes_of;
+using detail::MaskOf;
+using detail::VertexFitInput;
+
+/// One group of consecutive vertices: frame (x, y, n), position and neighbour lists per lane.
+template <class L>
+struct alignas(sizeof(L)) VertexGroup {
+  static constexpr int kWidth = lane_count<L>;
+  std::int64_t first = 0;
+  int active = 0;  ///< lanes holding a vertex; the rest repeat the last one and are not stored
+  int slots = 0;   ///< the largest neighbour count of the group
+  L px, py, pz, xx, xy, xz, yx, yy, yz, nx, ny, nz;
+  MaskOf<L> ok;  ///< -1 where the lane's vertex has a valid normal
+  L count;       ///< neighbours per lane
+  const int* ring[kWidth];
+  int size[kWidth];
+  int self[kWidth];  ///< the lane's vertex
+};
+
+/// One neighbour slot of a group: its rays (zero, weight -0.0, where a lane made none). The lane
+/// structs are aligned explicitly: the alignment of a vector typedef is lost as a template
+/// argument, and the AVX-512 code loads them with aligned moves.
+template <class L>
+struct alignas(sizeof(L)) RaySlot {
+  L u, v, sigma, tau, weight;
+};
+
+/// Per-lane sums of the normal equations' terms over the slots: lhs (uu, uv, vv), rhs (us,
+/// vs + ut, vt), counts of rays made and of rays of positive weight (as -1 per ray).
+template <class L>
+struct alignas(sizeof(L)) SlotSums {
+  L uu{}, uv{}, vv{}, r0{}, r1{}, r2{}, weight{};
+  MaskOf<L> used{}, positive{};
+};
+
+/// matrix(rows[l], col) in lane l.
+template <class L, class Matrix>
+[[gnu::always_inline]] inline L column(const Matrix& matrix, const int* rows, int col) {
+  return lanes_of<L>([&](int l) { return matrix(rows[l], col); });
+}
+
+/// -1 in lane l where flags[rows[l]] is set.
+template <class L>
+[[gnu::always_inline]] inline MaskOf<L> flags(const std::vector<char>& flags, const int* rows) {
+  return lanes_of<MaskOf<L>>([&](int l) {
+    return flags[static_cast<std::size_t>(rows[l])] ? std::int64_t{-1} : std::int64_t{0};
+  });
+}
+
+template <class L>
+[[gnu::always_inline]] inline void load_group(const VertexFitInput& in, std::int64_t first,
+                                              int active, VertexGroup<L>& g) {
+  g.first = first;
+  g.active = active;
+  g.slots = 0;
+  for (int l = 0; l < g.kWidth; ++l) {
+    const auto i = static_cast<int>(first + std::min(l, active - 1));
+    g.self[l] = i;
+    g.ring[l] = in.rings.begin(i);
+    g.size[l] = l < active ? in.rings.size(i) : 0;
+    g.slots = std::max(g.slots, g.size[l]);
+  }
+  const PositionsRef& V = in.V;
+  const RowMatrixX3d& N = in.unit_normals;
+  g.px = column<L>(V, g.self, 0), g.py = column<L>(V, g.self, 1), g.pz = column<L>(V, g.self, 2);
+  g.count = lanes_of<L>([&](int l) { return static_cast<double>(g.size[l]); });
+  g.ok = flags<L>(in.normal_ok, g.self) &
+         (lanes_of<L>([](int l) { return static_cast<double>(l); }) < active);
+  // An invalid normal is replaced by +z so that its lane computes finite values; the lane is
+  // stored as undefined.
+  const L zero{};
+  g.nx = g.ok ? column<L>(N, g.self, 0) : zero;
+  g.ny = g.ok ? column<L>(N, g.self, 1) : zero;
+  g.nz = g.ok ? column<L>(N, g.self, 2) : broadcast<L>(1.0);
+  detail::frame_lanes(g.nx, g.ny, g.nz, g.xx, g.xy, g.xz, g.yx, g.yy, g.yz);
+}
+
+/// The rays of slot k of every lane (detail::ray_of's formulas), added to the sums. Lanes with
+/// fewer than k + 1 neighbours read their own vertex and do not count it.
+template <class L>
+[[gnu::always_inline]] inline void make_slot(const FitContext& c, const VertexGroup<L>& g, int k,
+                                             RaySlot<L>& out, SlotSums<L>& sums) {
+  const VertexFitInput& in = c.in;
+  int j[g.kWidth];
+  for (int l = 0; l < g.kWidth; ++l) j[l] = k < g.size[l] ? g.ring[l][k] : g.self[l];
+  const PositionsRef& V = in.V;
+  const RowMatrixX3d& N = in.unit_normals;
+  const L dx = column<L>(V, j, 0) - g.px, dy = column<L>(V, j, 1) - g.py,
+          dz = column<L>(V, j, 2) - g.pz;
+  const L nx = column<L>(N, j, 0), ny = column<L>(N, j, 1), nz = column<L>(N, j, 2);
+  L weight = broadcast<L>(1.0);
+  if (c.options.weighting == RayWeighting::gaussian) {
+    const L d2 = dx * dx + dy * dy + dz * dz;
+    weight = lanes_of<L>([&](int l) { return std::exp(-d2[l] * c.inverse_two_width_squared); });
+  }
+  const L m_n = g.nx * nx + g.ny * ny + g.nz * nz;
+  const L q_n = g.nx * dx + g.ny * dy + g.nz * dz;
+  // One reciprocal, not two divisions: the divider is the narrowest port here.
+  const L inv_m_n = 1.0 / m_n;
+  const L sigma = (g.xx * nx + g.xy * ny + g.xz * nz) * inv_m_n;
+  const L tau = (g.yx * nx + g.yy * ny + g.yz * nz) * inv_m_n;
+  const L u = (g.xx * dx + g.xy * dy + g.xz * dz) - q_n * sigma;
+  const L v = (g.yx * dx + g.yy * dy + g.yz * dz) - q_n * tau;
+  // m_n > 0 also rejects NaN; a non-finite position or normal gives no ray.
+  const auto made = g.ok & (static_cast<double>(k) < g.count) & flags<L>(in.normal_ok, j) &
+                    (m_n > 0.0) & finite(sigma + tau + u + v);
+  const L zero{};
+  out.u = made ? u : zero;
+  out.v = made ? v : zero;
+  out.sigma = made ? sigma : zero;
+  out.tau = made ? tau : zero;
+  out.weight = made ? weight : broadcast<L>(-0.0);
+  const L w = out.weight;
+  sums.uu += w * out.u * out.u;
+  sums.uv += w * out.u * out.v;
+  sums.vv += w * out.v * out.v;
+  sums.r0 += w * (out.u * out.sigma);
+  sums.r1 += w * (out.v * out.sigma + out.u * out.tau);
+  sums.r2 += w * (out.v * out.tau);
+  sums.weight += w;
+  sums.used += made;
+  sums.positive += made & (w > 0.0);
+}
+
+/// A group's results, NaN and `undefined` where its fit is not valid.
+template <class L>
+struct alignas(sizeof(L)) GroupResult {
+  L k1, k2, H, K, residual, d1x, d1y, d1z, d2x, d2y, d2z;
+  MaskOf<L> point_class, used, excluded;
+};
+
+template <class L>
+[[gnu::always_inline]] inline void store_group(const VertexGroup<L>& g, const GroupResult<L>& x,
+                                               CurvatureResult& r) {
+  const std::int64_t i = g.first;
+  if (g.active == g.kWidth) {
+    using detail::store_lanes;
+    store_lanes(r.k1.data() + i, x.k1), store_lanes(r.k2.data() + i, x.k2);
+    store_lanes(r.H.data() + i, x.H), store_lanes(r.K.data() + i, x.K);
+    store_lanes(r.residual.data() + i, x.residual);
+  } else {
+    for (int l = 0; l < g.active; ++l) {
+      r.k1[i + l] = x.k1[l], r.k2[i + l] = x.k2[l], r.H[i + l] = x.H[l], r.K[i + l] = x.K[l];
+      r.residual[i + l] = x.residual[l];
+    }
+  }
+  double* d1 = r.d1.data() + 3 * i;
+  double* d2 = r.d2.data() + 3 * i;
+  for (int l = 0; l < g.active; ++l) {
+    d1[3 * l] = x.d1x[l], d1[3 * l + 1] = x.d1y[l], d1[3 * l + 2] = x.d1z[l];
+    d2[3 * l] = x.d2x[l], d2[3 * l + 1] = x.d2y[l], d2[3 * l + 2] = x.d2z[l];
+    r.point_class[i + l] = static_cast<std::uint8_t>(x.point_class[l]);
+    r.rays_used[i + l] = static_cast<int>(x.used[l]);
+    r.rays_excluded[i + l] = static_cast<int>(x.excluded[l]);
+  }
+}
+
+/// The closed-form fit of one group (closed_form_fit's equations, solved by cofactors).
+template <class L>
+[[gnu::always_inline]] inline void fit_group(const FitContext& c, std::int64_t first, int active,
+                                             std::vector<RaySlot<L>>& slots, CurvatureResult& r) {
+  VertexGroup<L> g;
+  load_group(c.in, first, active, g);
+  if (slots.size() < static_cast<std::size_t>(g.slots)) slots.resize(g.slots);
+  SlotSums<L> sums;
+  for (int k = 0; k < g.slots; ++k) make_slot(c, g, k, slots[k], sums);
+  // lhs = [a b 0; b a+c b; 0 b c] with a = uu, b = uv, c = vv: its cofactors, determinant and
+  // the scale-free conditioning test of solve_well_conditioned.
+  const L a = sums.uu, b = sums.uv, cc = sums.vv, s = a + cc;
+  const L c00 = s * cc - b * b, c01 = -(b * cc), c02 = b * b;
+  const L c11 = a * cc, c12 = -(a * b), c22 = a * s - b * b;
+  const L det = a * c00 + b * c01;
+  const L scale = (a + s + cc) * (1.0 / 3.0);
+  const L inv_det = 1.0 / det;
+  const L w0 = (c00 * sums.r0 + c01 * sums.r1 + c02 * sums.r2) * inv_det;
+  const L w1 = (c01 * sums.r0 + c11 * sums.r1 + c12 * sums.r2) * inv_det;
+  const L w2 = (c02 * sums.r0 + c12 * sums.r1 + c22 * sums.r2) * inv_det;
+  const auto used = -sums.used;
+  const auto valid = g.ok & (-sums.positive >= 2) & (scale > 0.0) &
+                     (det > 1e-12 * scale * scale * scale) & finite(w0) & finite(w1) & finite(w2);
+  const detail::PrincipalLanes<L> p = detail::principal_lanes(w0, w1, w2);
+  L energy{};
+  for (int k = 0; k < g.slots; ++k) {
+    const RaySlot<L>& ray = slots[k];
+    const L ru = w0 * ray.u + w1 * ray.v - ray.sigma;
+    const L rv = w1 * ray.u + w2 * ray.v - ray.tau;
+    energy += ray.weight * (ru * ru + rv * rv);
+  }
+  const L weight_sum = c.options.weighting == RayWeighting::gaussian
+                           ? sums.weight
+                           : __builtin_convertvector(used, L);
+  const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
+  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
+  GroupResult<L> x;
+  x.k1 = or_nan(p.k1), x.k2 = or_nan(p.k2);
+  x.H = or_nan(0.5 * (p.k1 + p.k2)), x.K = or_nan(p.k1 * p.k2);
+  x.residual = or_nan(detail::lane_sqrt(energy / weight_sum));
+  // frame.from_plane(d1) and from_plane(d2) with d2 = d1 turned by +90 degrees.
+  x.d1x = or_nan(p.d1x * g.xx + p.d1y * g.yx), x.d1y = or_nan(p.d1x * g.xy + p.d1y * g.yy);
+  x.d1z = or_nan(p.d1x * g.xz + p.d1y * g.yz);
+  x.d2x = or_nan(-p.d1y * g.xx + p.d1x * g.yx), x.d2y = or_nan(-p.d1y * g.xy + p.d1x * g.yy);
+  x.d2z = or_nan(-p.d1y * g.xz + p.d1x * g.yz);
+  const MaskOf<L> none{};
+  x.point_class = valid ? detail::classify_lanes(x.k1, x.k2, c.tolerances)
+                        : none + static_cast<std::int64_t>(PointClass::undefined);
+  x.used = g.ok ? used : none;
+  x.excluded = g.ok ? __builtin_convertvector(g.count, MaskOf<L>) - used : none;
+  store_group(g, x, r);
+}
+
+/// The closed-form fit of vertices [begin, end), one group after the other.
+template <class L>
+[[gnu::always_inline]] inline void fit_block_lanes(const FitContext& c, std::int64_t begin,
+                                                   std::int64_t end, CurvatureResult& r) {
+  constexpr int kWidth = lane_count<L>;
+  std::vector<RaySlot<L>> slots(8);
+  for (std::int64_t first = begin; first < end; first += kWidth) {
+    fit_group<L>(c, first, static_cast<int>(std::min<std::int64_t>(kWidth, end - first)), slots, r);
+  }
+}
+
+FOCAL_TARGET_AVX512 void fit_block_avx512(const FitContext& c, std::int64_t begin, std::int64_t end,
+                                          CurvatureResult& r) {
+  fit_block_lanes<detail::Lanes8>(c, begin, end, r);
+}
+FOCAL_TARGET_AVX2 void fit_block_avx2(const FitContext& c, std::int64_t begin, std::int64_t end,
+                                      CurvatureResult& r) {
+  fit_block_lanes<detail::Lanes4>(c, begin, end, r);
+}
+void fit_block_baseline(const FitContext& c, std::int64_t begin, std::int64_t end,
+                        CurvatureResult& r) {
+  fit_block_lanes<detail::Lanes2>(c, begin, end, r);
+}
+
+using FitBlock = void (*)(const FitContext&, std::int64_t, std::int64_t, CurvatureResult&);
+
+FitBlock fit_block_for(detail::SimdIsa isa) {
+  return detail::kernel_for(isa, fit_block_avx512, fit_block_avx2, fit_block_baseline);
+}
+
+CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options) {
+  std::vector<char> normal_ok;
+  const RowMatrixX3d unit = detail::unit_rows(N, normal_ok, options.threads);
+  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(V.rows()), F);
+  const Neighbourhoods rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
+  return detail::fit_vertices({V, unit, normal_ok, rings, mean_edge_length(V, F)}, options);
+}
+
+}  // namespace
+
+std::string_view class_name(PointClass c) {
+  switch (c) {
+    case PointClass::elliptic:
+      return "elliptic";
+    case PointClass::hyperbolic:
+      return "hyperbolic";
+    case PointClass::parabolic:
+      return "parabolic";
+    case PointClass::umbilic:
+      return "umbilic";
+    case PointClass::flat:
+      return "flat";
+    case PointClass::undefined:
+      return "undefined";
+  }
+  return "undefined";
+}
+
+PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_tolerance) {
+  if (!std::isfinite(k1) || !std::isfinite(k2)) return PointClass::undefined;
+  const bool zero1 = std::abs(k1) <= zero_tolerance, zero2 = std::abs(k2) <= zero_tolerance;
+  if (zero1 && zero2) return PointClass::flat;
+  if (zero1 || zero2) return PointClass::parabolic;
+  if (k1 - k2 <= umbilic_tolerance * std::max(std::abs(k1), std::abs(k2)))
+    return PointClass::umbilic;
+  return k1 * k2 > 0.0 ? PointClass::elliptic : PointClass::hyperbolic;
+}
+
+CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                   const CurvatureOptions& options) {
+  validate_options(options);
+  if (N.rows() != V.rows()) {
+    throw InvalidInput("curvature: " + std::to_string(N.rows()) + " normals for " +
+                       std::to_string(V.rows()) +
+                       " vertices (normals are required; estimate "
+                       "them with vertex_normals)");
+  }
+  validate_mesh_arrays(V, F, N, "curvature");
+  if (options.method == Method::triangle) return vertex_curvature_from_triangles(V, F, N, options);
+  return vertex_curvature_from_rays(V, F, N, options);
+}
+
+namespace detail {
+
+CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
+                             SimdIsa isa) {
+  const double h = in.mean_edge_length;
+  const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
+  const FitContext context{in, options, 0.5 / (width * width), class_tolerances(options, h)};
+  CurvatureResult result = unwritten_result(in.V.rows());
+  const FitBlock fit_block = fit_block_for(isa);
+  // Blocks of vertices share one scratch; 256 vertices amortise its allocation and still give
+  // each thread many blocks (static schedule, so the same split for any run). Blocks are whole
+  // groups of any lane width, so a group never straddles two threads' output.
+  parallel_for_blocks(in.V.rows(), 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    if (options.solver == Solver::closed_form) return fit_block(context, begin, end, result);
+    RayScratch scratch;
+    for (auto i = begin; i < end; ++i) fit_vertex(context, static_cast<int>(i), scratch, result);
+  });
+  return result;
+}
+
+}  // namespace detail
+}  // namespace focal

@@ -1,0 +1,142 @@
+#pragma once
+// Pieces shared by the per-vertex and per-triangle estimators.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "focal/curvature/curvature.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/curvature/triangle_curvature.h"
+#include "core/parallel.h"
+#include "core/simd_lanes.h"
+
+namespace focal::detail {
+
+/// Eigenvalues k1 >= k2 of the symmetric [a b; b c], unit d1 of k1 and d2 = d1 rotated by +90
+/// degrees (so that (d1, d2, n) is right-handed in a frame (x, y, n)).
+struct Principal2 {
+  double k1, k2;
+  Eigen::Vector2d d1, d2;
+};
+
+inline Principal2 principal_from_symmetric(double a, double b, double c) {
+  const double mean = 0.5 * (a + c);
+  const double d = 0.5 * (a - c);
+  // In units of s = max(|d|, |b|) squares neither overflow nor underflow, as with std::hypot;
+  // with the algebraic eigenvector below this avoids hypot, atan2 and sincos, which were a
+  // quarter of the per-vertex fit's time.
+  const double s = std::max(std::abs(d), std::abs(b));
+  if (s == 0.0) return {mean, mean, {1.0, 0.0}, {0.0, 1.0}};  // isotropic: any frame, take x
+  const double inv = 1.0 / s;
+  const double ds = d * inv, bs = b * inv;
+  const double r = std::sqrt(ds * ds + bs * bs);  // half the eigenvalue gap, over s
+  // The eigenvector of k1 with angle in (-pi/2, pi/2]: (r + d, b), or where that cancels
+  // (d < 0) the parallel (b, r - d) turned to x >= 0. Both have length sqrt(2 r (r + |d|)).
+  Eigen::Vector2d d1 = ds >= 0.0 ? Eigen::Vector2d(r + ds, bs)
+                                 : Eigen::Vector2d(std::abs(bs), std::copysign(r - ds, bs));
+  d1 /= std::sqrt(2.0 * r * (r + std::abs(ds)));
+  return {mean + s * r, mean - s * r, d1, Eigen::Vector2d(-d1.y(), d1.x())};
+}
+
+/// Unit copies of the rows of N; `valid[i]` is false where a row is zero or not finite.
+/// Rows are independent, so any thread count gives the same result.
+inline RowMatrixX3d unit_rows(NormalsRef N, std::vector<char>& valid, int threads = 0) {
+  RowMatrixX3d unit(N.rows(), 3);
+  valid.resize(static_cast<std::size_t>(N.rows()));
+  parallel_for(N.rows(), threads, [&](std::int64_t i) {
+    const double len = N.row(i).norm();
+    valid[static_cast<std::size_t>(i)] = std::isfinite(len) && len > 0.0;
+    unit.row(i) = N.row(i) / len;
+  });
+  return unit;
+}
+
+/// A result of n vertices with every field allocated but not written: the caller writes each
+/// row once, with store_vertex or store_undefined, from the thread that owns it (first touch
+/// then happens in parallel, and nothing is written twice).
+inline CurvatureResult unwritten_result(Eigen::Index n) {
+  CurvatureResult r;
+  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) v->resize(n);
+  r.d1.resize(n, 3);
+  r.d2.resize(n, 3);
+  r.point_class.resize(n);
+  r.rays_used.resize(n);
+  r.rays_excluded.resize(n);
+  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) {
+    advise_huge_pages(v->data(), sizeof(double) * static_cast<std::size_t>(n));
+  }
+  for (RowMatrixX3d* d : {&r.d1, &r.d2}) {
+    advise_huge_pages(d->data(), 3 * sizeof(double) * static_cast<std::size_t>(n));
+  }
+  return r;
+}
+
+/// Marks vertex i `undefined`: NaN in every numeric field. Leaves the ray counts alone.
+inline void store_undefined(CurvatureResult& r, Eigen::Index i) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r.k1[i] = r.k2[i] = r.H[i] = r.K[i] = r.residual[i] = nan;
+  r.d1.row(i).setConstant(nan);
+  r.d2.row(i).setConstant(nan);
+  r.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
+}
+
+/// A result of n vertices, every one `undefined` with NaN fields until it is filled.
+inline CurvatureResult undefined_result(Eigen::Index n, int threads = 0) {
+  CurvatureResult r = unwritten_result(n);
+  parallel_for(n, threads, [&](std::int64_t i) {
+    store_undefined(r, i);
+    r.rays_used[i] = r.rays_excluded[i] = 0;
+  });
+  return r;
+}
+
+/// Thresholds of the classification in absolute curvature units for a mesh of edge length h.
+struct ClassTolerances {
+  double zero = 0.0;     ///< |k| at or below this is zero
+  double umbilic = 0.0;  ///< relative k1 - k2 gap at or below this is umbilic
+};
+
+inline ClassTolerances class_tolerances(const CurvatureOptions& options, double edge_length) {
+  return {options.zero_tolerance / edge_length, options.umbilic_tolerance};
+}
+
+/// Stores one vertex's principal curvatures and directions (2D in `frame`).
+inline void store_vertex(CurvatureResult& r, Eigen::Index i, const TangentFrame& frame,
+                         const Principal2& p, double residual, const ClassTolerances& tol) {
+  r.k1[i] = p.k1;
+  r.k2[i] = p.k2;
+  r.H[i] = 0.5 * (p.k1 + p.k2);
+  r.K[i] = p.k1 * p.k2;
+  r.d1.row(i) = frame.from_plane(p.d1);
+  r.d2.row(i) = frame.from_plane(p.d2);
+  r.residual[i] = residual;
+  r.point_class[i] = static_cast<std::uint8_t>(classify(p.k1, p.k2, tol.zero, tol.umbilic));
+}
+
+/// What the per-vertex fit reads besides the options. Split from estimate_curvature so that
+/// bench/ can time the fit step alone (normals and neighbourhoods already at hand).
+struct VertexFitInput {
+  PositionsRef V;
+  const RowMatrixX3d& unit_normals;    ///< from unit_rows
+  const std::vector<char>& normal_ok;  ///< from unit_rows
+  const Neighbourhoods& rings;
+  double mean_edge_length;  ///< scale of the Gaussian weights and the class tolerances
+};
+
+/// The per-vertex two-slit fit of every vertex (Method::vertex); defined in curvature.cpp. The
+/// closed form runs one vertex per lane, compiled for `isa` (simd_lanes.h; tests compare the
+/// instruction sets, which give the same bits).
+CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
+                             SimdIsa isa = SimdIsa::best);
+
+/// focal::triangle_curvature with the faces solved by the lane kernel compiled for `isa`
+/// (tests compare the instruction sets); defined in triangle_curvature.cpp.
+TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options,
+                                           const TriangleFields& fields, SimdIsa isa);
+
+}  // namespace focal::detail

@@ -1,0 +1,425 @@
+#include "focal/curvature/triangle_curvature.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "curvature/detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "core/parallel.h"
+#include "core/simd_lanes.h"
+#include "mesh/topology.h"
+
+namespace focal {
+namespace {
+
+/// A result of m faces with the asked fields allocated but not written: each face's row is then
+/// written once (values or NaN) by the thread that computes it, so nothing is filled twice and
+/// the pages are first touched in parallel.
+TriangleCurvatureResult unwritten_faces(Eigen::Index m, const TriangleFields& want) {
+  TriangleCurvatureResult r;
+  // Huge pages where the kernel grants them: at 2M faces the asked fields are up to 450 MB,
+  // otherwise first-touched 4 KiB at a time (see detail::advise_huge_pages).
+  const auto scalars = [&](bool asked, std::initializer_list<Eigen::VectorXd*> fields) {
+    for (Eigen::VectorXd* v : fields) {
+      v->resize(asked ? m : 0);
+      detail::advise_huge_pages(v->data(), sizeof(double) * static_cast<std::size_t>(v->size()));
+    }
+  };
+  scalars(want.coefficients, {&r.A, &r.B, &r.C});
+  scalars(want.curvatures, {&r.K, &r.H, &r.k1, &r.k2});
+  scalars(want.focal_depths, {&r.lambda1, &r.lambda2});
+  const auto vectors = [&](bool asked, std::initializer_list<RowMatrixX3d*> fields) {
+    for (RowMatrixX3d* d : fields) {
+      d->resize(asked ? m : 0, 3);
+      detail::advise_huge_pages(d->data(), sizeof(double) * static_cast<std::size_t>(d->size()));
+    }
+  };
+  vectors(want.directions, {&r.d1, &r.d2});
+  vectors(want.slits, {&r.slit1, &r.slit2});
+  vectors(want.face_normal, {&r.face_normal});
+  r.shape_operator.resize(want.shape_operator ? m : 0, 4);
+  detail::advise_huge_pages(r.shape_operator.data(),
+                            sizeof(double) * static_cast<std::size_t>(r.shape_operator.size()));
+  r.point_class.resize(m);
+  return r;
+}
+
+// ---- The per-face solve, one face per lane.
+//
+// Faces in groups of the lane width (simd_lanes.h): the three vertex rays in the frame of the
+// face's mean normal (face_rays of version 3: inline frame_of and ray_of), the characteristic
+// equation with the sagitta shift, the curvatures and, where asked, directions, slits and the
+// shape operator, all as selects per lane; faces without a solution get NaN and `undefined`. No
+// lane reads another, so every instruction set and thread count gives the same bits.
+
+using detail::broadcast;
+using detail::finite;
+using detail::lane_abs;
+using detail::lane_count;
+using detail::lane_sqrt;
+using detail::lanes_of;
+using detail::MaskOf;
+
+/// What the face kernel reads.
+struct FaceInput {
+  PositionsRef V;
+  const RowMatrixX3d& N;        ///< unit normals (unit_rows)
+  const std::vector<char>& ok;  ///< normal flags (unit_rows)
+  FacesRef F;
+  detail::ClassTolerances tol;
+  const TriangleFields& want;
+};
+
+/// A 2x2 matrix per lane, as in the file's scalar formulas: columns are the edges 0->1, 0->2.
+template <class L>
+struct alignas(sizeof(L)) Lanes2x2 {
+  L m00, m01, m10, m11;
+  [[nodiscard]] L determinant() const { return m00 * m11 - m10 * m01; }
+  [[nodiscard]] L squared_norm() const { return (m00 * m00 + m10 * m10) + (m01 * m01 + m11 * m11); }
+};
+
+/// G X^-1 (Eigen's 2x2 inverse: one reciprocal of the determinant).
+template <class L>
+FOCAL_LANE_INLINE Lanes2x2<L> times_inverse(const Lanes2x2<L>& G, const Lanes2x2<L>& X) {
+  const L inv = 1.0 / X.determinant();
+  const L i00 = X.m11 * inv, i01 = -X.m01 * inv, i10 = -X.m10 * inv, i11 = X.m00 * inv;
+  return {G.m00 * i00 + G.m01 * i10, G.m00 * i01 + G.m01 * i11, G.m10 * i00 + G.m11 * i10,
+          G.m10 * i01 + G.m11 * i11};
+}
+
+/// slit_direction per lane: the unit slit in the face plane at depth lambda, zero where both
+/// candidate vectors vanish.
+template <class L>
+FOCAL_LANE_INLINE void slit_lanes(const Lanes2x2<L>& X, const Lanes2x2<L>& G, L lambda, L& sx,
+                                  L& sy) {
+  const auto infinite = lane_abs(lambda) == std::numeric_limits<double>::infinity();
+  const L ax = infinite ? G.m00 : X.m00 + lambda * G.m00;
+  const L ay = infinite ? G.m10 : X.m10 + lambda * G.m10;
+  const L bx = infinite ? G.m01 : X.m01 + lambda * G.m01;
+  const L by = infinite ? G.m11 : X.m11 + lambda * G.m11;
+  const L a2 = ax * ax + ay * ay, b2 = bx * bx + by * by;
+  const auto a_longer = a2 >= b2;
+  const L lx = a_longer ? ax : bx, ly = a_longer ? ay : by, l2 = a_longer ? a2 : b2;
+  const L g = lane_sqrt(G.squared_norm());
+  const L scale = lane_sqrt(X.squared_norm()) + (infinite ? g : lane_abs(lambda) * g);
+  const L length = lane_sqrt(l2);
+  const auto nonzero = length > 1e-9 * scale;
+  const L zero{};
+  sx = nonzero ? lx / length : zero;
+  sy = nonzero ? ly / length : zero;
+}
+
+/// Stores lanes [0, active) of x at rows first... of v (one vector store for a whole group).
+template <class L>
+FOCAL_LANE_INLINE void store_scalars(Eigen::VectorXd& v, std::int64_t first, int active, L x) {
+  if (active == lane_count<L>) return detail::store_lanes(v.data() + first, x);
+  for (int l = 0; l < active; ++l) v[first + l] = x[l];
+}
+
+template <class L>
+FOCAL_LANE_INLINE void store_rows(RowMatrixX3d& m, std::int64_t first, int active, L x, L y, L z) {
+  double* row = m.data() + 3 * first;
+  for (int l = 0; l < active; ++l) row[3 * l] = x[l], row[3 * l + 1] = y[l], row[3 * l + 2] = z[l];
+}
+
+/// Solves faces [first, first + active) and writes their asked fields.
+template <class L>
+FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first, int active,
+                                        TriangleCurvatureResult& r) {
+  constexpr int W = lane_count<L>;
+  int corner[3][W];
+  for (int l = 0; l < W; ++l) {
+    const std::int64_t f = first + std::min(l, active - 1);
+    for (int c = 0; c < 3; ++c) corner[c][l] = in.F(f, c);
+  }
+  const auto column = [&](const auto& matrix, int c, int col) FOCAL_LANE_LAMBDA {
+    return lanes_of<L>([&](int l) { return matrix(corner[c][l], col); });
+  };
+  L px[3], py[3], pz[3], mx[3], my[3], mz[3];
+  auto valid = lanes_of<L>([](int l) { return static_cast<double>(l); }) < active;
+  for (int c = 0; c < 3; ++c) {
+    px[c] = column(in.V, c, 0), py[c] = column(in.V, c, 1), pz[c] = column(in.V, c, 2);
+    mx[c] = column(in.N, c, 0), my[c] = column(in.N, c, 1), mz[c] = column(in.N, c, 2);
+    valid &= lanes_of<MaskOf<L>>([&](int l) {
+      return in.ok[static_cast<std::size_t>(corner[c][l])] ? std::int64_t{-1} : std::int64_t{0};
+    });
+  }
+  // The frame of the mean normal; the centroid as origin.
+  const L sx = mx[0] + mx[1] + mx[2], sy = my[0] + my[1] + my[2], sz = mz[0] + mz[1] + mz[2];
+  const L length = lane_sqrt(sx * sx + sy * sy + sz * sz);
+  valid &= (length > 0.0) & finite(length);
+  const L one = broadcast<L>(1.0), zero{};
+  // Reciprocals times, not divisions: the divider is the kernel's narrowest port (17 divisions
+  // per group became 7; each result moves by at most an ulp).
+  const L inv_length = 1.0 / length;
+  const L nx = valid ? sx * inv_length : zero, ny = valid ? sy * inv_length : zero,
+          nz = valid ? sz * inv_length : one;
+  L xx, xy, xz, yx, yy, yz;
+  detail::frame_lanes(nx, ny, nz, xx, xy, xz, yx, yy, yz);
+  const double third = 1.0 / 3.0;
+  const L cx = (px[0] + px[1] + px[2]) * third, cy = (py[0] + py[1] + py[2]) * third,
+          cz = (pz[0] + pz[1] + pz[2]) * third;
+  L u[3], v[3], sigma[3], tau[3], ox[3], oy[3];
+  for (int c = 0; c < 3; ++c) {  // ray_of, and the vertex's tangential offset
+    const L qx = px[c] - cx, qy = py[c] - cy, qz = pz[c] - cz;
+    const L m_n = nx * mx[c] + ny * my[c] + nz * mz[c];
+    const L q_n = nx * qx + ny * qy + nz * qz;
+    const L inv_m_n = 1.0 / m_n;
+    sigma[c] = (xx * mx[c] + xy * my[c] + xz * mz[c]) * inv_m_n;
+    tau[c] = (yx * mx[c] + yy * my[c] + yz * mz[c]) * inv_m_n;
+    ox[c] = xx * qx + xy * qy + xz * qz;
+    oy[c] = yx * qx + yy * qy + yz * qz;
+    u[c] = ox[c] - q_n * sigma[c];
+    v[c] = oy[c] - q_n * tau[c];
+    valid &= (m_n > 0.0) & finite(sigma[c] + tau[c] + u[c] + v[c]);
+  }
+  Lanes2x2<L> X{u[1] - u[0], u[2] - u[0], v[1] - v[0], v[2] - v[0]};
+  const Lanes2x2<L> G{sigma[1] - sigma[0], sigma[2] - sigma[0], tau[1] - tau[0], tau[2] - tau[0]};
+  valid &= lane_abs(X.determinant()) > 1e-14 * X.squared_norm();  // area in the ray frame
+  // The centroid lies below the surface by the sagitta s = (1/6) sum x^T M x (second order,
+  // x the vertices' tangential offsets). Depths measured from the centroid's plane would carry
+  // that O(h^2) bias into K and H, so the rays are re-parametrised on the plane z = s, the
+  // tangent plane at the surface point above the centroid: (u, v) += s (sigma, tau).
+  const Lanes2x2<L> M0 = times_inverse(G, X);
+  const L s01 = 0.5 * (M0.m01 + M0.m10);
+  L sagitta{};
+  for (int c = 0; c < 3; ++c) {
+    sagitta += ox[c] * (M0.m00 * ox[c] + s01 * oy[c]) + oy[c] * (s01 * ox[c] + M0.m11 * oy[c]);
+  }
+  sagitta *= 1.0 / 6.0;
+  X.m00 += sagitta * G.m00, X.m01 += sagitta * G.m01;
+  X.m10 += sagitta * G.m10, X.m11 += sagitta * G.m11;
+  const L A = G.determinant();
+  const L B = G.m00 * X.m11 - G.m01 * X.m10 - G.m10 * X.m01 + G.m11 * X.m00;
+  const L C = X.determinant();
+  valid &= lane_abs(C) > 1e-14 * X.squared_norm();
+  const L inv_C = 1.0 / C;
+  const L K = A * inv_C, H = 0.5 * (B * inv_C);
+  // H^2 < K only through rounding or a non-symmetric M (noise): the double root H.
+  const L root = lane_sqrt(detail::lane_max(H * H - K, zero));
+  const L k1 = H + root, k2 = H - root;
+  const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
+  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
+  const TriangleFields& want = in.want;
+  if (want.coefficients) {
+    store_scalars(r.A, first, active, or_nan(A)), store_scalars(r.B, first, active, or_nan(B));
+    store_scalars(r.C, first, active, or_nan(C));
+  }
+  if (want.curvatures) {
+    store_scalars(r.K, first, active, or_nan(K)), store_scalars(r.H, first, active, or_nan(H));
+    store_scalars(r.k1, first, active, or_nan(k1)), store_scalars(r.k2, first, active, or_nan(k2));
+  }
+  const L lambda1 = -1.0 / k1, lambda2 = -1.0 / k2;
+  if (want.focal_depths) {
+    store_scalars(r.lambda1, first, active, or_nan(lambda1));
+    store_scalars(r.lambda2, first, active, or_nan(lambda2));
+  }
+  if (want.directions || want.slits || want.shape_operator) {
+    const Lanes2x2<L> M = times_inverse(G, X);  // M on the shifted X
+    if (want.shape_operator) {
+      double* row = r.shape_operator.data() + 4 * first;
+      const L m00 = or_nan(M.m00), m01 = or_nan(M.m01), m10 = or_nan(M.m10), m11 = or_nan(M.m11);
+      for (int l = 0; l < active; ++l) {
+        row[4 * l] = m00[l], row[4 * l + 1] = m01[l], row[4 * l + 2] = m10[l];
+        row[4 * l + 3] = m11[l];
+      }
+    }
+    if (want.directions || want.slits) {
+      const detail::PrincipalLanes<L> p =
+          detail::principal_lanes(M.m00, 0.5 * (M.m01 + M.m10), M.m11);
+      // frame.from_plane of d1 and of d2 = d1 turned by +90 degrees.
+      const auto to_3d = [&](L a, L b, RowMatrixX3d& m) FOCAL_LANE_LAMBDA {
+        store_rows(m, first, active, or_nan(a * xx + b * yx), or_nan(a * xy + b * yy),
+                   or_nan(a * xz + b * yz));
+      };
+      if (want.directions) to_3d(p.d1x, p.d1y, r.d1), to_3d(-p.d1y, p.d1x, r.d2);
+      if (want.slits) {
+        // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
+        L s1x, s1y, s2x, s2y;
+        slit_lanes(X, G, lambda1, s1x, s1y);
+        slit_lanes(X, G, lambda2, s2x, s2y);
+        const auto empty1 = s1x * s1x + s1y * s1y == 0.0, empty2 = s2x * s2x + s2y * s2y == 0.0;
+        to_3d(empty1 ? -p.d1y : s1x, empty1 ? p.d1x : s1y, r.slit1);
+        to_3d(empty2 ? p.d1x : s2x, empty2 ? p.d1y : s2y, r.slit2);
+      }
+    }
+  }
+  if (want.face_normal)
+    store_rows(r.face_normal, first, active, or_nan(nx), or_nan(ny), or_nan(nz));
+  const auto point_class = valid ? detail::classify_lanes(k1, k2, in.tol)
+                                 : MaskOf<L>{} + static_cast<std::int64_t>(PointClass::undefined);
+  for (int l = 0; l < active; ++l) {
+    r.point_class[first + l] = static_cast<std::uint8_t>(point_class[l]);
+  }
+}
+
+template <class L>
+FOCAL_LANE_INLINE void solve_face_block_lanes(const FaceInput& in, std::int64_t begin,
+                                              std::int64_t end, TriangleCurvatureResult& r) {
+  constexpr int W = lane_count<L>;
+  for (std::int64_t first = begin; first < end; first += W) {
+    solve_face_group<L>(in, first, static_cast<int>(std::min<std::int64_t>(W, end - first)), r);
+  }
+}
+
+FOCAL_TARGET_AVX512 void solve_face_block_avx512(const FaceInput& in, std::int64_t begin,
+                                                 std::int64_t end, TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes8>(in, begin, end, r);
+}
+FOCAL_TARGET_AVX2 void solve_face_block_avx2(const FaceInput& in, std::int64_t begin,
+                                             std::int64_t end, TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes4>(in, begin, end, r);
+}
+void solve_face_block_baseline(const FaceInput& in, std::int64_t begin, std::int64_t end,
+                               TriangleCurvatureResult& r) {
+  solve_face_block_lanes<detail::Lanes2>(in, begin, end, r);
+}
+
+using FaceBlock = void (*)(const FaceInput&, std::int64_t, std::int64_t, TriangleCurvatureResult&);
+
+FaceBlock solve_face_block_for(detail::SimdIsa isa) {
+  return detail::kernel_for(isa, solve_face_block_avx512, solve_face_block_avx2,
+                            solve_face_block_baseline);
+}
+
+/// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
+/// both normals lie in each other's hemisphere here).
+Eigen::Vector3d rotate_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& w) {
+  const Eigen::Vector3d axis = a.cross(b);
+  const double c = a.dot(b);
+  return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+}
+
+/// The face's symmetrised shape operator in a vertex's tangent frame: the face frame is rotated
+/// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
+/// stays kI exactly, as on a sphere).
+Eigen::Matrix2d operator_in_frame(const TriangleCurvatureResult& t, int f, const TangentFrame& to) {
+  const TangentFrame from = detail::frame_of(t.face_normal.row(f).transpose());
+  const auto& m = t.shape_operator.row(f);
+  Eigen::Matrix2d sym;
+  sym << m[0], 0.5 * (m[1] + m[2]), 0.5 * (m[1] + m[2]), m[3];
+  const Eigen::Vector3d x = rotate_between(from.n, to.n, from.x);
+  const Eigen::Vector3d y = rotate_between(from.n, to.n, from.y);
+  Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
+  q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
+  return q * sym * q.transpose();
+}
+
+double face_area(PositionsRef V, FacesRef F, int f) {
+  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+}  // namespace
+
+TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options) {
+  return triangle_curvature(V, F, N, options, TriangleFields{});
+}
+
+TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options,
+                                           const TriangleFields& fields) {
+  return detail::triangle_curvature(V, F, N, options, fields, detail::SimdIsa::best);
+}
+
+TriangleCurvatureResult detail::triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
+                                                   const CurvatureOptions& options,
+                                                   const TriangleFields& fields, SimdIsa isa) {
+  if (N.rows() != V.rows()) {
+    throw InvalidInput("triangle curvature: " + std::to_string(N.rows()) + " normals for " +
+                       std::to_string(V.rows()) + " vertices");
+  }
+  validate_mesh_arrays(V, F, N, "triangle curvature");
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(N, ok, options.threads);
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
+  TriangleCurvatureResult r = unwritten_faces(F.rows(), fields);
+  const FaceInput in{V, unit, ok, F, tol, fields};
+  const FaceBlock solve_block = solve_face_block_for(isa);
+  // Blocks are whole groups of every lane width, so each face's row is written by one thread.
+  detail::parallel_for_blocks(
+      F.rows(), 1024, options.threads,
+      [&](std::int64_t begin, std::int64_t end) { solve_block(in, begin, end, r); });
+  return r;
+}
+
+namespace {
+
+/// One face's part of a vertex's mean operator.
+struct FacePart {
+  double area;
+  Eigen::Matrix2d op;
+};
+
+/// Area-weighted mean of the operators of vertex i's usable faces, and their spread about it.
+void average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult& faces,
+                       const detail::VertexFaces& inc, const RowMatrixX3d& unit,
+                       const detail::ClassTolerances& tol, Eigen::Index i,
+                       std::vector<FacePart>& parts, CurvatureResult& r) {
+  const TangentFrame frame = detail::frame_of(unit.row(i).transpose());
+  parts.clear();
+  Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
+  double area = 0.0;
+  for (int k = inc.begin(i); k < inc.end(i); ++k) {
+    const int f = inc.faces[static_cast<std::size_t>(k)];
+    if (faces.point_class[f] == static_cast<std::uint8_t>(PointClass::undefined) ||
+        !(faces.face_normal.row(f).dot(frame.n) > 0.0)) {
+      continue;
+    }
+    parts.push_back({face_area(V, F, f), operator_in_frame(faces, f, frame)});
+    mean += parts.back().area * parts.back().op;
+    area += parts.back().area;
+  }
+  r.rays_used[i] = static_cast<int>(parts.size());
+  r.rays_excluded[i] = inc.size(i) - r.rays_used[i];
+  if (!(area > 0.0)) return detail::store_undefined(r, i);
+  mean /= area;
+  double spread = 0.0;
+  for (const auto& [a, m] : parts) spread += a * (m - mean).squaredNorm();
+  const auto p =
+      detail::principal_from_symmetric(mean(0, 0), 0.5 * (mean(0, 1) + mean(1, 0)), mean(1, 1));
+  detail::store_vertex(r, i, frame, p, std::sqrt(spread / area), tol);
+}
+
+}  // namespace
+
+CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
+                                                const CurvatureOptions& options) {
+  // Only what the averaging reads: the face operators, their normals and classes.
+  TriangleFields needed;
+  needed.coefficients = needed.curvatures = needed.focal_depths = false;
+  needed.directions = needed.slits = false;
+  const TriangleCurvatureResult faces = triangle_curvature(V, F, N, options, needed);
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(N, ok, options.threads);
+  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F);
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
+  CurvatureResult r = detail::unwritten_result(V.rows());
+  // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
+  detail::parallel_for_blocks(V.rows(), 256, options.threads,
+                              [&](std::int64_t begin, std::int64_t end) {
+                                std::vector<FacePart> parts;
+                                for (auto i = begin; i < end; ++i) {
+                                  if (ok[static_cast<std::size_t>(i)]) {
+                                    average_at_vertex(V, F, faces, inc, unit, tol, i, parts, r);
+                                  } else {
+                                    detail::store_undefined(r, i);
+                                    r.rays_used[i] = r.rays_excluded[i] = 0;
+                                  }
+                                }
+                              });
+  return r;
+}
+
+}  // namespace focal

@@ -1,0 +1,176 @@
+#pragma once
+/// \file io_detail.h
+/// Internal helpers shared by the mesh readers and writers: whole-file reading, error messages
+/// that name the file and the place, text scanning with line numbers, fan triangulation, number
+/// formatting and the atomic (temporary file + rename) writer.
+
+#include <cerrno>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "focal/core/mesh.h"
+#include "focal/io/mesh_io.h"
+
+namespace focal::io_detail {
+
+/// Throws IoError("<path>: <what>").
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what);
+/// Throws IoError("<path>: line <line>: <what>").
+[[noreturn]] void fail_at_line(const std::filesystem::path& path, std::size_t line,
+                               const std::string& what);
+/// Throws IoError("<path>: byte offset <offset>: <what>").
+[[noreturn]] void fail_at_offset(const std::filesystem::path& path, std::size_t offset,
+                                 const std::string& what);
+
+/// The whole file in memory (one read, so that parsers work on a contiguous buffer).
+/// \throw IoError when the path is missing, a directory or unreadable.
+[[nodiscard]] std::string read_whole_file(const std::filesystem::path& path);
+
+/// Throws IoError unless `count` elements of at least `min_bytes` each fit in `available` bytes.
+/// Called before anything is allocated for a count declared in a file header, so that a header
+/// claiming 1e12 vertices is rejected instead of exhausting memory. `where` is the place the
+/// elements start ("line 12", "byte offset 345"), for the message.
+void check_count_fits(const std::filesystem::path& path, std::string_view where,
+                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                      std::string_view what);
+
+/// `'text'`, for messages. (Also avoids "'" + std::string temporaries, on which GCC 12 gives a
+/// false -Wrestrict warning.)
+[[nodiscard]] std::string quoted(std::string_view text);
+
+/// Lower-case ASCII copy.
+[[nodiscard]] std::string to_lower(std::string_view s);
+
+/// Splits a text buffer into lines ('\n', with a trailing '\r' removed) and counts them.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text, std::size_t first_line = 1)
+      : text_(text), next_line_(first_line) {}
+  /// Next line, false at the end of the text.
+  bool next(std::string_view& line);
+  /// 1-based number of the line last returned by next().
+  [[nodiscard]] std::size_t line_number() const { return next_line_ - 1; }
+  /// Offset just past the line last returned (its '\n' included).
+  [[nodiscard]] std::size_t offset() const { return pos_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  std::size_t next_line_;
+};
+
+/// Splits `line` at blanks (space, tab, CR, VT, FF) into `tokens` (cleared first).
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
+
+/// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
+[[nodiscard]] bool parse_double(std::string_view token, double& value);
+/// Parses a whole token as a decimal integer (a leading '+' accepted).
+[[nodiscard]] bool parse_int(std::string_view token, std::int64_t& value);
+
+/// Triangles collected while reading: polygons are fan-triangulated (v0, vk, vk+1) and each
+/// triangle remembers the index of its input polygon.
+class TriangleCollector {
+ public:
+  void reserve(std::size_t polygons);
+  void add_polygon(const std::int32_t* corners, std::size_t count, std::int32_t polygon);
+  /// Moves the collected triangles into mesh.F and mesh.face_source.
+  void move_into(Mesh& mesh);
+
+ private:
+  std::vector<std::int32_t> corners_;
+  std::vector<std::int32_t> source_;
+};
+
+/// Appends the shortest text that reads back to exactly `value`; NaN as `nan`, infinities as
+/// `inf` / `-inf`.
+void append_number(std::string& out, double value);
+void append_number(std::string& out, float value);
+void append_number(std::string& out, std::int64_t value);
+
+/// "3 a b c\n": one triangle as OFF and ascii PLY write it.
+inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMatrixX3i>& F,
+                                  Eigen::Index f) {
+  out += '3';
+  for (int c = 0; c < 3; ++c) {
+    out += ' ';
+    append_number(out, static_cast<std::int64_t>(F(f, c)));
+  }
+  out += '\n';
+}
+
+/// Buffered output to the temporary file of write_atomically().
+class OutputSink {
+ public:
+  OutputSink(std::FILE* file, const std::filesystem::path& target) : file_(file), target_(target) {}
+  /// The buffer to append to; call maybe_flush() now and then.
+  std::string& buffer() { return buffer_; }
+  void maybe_flush() {
+    if (buffer_.size() >= kFlushBytes) flush();
+  }
+  /// Writes the buffer out. \throw IoError naming the target on failure.
+  void flush();
+  /// Writes the buffer out, then `bytes` bytes from `data` without copying them into the buffer
+  /// (for writers that format large blocks themselves). \throw IoError as flush().
+  void write(const char* data, std::size_t bytes) {
+    flush();
+    if (std::fwrite(data, 1, bytes, file_) != bytes) {
+      fail(target_, std::string("write failed: ") + std::strerror(errno));
+    }
+  }
+
+ private:
+  static constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
+  std::FILE* file_;
+  const std::filesystem::path& target_;
+  std::string buffer_;
+};
+
+/// Runs `body` on a temporary file in the folder of `path`, then renames it to `path`. On any
+/// failure (or exception from `body`) the temporary file is removed and `path` is left as it was.
+/// \throw IoError naming `path` when the file cannot be created, written or renamed.
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(OutputSink&)>& body);
+
+/// One per-vertex column for write_ply_columns(): value i is f64[i * stride] or u8[i * stride],
+/// read in place, so that callers holding the values in other arrays (a matrix column, a uint8
+/// code vector) need not copy them into a VertexProperty first.
+struct PlyColumn {
+  std::string_view name;
+  PropertyType type = PropertyType::float32;
+  const double* f64 = nullptr;       ///< the values when they are doubles, else null
+  const std::uint8_t* u8 = nullptr;  ///< the values when they are uint8 codes, else null
+  Eigen::Index size = 0;             ///< number of values
+  Eigen::Index stride = 1;           ///< distance between consecutive values, in elements
+
+  [[nodiscard]] double value(Eigen::Index i) const {
+    return f64 != nullptr ? f64[i * stride] : static_cast<double>(u8[i * stride]);
+  }
+};
+
+/// write_ply() on columns: same file, same validation and exceptions.
+void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
+                       std::span<const PlyColumn> columns, const PlyWriteOptions& options);
+
+// The per-format readers, dispatched by read_mesh().
+[[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_ply(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
+
+// The same readers on the contents of a file already in memory (read_X(path) is
+// parse_X(path, read_whole_file(path))); `path` only names the file in messages. The fuzz targets
+// in fuzz/ call these directly. \throw IoError as the readers.
+[[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
+
+}  // namespace focal::io_detail

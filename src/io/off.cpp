@@ -1,0 +1,219 @@
+// OFF reading and writing (Geomview's Object File Format, ascii). The keyword may carry the
+// prefixes ST (texture coordinates), C (colours) and N (normals), in that order: [ST][C][N]OFF.
+// Vertex lines are `x y z [nx ny nz] [colour] [s t]`, face lines `n i0 .. in-1 [colour]`;
+// colours and texture coordinates are skipped. `#` starts a comment.
+
+#include <cmath>
+
+#include "focal/core/error.h"
+#include "focal/io/mesh_io.h"
+#include "io/detail.h"
+
+namespace focal {
+namespace {
+
+using io_detail::fail;
+using io_detail::fail_at_line;
+
+class OffReader {
+ public:
+  OffReader(const std::filesystem::path& path, std::string_view text)
+      : path_(path), text_(text), cursor_(text) {}
+
+  Mesh read() {
+    if (!next_line()) fail(path_, "empty file, expected an OFF header");
+    const bool normals = parse_keyword(tokens_[0]);
+    tokens_.erase(tokens_.begin());
+    // Counts usually follow on the next line, but "OFF 8 6 12" on one line is common too.
+    if (tokens_.empty() && !next_line()) fail(path_, "file ends before the element counts");
+    const auto [vertex_count, face_count] = parse_counts();
+
+    // Every vertex and face takes at least one non-blank line ("x\n"). The bound is loose on
+    // purpose: it only has to stop a header claiming 1e12 vertices before allocation, while a
+    // merely malformed file gets the precise message of the line where it goes wrong.
+    const std::size_t rest = text_.size() - cursor_.offset();
+    const std::string where = "line " + std::to_string(cursor_.line_number() + 1);
+    io_detail::check_count_fits(path_, where, vertex_count, 2, rest, "vertices");
+    io_detail::check_count_fits(path_, where, face_count, 2, rest, "faces");
+
+    Mesh mesh;
+    read_vertices(static_cast<Eigen::Index>(vertex_count), normals, mesh);
+    read_faces(static_cast<std::int64_t>(face_count), static_cast<std::int64_t>(vertex_count),
+               mesh);
+    return mesh;
+  }
+
+ private:
+  /// Next line with tokens (comments and blank lines skipped); false at the end of the file.
+  bool next_line() {
+    std::string_view line;
+    while (cursor_.next(line)) {
+      const std::size_t hash = line.find('#');
+      if (hash != std::string_view::npos) line = line.substr(0, hash);
+      io_detail::split_tokens(line, tokens_);
+      if (!tokens_.empty()) return true;
+    }
+    return false;
+  }
+
+  /// True for a keyword with the N prefix (vertex normals follow the coordinates).
+  bool parse_keyword(std::string_view keyword) const {
+    std::string_view k = keyword;
+    if (k.size() < 3 || k.substr(k.size() - 3) != "OFF") {
+      fail_at_line(path_, cursor_.line_number(),
+                   "not an OFF file (expected a keyword such as OFF or NOFF, got '" +
+                       std::string(keyword) + "')");
+    }
+    k.remove_suffix(3);
+    if (k.starts_with("ST")) k.remove_prefix(2);
+    if (k.starts_with("C")) k.remove_prefix(1);
+    const bool normals = k.starts_with("N");
+    if (normals) k.remove_prefix(1);
+    if (!k.empty()) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "unsupported OFF variant '" + std::string(keyword) +
+                       "' (4OFF and nOFF are not 3-d meshes)");
+    }
+    if (tokens_.size() > 1 && tokens_[1] == "BINARY") {
+      fail_at_line(path_, cursor_.line_number(), "binary OFF is not supported");
+    }
+    return normals;
+  }
+
+  std::pair<std::uint64_t, std::uint64_t> parse_counts() const {
+    std::int64_t counts[3] = {0, 0, 0};
+    const bool ok = (tokens_.size() == 2 || tokens_.size() == 3) &&
+                    io_detail::parse_int(tokens_[0], counts[0]) &&
+                    io_detail::parse_int(tokens_[1], counts[1]) &&
+                    (tokens_.size() == 2 || io_detail::parse_int(tokens_[2], counts[2]));
+    if (!ok || counts[0] < 0 || counts[1] < 0) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "expected the counts '<vertices> <faces> [<edges>]' (non-negative integers)");
+    }
+    return {static_cast<std::uint64_t>(counts[0]), static_cast<std::uint64_t>(counts[1])};
+  }
+
+  double number(std::size_t t) const {
+    double value = 0.0;
+    if (!io_detail::parse_double(tokens_[t], value)) {
+      fail_at_line(path_, cursor_.line_number(),
+                   io_detail::quoted(tokens_[t]) + " is not a number");
+    }
+    return value;
+  }
+
+  void read_vertices(Eigen::Index count, bool normals, Mesh& mesh) {
+    const std::size_t needed = normals ? 6 : 3;
+    mesh.V.resize(count, 3);
+    if (normals) mesh.N.resize(count, 3);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      if (!next_line()) {
+        fail_at_line(
+            path_, cursor_.line_number(),
+            "file ends inside vertex " + std::to_string(i) + " of " + std::to_string(count));
+      }
+      if (tokens_.size() < needed) {
+        fail_at_line(path_, cursor_.line_number(),
+                     "vertex " + std::to_string(i) + ": expected " + std::to_string(needed) +
+                         (normals ? " coordinates and normal components" : " coordinates") +
+                         ", got " + std::to_string(tokens_.size()));
+      }
+      for (int c = 0; c < 3; ++c) mesh.V(i, c) = number(static_cast<std::size_t>(c));
+      for (int c = 0; normals && c < 3; ++c) mesh.N(i, c) = number(static_cast<std::size_t>(3 + c));
+    }
+  }
+
+  void read_faces(std::int64_t count, std::int64_t vertex_count, Mesh& mesh) {
+    io_detail::TriangleCollector triangles;
+    triangles.reserve(static_cast<std::size_t>(count));
+    std::vector<std::int32_t> corners;
+    for (std::int64_t f = 0; f < count; ++f) {
+      const std::string face = "face " + std::to_string(f);
+      if (!next_line()) {
+        fail_at_line(path_, cursor_.line_number(),
+                     "file ends inside " + face + " of " + std::to_string(count));
+      }
+      std::int64_t n = 0;
+      if (!io_detail::parse_int(tokens_[0], n) || n < 0) {
+        fail_at_line(path_, cursor_.line_number(),
+                     face + ": '" + std::string(tokens_[0]) + "' is not a vertex count");
+      }
+      if (n < 3) {
+        fail_at_line(path_, cursor_.line_number(),
+                     face + " has " + std::to_string(n) + " vertices; a face needs at least 3");
+      }
+      // Tokens after the indices are a colour.
+      if (tokens_.size() < static_cast<std::size_t>(n) + 1) {
+        fail_at_line(path_, cursor_.line_number(),
+                     face + ": expected " + std::to_string(n) + " vertex indices, got " +
+                         std::to_string(tokens_.size() - 1));
+      }
+      corners.resize(static_cast<std::size_t>(n));
+      for (std::size_t c = 0; c < corners.size(); ++c) {
+        corners[c] = vertex_index(tokens_[c + 1], face, vertex_count);
+      }
+      triangles.add_polygon(corners.data(), corners.size(), static_cast<std::int32_t>(f));
+    }
+    triangles.move_into(mesh);
+  }
+
+  std::int32_t vertex_index(std::string_view token, const std::string& face,
+                            std::int64_t vertex_count) const {
+    std::int64_t v = 0;
+    if (!io_detail::parse_int(token, v)) {
+      fail_at_line(path_, cursor_.line_number(),
+                   face + ": '" + std::string(token) + "' is not a vertex index");
+    }
+    if (v < 0 || v >= vertex_count) {
+      fail_at_line(path_, cursor_.line_number(),
+                   face + " refers to vertex " + std::to_string(v) + " but there are " +
+                       std::to_string(vertex_count) + " vertices");
+    }
+    return static_cast<std::int32_t>(v);
+  }
+
+  const std::filesystem::path& path_;
+  std::string_view text_;
+  io_detail::LineCursor cursor_;
+  std::vector<std::string_view> tokens_;
+};
+
+}  // namespace
+
+namespace io_detail {
+
+Mesh parse_off(const std::filesystem::path& path, std::string_view data) {
+  return OffReader(path, data).read();
+}
+
+Mesh read_off(const std::filesystem::path& path) { return parse_off(path, read_whole_file(path)); }
+
+}  // namespace io_detail
+
+void write_off(const std::filesystem::path& path, const Mesh& mesh) {
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str());
+  const bool normals = mesh.has_normals();
+  io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
+    std::string& out = sink.buffer();
+    out += normals ? "NOFF\n" : "OFF\n";
+    out += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
+    for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        if (c > 0) out += ' ';
+        io_detail::append_number(out, mesh.V(i, c));
+      }
+      for (int c = 0; normals && c < 3; ++c) {
+        out += ' ';
+        io_detail::append_number(out, mesh.N(i, c));
+      }
+      out += '\n';
+      sink.maybe_flush();
+    }
+    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+      io_detail::append_ascii_triangle(out, mesh.F, f);
+      sink.maybe_flush();
+    }
+  });
+}
+
+}  // namespace focal

@@ -1,0 +1,1047 @@
+// PLY reading (ascii, binary little and big endian) and writing.
+// Format reference: Greg Turk, "The PLY Polygon File Format" (1994), and the type aliases
+// (int8..float64) added by later writers such as VTK and rply.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <type_traits>
+
+#include "focal/core/error.h"
+#include "focal/io/mesh_io.h"
+#include "io/detail.h"
+#include "core/parallel.h"
+
+namespace focal {
+namespace {
+
+using io_detail::fail;
+using io_detail::fail_at_line;
+using io_detail::fail_at_offset;
+
+enum class Scalar : std::uint8_t { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+
+std::size_t scalar_size(Scalar t) {
+  switch (t) {
+    case Scalar::int8:
+    case Scalar::uint8:
+      return 1;
+    case Scalar::int16:
+    case Scalar::uint16:
+      return 2;
+    case Scalar::int32:
+    case Scalar::uint32:
+    case Scalar::float32:
+      return 4;
+    case Scalar::float64:
+      return 8;
+  }
+  return 0;
+}
+
+bool is_integer(Scalar t) { return t != Scalar::float32 && t != Scalar::float64; }
+
+bool parse_scalar_type(std::string_view name, Scalar& t) {
+  struct Alias {
+    std::string_view name;
+    Scalar type;
+  };
+  static constexpr Alias kAliases[] = {
+      {"char", Scalar::int8},       {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
+      {"uint8", Scalar::uint8},     {"short", Scalar::int16},     {"int16", Scalar::int16},
+      {"ushort", Scalar::uint16},   {"uint16", Scalar::uint16},   {"int", Scalar::int32},
+      {"int32", Scalar::int32},     {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
+      {"float", Scalar::float32},   {"float32", Scalar::float32}, {"double", Scalar::float64},
+      {"float64", Scalar::float64},
+  };
+  for (const auto& alias : kAliases) {
+    if (alias.name == name) {
+      t = alias.type;
+      return true;
+    }
+  }
+  return false;
+}
+
+struct PlyProperty {
+  std::string name;
+  Scalar type = Scalar::float32;  ///< the item type for a list
+  bool is_list = false;
+  Scalar count_type = Scalar::uint8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+
+  /// Bytes of the smallest binary element: every list empty.
+  [[nodiscard]] std::size_t min_binary_bytes() const {
+    std::size_t bytes = 0;
+    for (const auto& p : properties) bytes += scalar_size(p.is_list ? p.count_type : p.type);
+    return bytes;
+  }
+  [[nodiscard]] bool fixed_size() const {
+    return std::none_of(properties.begin(), properties.end(),
+                        [](const PlyProperty& p) { return p.is_list; });
+  }
+};
+
+enum class PlyEncoding { ascii, binary_little_endian, binary_big_endian };
+
+struct PlyHeader {
+  PlyEncoding encoding = PlyEncoding::ascii;
+  std::vector<PlyElement> elements;
+  std::size_t body_offset = 0;  ///< first byte after the end_header line
+  std::size_t body_line = 0;    ///< line number of the first body line (ascii)
+};
+
+PlyProperty parse_property_line(const std::filesystem::path& path, std::size_t line,
+                                const std::vector<std::string_view>& tokens) {
+  PlyProperty prop;
+  auto type_of = [&](std::string_view name) {
+    Scalar t{};
+    if (!parse_scalar_type(name, t)) {
+      fail_at_line(path, line, "unknown property type '" + std::string(name) + "'");
+    }
+    return t;
+  };
+  if (tokens.size() >= 2 && tokens[1] == "list") {
+    if (tokens.size() != 5) {
+      fail_at_line(path, line, "expected 'property list <count type> <item type> <name>'");
+    }
+    prop.is_list = true;
+    prop.count_type = type_of(tokens[2]);
+    prop.type = type_of(tokens[3]);
+    prop.name = tokens[4];
+    if (!is_integer(prop.count_type)) {
+      fail_at_line(path, line, "list count type must be an integer type");
+    }
+    return prop;
+  }
+  if (tokens.size() != 3) fail_at_line(path, line, "expected 'property <type> <name>'");
+  prop.type = type_of(tokens[1]);
+  prop.name = tokens[2];
+  return prop;
+}
+
+PlyHeader parse_header(const std::filesystem::path& path, std::string_view data) {
+  io_detail::LineCursor cursor(data);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  if (!cursor.next(line) || line != "ply") fail(path, "not a PLY file (first line is not 'ply')");
+  PlyHeader header;
+  bool have_format = false;
+  while (cursor.next(line)) {
+    const std::size_t n = cursor.line_number();
+    io_detail::split_tokens(line, tokens);
+    if (tokens.empty()) continue;
+    const std::string_view key = tokens[0];
+    if (key == "comment" || key == "obj_info") continue;
+    if (key == "end_header") {
+      if (!have_format) fail_at_line(path, n, "end_header before the format line");
+      header.body_offset = cursor.offset();
+      header.body_line = n + 1;
+      return header;
+    }
+    if (key == "format") {
+      if (tokens.size() != 3) fail_at_line(path, n, "expected 'format <encoding> 1.0'");
+      if (tokens[1] == "ascii") {
+        header.encoding = PlyEncoding::ascii;
+      } else if (tokens[1] == "binary_little_endian") {
+        header.encoding = PlyEncoding::binary_little_endian;
+      } else if (tokens[1] == "binary_big_endian") {
+        header.encoding = PlyEncoding::binary_big_endian;
+      } else {
+        fail_at_line(path, n, "unknown format '" + std::string(tokens[1]) + "'");
+      }
+      have_format = true;
+    } else if (key == "element") {
+      std::int64_t count = 0;
+      if (tokens.size() != 3 || !io_detail::parse_int(tokens[2], count) || count < 0) {
+        fail_at_line(path, n, "expected 'element <name> <count>' with a count >= 0");
+      }
+      header.elements.push_back({std::string(tokens[1]), static_cast<std::uint64_t>(count), {}});
+    } else if (key == "property") {
+      if (header.elements.empty()) fail_at_line(path, n, "property before any element");
+      header.elements.back().properties.push_back(parse_property_line(path, n, tokens));
+    } else {
+      fail_at_line(path, n, "unknown header keyword '" + std::string(key) + "'");
+    }
+  }
+  fail(path, "the header has no end_header line");
+}
+
+/// Where each property of the vertex element goes: 0..2 x y z, 3..5 nx ny nz, -1 skipped.
+std::vector<int> vertex_roles(const std::filesystem::path& path, const PlyElement& vertex,
+                              bool& has_normals) {
+  static constexpr std::string_view kNames[6] = {"x", "y", "z", "nx", "ny", "nz"};
+  std::vector<int> roles(vertex.properties.size(), -1);
+  int found[6] = {-1, -1, -1, -1, -1, -1};
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    const auto& p = vertex.properties[i];
+    for (int r = 0; r < 6; ++r) {
+      if (p.name == kNames[r] && !p.is_list && found[r] < 0) {
+        found[r] = static_cast<int>(i);
+        roles[i] = r;
+      }
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    if (found[r] < 0) {
+      fail(path, "the vertex element has no scalar property '" + std::string(kNames[r]) + "'");
+    }
+  }
+  has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
+  if (!has_normals) {
+    for (int& r : roles) r = r >= 3 ? -1 : r;
+  }
+  return roles;
+}
+
+/// Index of the face element's vertex list property.
+std::size_t face_list_property(const std::filesystem::path& path, const PlyElement& face) {
+  for (std::size_t i = 0; i < face.properties.size(); ++i) {
+    const auto& p = face.properties[i];
+    if (p.name == "vertex_indices" || p.name == "vertex_index") {
+      if (!p.is_list) fail(path, "face property '" + p.name + "' is not a list");
+      if (!is_integer(p.type)) fail(path, "face property '" + p.name + "' has non-integer items");
+      return i;
+    }
+  }
+  fail(path, "the face element has no list property 'vertex_indices' or 'vertex_index'");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Binary body
+
+template <class T>
+T load(const unsigned char* p, bool swap) {
+  unsigned char bytes[sizeof(T)];
+  if (swap) {
+    for (std::size_t i = 0; i < sizeof(T); ++i) bytes[i] = p[sizeof(T) - 1 - i];
+  } else {
+    std::memcpy(bytes, p, sizeof(T));
+  }
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+/// A binary scalar of type t converted to Out. Integer reads (indices, list counts) only see
+/// integer types: the header parser rejects float index and count types.
+template <class Out>
+Out load_as(const unsigned char* p, Scalar t, bool swap) {
+  switch (t) {
+    case Scalar::int8:
+      return static_cast<Out>(load<std::int8_t>(p, swap));
+    case Scalar::uint8:
+      return static_cast<Out>(load<std::uint8_t>(p, swap));
+    case Scalar::int16:
+      return static_cast<Out>(load<std::int16_t>(p, swap));
+    case Scalar::uint16:
+      return static_cast<Out>(load<std::uint16_t>(p, swap));
+    case Scalar::int32:
+      return static_cast<Out>(load<std::int32_t>(p, swap));
+    case Scalar::uint32:
+      return static_cast<Out>(load<std::uint32_t>(p, swap));
+    case Scalar::float32:
+      if constexpr (std::is_floating_point_v<Out>) return static_cast<Out>(load<float>(p, swap));
+      break;
+    case Scalar::float64:
+      if constexpr (std::is_floating_point_v<Out>) return static_cast<Out>(load<double>(p, swap));
+      break;
+  }
+  return Out{0};
+}
+
+class BinaryBody {
+ public:
+  BinaryBody(const std::filesystem::path& path, std::string_view data, std::size_t offset,
+             bool swap)
+      : path_(path),
+        begin_(reinterpret_cast<const unsigned char*>(data.data())),
+        p_(begin_ + offset),
+        end_(begin_ + data.size()),
+        swap_(swap) {}
+
+  /// Rejects a count that cannot fit in the rest of the file, before anything is allocated.
+  void check_fits(const PlyElement& e) const {
+    const std::size_t min_bytes = e.min_binary_bytes();
+    const auto remaining = static_cast<std::uint64_t>(end_ - p_);
+    if (min_bytes > 0 && e.count > remaining / min_bytes && e.fixed_size()) {
+      // Fixed-size elements: say exactly which one the file ends in.
+      const std::uint64_t complete = remaining / min_bytes;
+      fail_at_offset(path_, offset() + complete * min_bytes,
+                     "file ends inside " + e.name + " " + std::to_string(complete) + " of " +
+                         std::to_string(e.count));
+    }
+    io_detail::check_count_fits(path_, "byte offset " + std::to_string(offset()), e.count,
+                                min_bytes, remaining, e.name + " elements");
+  }
+
+  void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
+    if (e.fixed_size()) {
+      read_fixed_vertices(e, roles, V, N);
+      return;
+    }
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      const unsigned char* start = p_;
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const auto& prop = e.properties[k];
+        if (prop.is_list) {
+          skip_list(prop, e, i, start);
+          continue;
+        }
+        require(scalar_size(prop.type), e, i, start);
+        const int role = roles[k];
+        if (role >= 0) {
+          const double value = load_as<double>(p_, prop.type, swap_);
+          if (role < 3) {
+            V[3 * i + role] = value;
+          } else {
+            N[3 * i + role - 3] = value;
+          }
+        }
+        p_ += scalar_size(prop.type);
+      }
+    }
+  }
+
+  /// Reads the face element straight into mesh.F and mesh.face_source, in parallel, when every
+  /// face is a triangle stored at a fixed stride (no other list property) and every index is in
+  /// range. Returns false, having read and changed nothing, otherwise: read_faces() then gives
+  /// the exact results and error messages of the serial reader.
+  bool read_triangle_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
+                           Mesh& mesh) {
+    std::size_t count_offset = 0;
+    std::size_t stride = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const auto& prop = e.properties[k];
+      if (k == list_prop) {
+        count_offset = stride;
+        stride += scalar_size(prop.count_type) + 3 * scalar_size(prop.type);
+      } else if (prop.is_list) {
+        return false;
+      } else {
+        stride += scalar_size(prop.type);
+      }
+    }
+    const auto remaining = static_cast<std::uint64_t>(end_ - p_);
+    if (e.count == 0 || e.count > remaining / stride ||
+        e.count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
+      return false;
+    }
+    const PlyProperty& list = e.properties[list_prop];
+    const std::size_t count_bytes = scalar_size(list.count_type);
+    const std::size_t item = scalar_size(list.type);
+    // `list uchar int` (or uint) in the host's byte order, as focal and most writers store it.
+    const bool common = !swap_ && list.count_type == Scalar::uint8 &&
+                        (list.type == Scalar::int32 || list.type == Scalar::uint32);
+    const auto faces = static_cast<std::int64_t>(e.count);
+    RowMatrixX3i F(faces, 3);
+    Eigen::VectorXi source(faces);
+    detail::advise_huge_pages(F.data(), sizeof(std::int32_t) * F.size());
+    detail::advise_huge_pages(source.data(), sizeof(std::int32_t) * source.size());
+    std::int32_t* corners = F.data();
+    const unsigned char* first = p_ + count_offset;
+    // One flag per block of faces (blocks independent of the thread count): the first pass
+    // both checks and converts, so a valid file is read once.
+    constexpr std::int64_t kBlock = 1 << 14;
+    std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
+    detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+      bool ok = true;
+      if (common) {
+        for (std::int64_t f = begin; f < end; ++f) {
+          const unsigned char* rec = first + static_cast<std::size_t>(f) * stride;
+          ok &= rec[0] == 3;
+          for (int c = 0; c < 3; ++c) {
+            const std::int64_t v = list.type == Scalar::int32
+                                       ? std::int64_t{load<std::int32_t>(rec + 1 + 4 * c, false)}
+                                       : std::int64_t{load<std::uint32_t>(rec + 1 + 4 * c, false)};
+            ok &= v >= 0 && v < vertex_count;
+            corners[3 * f + c] = static_cast<std::int32_t>(v);
+          }
+          source[f] = static_cast<std::int32_t>(f);
+        }
+      } else {
+        for (std::int64_t f = begin; f < end; ++f) {
+          const unsigned char* rec = first + static_cast<std::size_t>(f) * stride;
+          ok &= load_as<std::int64_t>(rec, list.count_type, swap_) == 3;
+          rec += count_bytes;
+          for (int c = 0; c < 3; ++c) {
+            const std::int64_t v = load_as<std::int64_t>(rec + c * item, list.type, swap_);
+            ok &= v >= 0 && v < vertex_count;
+            corners[3 * f + c] = static_cast<std::int32_t>(v);
+          }
+          source[f] = static_cast<std::int32_t>(f);
+        }
+      }
+      if (!ok) bad[static_cast<std::size_t>(begin / kBlock)] = 1;
+    });
+    if (std::find(bad.begin(), bad.end(), 1) != bad.end()) return false;
+    mesh.F = std::move(F);
+    mesh.face_source = std::move(source);
+    p_ += e.count * stride;
+    return true;
+  }
+
+  void read_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
+                  io_detail::TriangleCollector& triangles) {
+    std::vector<std::int32_t> corners;
+    for (std::uint64_t f = 0; f < e.count; ++f) {
+      const unsigned char* start = p_;
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const auto& prop = e.properties[k];
+        if (k != list_prop) {
+          if (prop.is_list) {
+            skip_list(prop, e, f, start);
+          } else {
+            require(scalar_size(prop.type), e, f, start);
+            p_ += scalar_size(prop.type);
+          }
+          continue;
+        }
+        const std::int64_t n = read_count(prop, e, f, start);
+        if (n < 3) {
+          fail_at_offset(path_, offset_of(start),
+                         "face " + std::to_string(f) + " has " + std::to_string(n) +
+                             " vertices; a face needs at least 3");
+        }
+        const std::size_t item = scalar_size(prop.type);
+        require(static_cast<std::size_t>(n) * item, e, f, start);
+        corners.resize(static_cast<std::size_t>(n));
+        for (std::int64_t c = 0; c < n; ++c) {
+          const std::int64_t v = load_as<std::int64_t>(p_, prop.type, swap_);
+          if (v < 0 || v >= vertex_count) {
+            fail_at_offset(path_, offset_of(start),
+                           "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
+                               " but there are " + std::to_string(vertex_count) + " vertices");
+          }
+          corners[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(v);
+          p_ += item;
+        }
+        triangles.add_polygon(corners.data(), corners.size(), static_cast<std::int32_t>(f));
+      }
+    }
+  }
+
+  void skip_element(const PlyElement& e) {
+    if (e.fixed_size()) {
+      p_ += e.count * e.min_binary_bytes();  // check_fits() made sure this is inside the file
+      return;
+    }
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      const unsigned char* start = p_;
+      for (const auto& prop : e.properties) {
+        if (prop.is_list) {
+          skip_list(prop, e, i, start);
+        } else {
+          require(scalar_size(prop.type), e, i, start);
+          p_ += scalar_size(prop.type);
+        }
+      }
+    }
+  }
+
+  [[nodiscard]] std::uint64_t offset() const { return offset_of(p_); }
+
+ private:
+  /// Fixed-size records: check_fits() made sure all of them are in the file, so no record can
+  /// fail and they are converted in parallel blocks.
+  void read_fixed_vertices(const PlyElement& e, const std::vector<int>& roles, double* V,
+                           double* N) {
+    if (e.count == 0) return;  // V and N may be null: no column pointers to form
+    struct Field {
+      std::size_t offset;
+      Scalar type;
+      double* out;  ///< column base: out[3 * i]
+    };
+    Field fields[6];
+    int used = 0;
+    std::size_t offset = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const int role = roles[k];
+      if (role >= 0) {
+        fields[used++] = {offset, e.properties[k].type, role < 3 ? V + role : N + role - 3};
+      }
+      offset += scalar_size(e.properties[k].type);
+    }
+    const std::size_t stride = offset;
+    const unsigned char* first = p_;
+    detail::parallel_for_blocks(
+        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, 0,
+        [&](std::int64_t begin, std::int64_t end) {
+          // Field by field, so that the type switch is decided once per block and field.
+          for (int k = 0; k < used; ++k) {
+            const Field& field = fields[k];
+            const unsigned char* rec = first + field.offset;
+            switch (field.type) {
+              case Scalar::float64:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] =
+                      load<double>(rec + static_cast<std::size_t>(i) * stride, swap_);
+                }
+                break;
+              case Scalar::float32:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] = load<float>(rec + static_cast<std::size_t>(i) * stride, swap_);
+                }
+                break;
+              default:
+                for (std::int64_t i = begin; i < end; ++i) {
+                  field.out[3 * i] = load_as<double>(rec + static_cast<std::size_t>(i) * stride,
+                                                     field.type, swap_);
+                }
+                break;
+            }
+          }
+        });
+    p_ += e.count * stride;
+  }
+
+  [[nodiscard]] std::uint64_t offset_of(const unsigned char* p) const {
+    return static_cast<std::uint64_t>(p - begin_);
+  }
+
+  /// Throws unless `bytes` more bytes of element `index` (which began at `start`) are present.
+  void require(std::size_t bytes, const PlyElement& e, std::uint64_t index,
+               const unsigned char* start) const {
+    if (static_cast<std::size_t>(end_ - p_) < bytes) {
+      fail_at_offset(path_, offset_of(start),
+                     "file ends inside " + e.name + " " + std::to_string(index) + " of " +
+                         std::to_string(e.count));
+    }
+  }
+
+  std::int64_t read_count(const PlyProperty& prop, const PlyElement& e, std::uint64_t index,
+                          const unsigned char* start) {
+    require(scalar_size(prop.count_type), e, index, start);
+    const std::int64_t n = load_as<std::int64_t>(p_, prop.count_type, swap_);
+    p_ += scalar_size(prop.count_type);
+    if (n < 0) {
+      fail_at_offset(
+          path_, offset_of(start),
+          e.name + " " + std::to_string(index) + ": negative list length " + std::to_string(n));
+    }
+    return n;
+  }
+
+  void skip_list(const PlyProperty& prop, const PlyElement& e, std::uint64_t index,
+                 const unsigned char* start) {
+    const std::int64_t n = read_count(prop, e, index, start);
+    const std::size_t bytes = static_cast<std::size_t>(n) * scalar_size(prop.type);
+    require(bytes, e, index, start);
+    p_ += bytes;
+  }
+
+  const std::filesystem::path& path_;
+  const unsigned char* begin_;
+  const unsigned char* p_;
+  const unsigned char* end_;
+  bool swap_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Ascii body: one element per line, blank lines ignored.
+
+class AsciiBody {
+ public:
+  AsciiBody(const std::filesystem::path& path, std::string_view body, std::size_t first_line)
+      : path_(path), cursor_(body, first_line), size_(body.size()) {}
+
+  void check_fits(const PlyElement& e) const {
+    // Each element takes at least one non-blank line ("x\n"). A loose bound on purpose: it only
+    // has to stop a header claiming 1e12 vertices before allocation; a merely malformed file
+    // gets the precise message of the line where it goes wrong.
+    if (e.properties.empty()) return;
+    io_detail::check_count_fits(path_, "line " + std::to_string(cursor_.line_number() + 1), e.count,
+                                2, size_ - cursor_.offset(), e.name + " elements");
+  }
+
+  void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      next_element(e, i);
+      std::size_t t = 0;
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const auto& prop = e.properties[k];
+        if (prop.is_list) {
+          t += 1 + list_length(prop, e, i, t);
+          continue;
+        }
+        need(t + 1, e, i);
+        const int role = roles[k];
+        if (role >= 0) {
+          double value = 0.0;
+          if (!io_detail::parse_double(tokens_[t], value)) not_a_number(e, i, tokens_[t]);
+          if (role < 3) {
+            V[3 * i + role] = value;
+          } else {
+            N[3 * i + role - 3] = value;
+          }
+        }
+        ++t;
+      }
+      finish_element(t, e, i);
+    }
+  }
+
+  void read_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
+                  io_detail::TriangleCollector& triangles) {
+    std::vector<std::int32_t> corners;
+    for (std::uint64_t f = 0; f < e.count; ++f) {
+      next_element(e, f);
+      std::size_t t = 0;
+      for (std::size_t k = 0; k < e.properties.size(); ++k) {
+        const auto& prop = e.properties[k];
+        if (!prop.is_list) {
+          need(++t, e, f);
+          continue;
+        }
+        const std::size_t n = list_length(prop, e, f, t);
+        if (k == list_prop) read_polygon(t + 1, n, f, vertex_count, corners, triangles);
+        t += 1 + n;
+      }
+      finish_element(t, e, f);
+    }
+  }
+
+  void skip_element(const PlyElement& e) {
+    if (e.properties.empty()) return;  // such elements occupy no text at all
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      next_element(e, i);
+      std::size_t t = 0;
+      for (const auto& prop : e.properties) {
+        t += prop.is_list ? 1 + list_length(prop, e, i, t) : 1;
+        need(t, e, i);
+      }
+      finish_element(t, e, i);
+    }
+  }
+
+ private:
+  void next_element(const PlyElement& e, std::uint64_t index) {
+    std::string_view line;
+    do {
+      if (!cursor_.next(line)) {
+        fail_at_line(path_, cursor_.line_number(),
+                     "file ends inside " + e.name + " " + std::to_string(index) + " of " +
+                         std::to_string(e.count));
+      }
+      io_detail::split_tokens(line, tokens_);
+    } while (tokens_.empty());
+  }
+
+  [[noreturn]] void wrong_count(const PlyElement& e, std::uint64_t index,
+                                std::size_t expected) const {
+    fail_at_line(path_, cursor_.line_number(),
+                 e.name + " " + std::to_string(index) + ": expected " + std::to_string(expected) +
+                     " values, got " + std::to_string(tokens_.size()));
+  }
+
+  void need(std::size_t tokens, const PlyElement& e, std::uint64_t index) const {
+    if (tokens > tokens_.size()) wrong_count(e, index, tokens);
+  }
+
+  void finish_element(std::size_t used, const PlyElement& e, std::uint64_t index) const {
+    if (used != tokens_.size()) wrong_count(e, index, used);
+  }
+
+  [[noreturn]] void not_a_number(const PlyElement& e, std::uint64_t index,
+                                 std::string_view token) const {
+    fail_at_line(
+        path_, cursor_.line_number(),
+        e.name + " " + std::to_string(index) + ": '" + std::string(token) + "' is not a number");
+  }
+
+  std::int64_t integer(std::size_t t, const PlyElement& e, std::uint64_t index) const {
+    std::int64_t value = 0;
+    if (!io_detail::parse_int(tokens_[t], value)) {
+      fail_at_line(path_, cursor_.line_number(),
+                   e.name + " " + std::to_string(index) + ": '" + std::string(tokens_[t]) +
+                       "' is not an integer");
+    }
+    return value;
+  }
+
+  /// Length of the list whose count is token t; checks that its items are on the line.
+  std::size_t list_length(const PlyProperty& prop, const PlyElement& e, std::uint64_t index,
+                          std::size_t t) const {
+    need(t + 1, e, index);
+    const std::int64_t n = integer(t, e, index);
+    if (n < 0) {
+      fail_at_line(
+          path_, cursor_.line_number(),
+          e.name + " " + std::to_string(index) + ": negative length of list '" + prop.name + "'");
+    }
+    need(t + 1 + static_cast<std::size_t>(n), e, index);
+    return static_cast<std::size_t>(n);
+  }
+
+  void read_polygon(std::size_t first, std::size_t n, std::uint64_t f, std::int64_t vertex_count,
+                    std::vector<std::int32_t>& corners, io_detail::TriangleCollector& triangles) {
+    const std::size_t line = cursor_.line_number();
+    if (n < 3) {
+      fail_at_line(path_, line,
+                   "face " + std::to_string(f) + " has " + std::to_string(n) +
+                       " vertices; a face needs at least 3");
+    }
+    corners.resize(n);
+    for (std::size_t c = 0; c < n; ++c) {
+      std::int64_t v = 0;
+      if (!io_detail::parse_int(tokens_[first + c], v)) {
+        fail_at_line(path_, line,
+                     "face " + std::to_string(f) + ": '" + std::string(tokens_[first + c]) +
+                         "' is not a vertex index");
+      }
+      if (v < 0 || v >= vertex_count) {
+        fail_at_line(path_, line,
+                     "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
+                         " but there are " + std::to_string(vertex_count) + " vertices");
+      }
+      corners[c] = static_cast<std::int32_t>(v);
+    }
+    triangles.add_polygon(corners.data(), n, static_cast<std::int32_t>(f));
+  }
+
+  const std::filesystem::path& path_;
+  io_detail::LineCursor cursor_;
+  std::size_t size_;
+  std::vector<std::string_view> tokens_;
+};
+
+/// Reads every element in file order with `Body` (BinaryBody or AsciiBody).
+template <class Body>
+Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body& body) {
+  const auto vertex_it = std::find_if(header.elements.begin(), header.elements.end(),
+                                      [](const PlyElement& e) { return e.name == "vertex"; });
+  if (vertex_it == header.elements.end()) fail(path, "the header has no vertex element");
+  bool has_normals = false;
+  const std::vector<int> roles = vertex_roles(path, *vertex_it, has_normals);
+  const auto vertex_count = static_cast<std::int64_t>(vertex_it->count);
+
+  Mesh mesh;
+  io_detail::TriangleCollector triangles;
+  bool vertices_done = false;
+  bool faces_done = false;
+  bool faces_direct = false;  // read_triangle_faces() filled mesh.F and mesh.face_source
+  for (const PlyElement& e : header.elements) {
+    body.check_fits(e);
+    if (e.name == "vertex" && !vertices_done) {
+      mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
+      detail::advise_huge_pages(mesh.V.data(), sizeof(double) * mesh.V.size());
+      if (has_normals) {
+        mesh.N.resize(static_cast<Eigen::Index>(e.count), 3);
+        detail::advise_huge_pages(mesh.N.data(), sizeof(double) * mesh.N.size());
+      }
+      body.read_vertices(e, roles, mesh.V.data(), has_normals ? mesh.N.data() : nullptr);
+      vertices_done = true;
+    } else if (e.name == "face" && !faces_done) {
+      const std::size_t list_prop = face_list_property(path, e);
+      if constexpr (std::is_same_v<Body, BinaryBody>) {
+        faces_direct = body.read_triangle_faces(e, list_prop, vertex_count, mesh);
+      }
+      if (!faces_direct) {
+        triangles.reserve(static_cast<std::size_t>(e.count));
+        body.read_faces(e, list_prop, vertex_count, triangles);
+      }
+      faces_done = true;
+    } else {
+      body.skip_element(e);
+    }
+  }
+  if (!faces_direct) triangles.move_into(mesh);
+  return mesh;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+std::string_view ply_type_name(PropertyType t) {
+  switch (t) {
+    case PropertyType::float32:
+      return "float";
+    case PropertyType::float64:
+      return "double";
+    case PropertyType::uint8:
+      return "uchar";
+    case PropertyType::int32:
+      return "int";
+  }
+  return "double";
+}
+
+bool valid_property_name(std::string_view name) {
+  if (name.empty()) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char c) { return static_cast<unsigned char>(c) > ' ' && c != 127; });
+}
+
+using io_detail::PlyColumn;
+
+/// Throws InvalidInput for anything the file could not represent faithfully.
+void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
+                      std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
+  const std::string what = "write_ply: " + path.string();
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
+  std::vector<std::string_view> names = {"x", "y", "z"};
+  if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
+  for (const auto& column : columns) {
+    const std::string name(column.name);
+    if (!valid_property_name(name)) {
+      throw InvalidInput(what + ": property name '" + name + "' is empty or contains blanks");
+    }
+    if (std::find(names.begin(), names.end(), column.name) != names.end()) {
+      throw InvalidInput(what + ": property name '" + name + "' is used twice");
+    }
+    names.push_back(column.name);
+    if (column.size != mesh.V.rows()) {
+      throw InvalidInput(what + ": property '" + name + "' has " + std::to_string(column.size) +
+                         " values but the mesh has " + std::to_string(mesh.V.rows()) + " vertices");
+    }
+    // uint8 codes fit both integer types; only doubles need checking.
+    const bool is_int = column.type == PropertyType::uint8 || column.type == PropertyType::int32;
+    const double lo = column.type == PropertyType::uint8 ? 0.0 : -2147483648.0;
+    const double hi = column.type == PropertyType::uint8 ? 255.0 : 2147483647.0;
+    for (Eigen::Index i = 0; is_int && column.f64 != nullptr && i < column.size; ++i) {
+      const double v = column.value(i);
+      if (!(v >= lo && v <= hi && v == std::floor(v))) {
+        throw InvalidInput(what + ": property '" + name + "' value " + std::to_string(v) +
+                           " at vertex " + std::to_string(i) + " is not representable as " +
+                           std::string(ply_type_name(column.type)));
+      }
+    }
+  }
+  for (const auto& comment : options.comments) {
+    if (comment.find_first_of("\r\n") != std::string::npos) {
+      throw InvalidInput(what + ": a comment contains a line break");
+    }
+  }
+}
+
+std::string ply_header(const Mesh& mesh, std::span<const PlyColumn> columns,
+                       const PlyWriteOptions& options) {
+  std::string h = "ply\nformat ";
+  h += options.binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
+  for (const auto& comment : options.comments) h += "comment " + comment + "\n";
+  h += "element vertex " + std::to_string(mesh.V.rows()) + "\n";
+  h += "property double x\nproperty double y\nproperty double z\n";
+  if (mesh.has_normals()) h += "property double nx\nproperty double ny\nproperty double nz\n";
+  for (const auto& column : columns) {
+    h += "property ";
+    h += ply_type_name(column.type);
+    h += ' ';
+    h += column.name;
+    h += '\n';
+  }
+  h += "element face " + std::to_string(mesh.F.rows()) + "\n";
+  h += "property list uchar int vertex_indices\nend_header\n";
+  return h;
+}
+
+std::size_t property_bytes(PropertyType t) {
+  switch (t) {
+    case PropertyType::float32:
+    case PropertyType::int32:
+      return 4;
+    case PropertyType::float64:
+      return 8;
+    case PropertyType::uint8:
+      return 1;
+  }
+  return 8;
+}
+
+/// Stores `value` little endian at p; returns the byte after it.
+template <class T>
+char* put_little_endian(char* p, T value) {
+  std::memcpy(p, &value, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(p, p + sizeof(T));
+  return p + sizeof(T);
+}
+
+void append_property_ascii(std::string& out, PropertyType t, double v) {
+  switch (t) {
+    case PropertyType::float32:
+      io_detail::append_number(out, static_cast<float>(v));
+      break;
+    case PropertyType::float64:
+      io_detail::append_number(out, v);
+      break;
+    case PropertyType::uint8:
+    case PropertyType::int32:
+      io_detail::append_number(out, static_cast<std::int64_t>(v));
+      break;
+  }
+}
+
+void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
+                          std::span<const PlyColumn> columns) {
+  std::string& out = sink.buffer();
+  const bool normals = mesh.has_normals();
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
+    for (int c = 0; c < (normals ? 6 : 3); ++c) {
+      if (c > 0) out += ' ';
+      io_detail::append_number(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3));
+    }
+    for (const auto& column : columns) {
+      out += ' ';
+      append_property_ascii(out, column.type, column.value(i));
+    }
+    out += '\n';
+    sink.maybe_flush();
+  }
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    io_detail::append_ascii_triangle(out, mesh.F, f);
+    sink.maybe_flush();
+  }
+}
+
+/// Writes `count` fixed-size records of `record` bytes in batches of about 8 MiB, each filled in
+/// parallel blocks by put(begin, end, out) (records [begin, end) stored from `out` on) and then
+/// written. Every record has its own place in the batch, so the bytes do not depend on the
+/// thread count.
+template <class Put>
+void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::size_t record,
+                         const Put& put) {
+  if (count == 0) return;
+  constexpr std::int64_t kBlock = 1 << 12;
+  const std::int64_t per_batch =
+      std::max<std::int64_t>(1,
+                             static_cast<std::int64_t>((std::size_t{8} << 20) / record / kBlock)) *
+      kBlock;
+  const std::int64_t batch = std::min(count, per_batch);
+  const std::unique_ptr<char[]> buffer(new char[static_cast<std::size_t>(batch) * record]);
+  for (std::int64_t first = 0; first < count; first += batch) {
+    const std::int64_t n = std::min(batch, count - first);
+    detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+      put(first + begin, first + end, buffer.get() + static_cast<std::size_t>(begin) * record);
+    });
+    sink.write(buffer.get(), static_cast<std::size_t>(n) * record);
+  }
+}
+
+/// Stores column values for records [begin, end) at `offset` in each record of `out`.
+template <class T, class Source>
+void put_column(char* out, std::size_t record, std::int64_t begin, std::int64_t end,
+                const Source* values, Eigen::Index stride) {
+  for (std::int64_t i = begin; i < end; ++i) {
+    put_little_endian(out + static_cast<std::size_t>(i - begin) * record,
+                      static_cast<T>(static_cast<double>(values[i * stride])));
+  }
+}
+
+void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
+                           std::span<const PlyColumn> columns) {
+  const bool normals = mesh.has_normals();
+  std::size_t record = (normals ? 6 : 3) * sizeof(double);
+  for (const auto& column : columns) record += property_bytes(column.type);
+  // Column by column within a block, so that each type is dispatched once per block.
+  write_fixed_records(sink, mesh.V.rows(), record,
+                      [&](std::int64_t begin, std::int64_t end, char* out) {
+                        for (std::int64_t i = begin; i < end; ++i) {
+                          char* p = out + static_cast<std::size_t>(i - begin) * record;
+                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.V(i, c));
+                          if (normals) {
+                            for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.N(i, c));
+                          }
+                        }
+                        std::size_t offset = (normals ? 6 : 3) * sizeof(double);
+                        for (const auto& column : columns) {
+                          char* at = out + offset;
+                          const Eigen::Index s = column.stride;
+                          if (column.f64 != nullptr) {
+                            switch (column.type) {
+                              case PropertyType::float32:
+                                put_column<float>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::float64:
+                                put_column<double>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::uint8:
+                                put_column<std::uint8_t>(at, record, begin, end, column.f64, s);
+                                break;
+                              case PropertyType::int32:
+                                put_column<std::int32_t>(at, record, begin, end, column.f64, s);
+                                break;
+                            }
+                          } else {
+                            switch (column.type) {
+                              case PropertyType::float32:
+                                put_column<float>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::float64:
+                                put_column<double>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::uint8:
+                                put_column<std::uint8_t>(at, record, begin, end, column.u8, s);
+                                break;
+                              case PropertyType::int32:
+                                put_column<std::int32_t>(at, record, begin, end, column.u8, s);
+                                break;
+                            }
+                          }
+                          offset += property_bytes(column.type);
+                        }
+                      });
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t),
+                      [&](std::int64_t begin, std::int64_t end, char* out) {
+                        char* p = out;
+                        for (std::int64_t f = begin; f < end; ++f) {
+                          *p++ = static_cast<char>(3);
+                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.F(f, c));
+                        }
+                      });
+}
+
+}  // namespace
+
+namespace io_detail {
+
+Mesh read_ply(const std::filesystem::path& path) { return parse_ply(path, read_whole_file(path)); }
+
+Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
+  const PlyHeader header = parse_header(path, data);
+  if (header.encoding == PlyEncoding::ascii) {
+    AsciiBody body(path, data.substr(header.body_offset), header.body_line);
+    return read_body(path, header, body);
+  }
+  const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
+  const bool host_big = std::endian::native == std::endian::big;
+  BinaryBody body(path, data, header.body_offset, file_big != host_big);
+  return read_body(path, header, body);
+}
+
+}  // namespace io_detail
+
+namespace io_detail {
+
+void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
+                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
+  validate_for_ply(path, mesh, columns, options);
+  write_atomically(path, [&](OutputSink& sink) {
+    sink.buffer() += ply_header(mesh, columns, options);
+    if (options.binary) {
+      write_ply_body_binary(sink, mesh, columns);
+    } else {
+      write_ply_body_ascii(sink, mesh, columns);
+    }
+  });
+}
+
+}  // namespace io_detail
+
+void write_ply(const std::filesystem::path& path, const Mesh& mesh,
+               std::span<const VertexProperty> properties, const PlyWriteOptions& options) {
+  std::vector<PlyColumn> columns;
+  columns.reserve(properties.size());
+  for (const auto& prop : properties) {
+    columns.push_back({prop.name, prop.type, prop.values.data(), nullptr, prop.values.size(), 1});
+  }
+  io_detail::write_ply_columns(path, mesh, columns, options);
+}
+
+}  // namespace focal

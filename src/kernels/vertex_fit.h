@@ -1,0 +1,300 @@
+#pragma once
+// The per-vertex closed-form two-slit fit (paper section 5; docs/ESTIMATOR.md) as plain-data
+// math that nvcc compiles into the CUDA kernel and g++ into the CPU test that checks it against
+// estimate_curvature. No Eigen, no allocation: one thread runs fit_vertex for one vertex.
+//
+// The formulas are those of src/curvature.cpp and src/*_detail.h (frame of Duff et al., rays of
+// paper eq. 3, 3x3 normal equations in W = [a b; b c], eigen-decomposition, classification), in
+// an arithmetic type T (float on the device, double to check the formula). Three changes keep
+// float32 accurate to a few units of its rounding relative to the curvature, whatever the mesh
+// size, units or placement (docs/GPU.md):
+//  - Positions and normals arrive as float pairs hi + lo (lo = the rounding error of hi). A
+//    neighbour's offset (q_hi - p_hi) + (q_lo - p_lo) is then exact to float rounding relative to
+//    the edge length, not to the coordinates' magnitude (1e-4 edge lengths on a 1M-vertex mesh).
+//  - The slopes use the normal's change D = M - N (from the pairs): x.M = x.D because x is
+//    orthogonal to N, and x.D has float rounding relative to |D| ~ |k| h, where x.M computed from
+//    rounded M would carry an absolute 6e-8 (relative 6e-8 / (|k| h)).
+//  - Positions are scaled by a power of two near 1 / (mean edge length x rings), exactly, so that
+//    u, v are O(1) in every unit system, and the normal equations are divided by their trace/3
+//    before the solve, so that no determinant under- or overflows.
+
+#include <cmath>
+#include <cstdint>
+
+#include "kernels/host_device.h"
+
+namespace focal::cuda {
+
+/// One vertex's data, gathered by every neighbour's thread: 48 contiguous bytes in float.
+/// position = position_hi + position_lo, likewise the unit normal; normal_hi is NaN where the
+/// input normal was zero or not finite (the vertex is undefined and no neighbour uses its ray).
+template <class T>
+struct alignas(16) VertexRecord {
+  T position_hi[3];
+  T position_lo[3];
+  T normal_hi[3];
+  T normal_lo[3];
+};
+
+/// Per-vertex outputs, #V entries each (d1, d2: 3 per vertex, row-major as RowMatrixX3d).
+template <class T>
+struct VertexFitOutput {
+  T* k1;
+  T* k2;
+  T* H;
+  T* K;
+  T* d1;
+  T* d2;
+  T* residual;
+  std::uint8_t* point_class;  ///< PointClass codes
+  int* rays_used;
+  int* rays_excluded;
+};
+
+/// The one parameter struct of the kernel (plain data, shared by host and device).
+template <class T>
+struct VertexFitParams {
+  const VertexRecord<T>* vertices;  ///< #V, positions already multiplied by 1 / length_unit
+  const int* offsets;               ///< CSR of the neighbourhoods (#V + 1)
+  const int* indices;
+  int vertex_count;
+  bool gaussian;                      ///< Gaussian weights; else uniform
+  T inverse_two_width_squared;        ///< Gaussian weights exp(-d^2 * this), d in scaled units
+  T curvature_unit;                   ///< 1 / length_unit: k = (eigenvalue of W) x this (exact)
+  T zero_tolerance;                   ///< |k| at or below this is zero (absolute curvature)
+  T umbilic_tolerance;                ///< relative gap at or below this is umbilic
+  T min_relative_determinant;         ///< det / (trace/3)^3 at or below this: undefined
+  VertexFitOutput<T> out;
+};
+
+/// PointClass codes (focal/curvature.h), repeated so that this header needs no Eigen.
+enum : std::uint8_t {
+  kElliptic = 0,
+  kHyperbolic = 1,
+  kParabolic = 2,
+  kUmbilic = 3,
+  kFlat = 4,
+  kUndefined = 5,
+};
+
+template <class T>
+struct Vec3 {
+  T x, y, z;
+};
+
+template <class T>
+FOCAL_HD inline T dot(const Vec3<T>& a, const Vec3<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+/// hi + lo of `a` minus hi + lo of `b`: the hi difference first, which is exact to rounding
+/// relative to itself, then the small correction.
+template <class T>
+FOCAL_HD inline Vec3<T> pair_difference(const T* a_hi, const T* a_lo, const T* b_hi,
+                                        const T* b_lo) {
+  return {(a_hi[0] - b_hi[0]) + (a_lo[0] - b_lo[0]), (a_hi[1] - b_hi[1]) + (a_lo[1] - b_lo[1]),
+          (a_hi[2] - b_hi[2]) + (a_lo[2] - b_lo[2])};
+}
+
+/// Tangent frame (x, y, n) of Duff et al. 2017, as normal_rays_detail.h's frame_of.
+template <class T>
+struct Frame {
+  Vec3<T> x, y, n;
+};
+
+template <class T>
+FOCAL_HD inline Frame<T> frame_of(const Vec3<T>& n) {
+  const T sign = std::copysign(T(1), n.z);
+  const T a = T(-1) / (sign + n.z);
+  const T b = n.x * n.y * a;
+  return {{T(1) + sign * n.x * n.x * a, sign * b, -sign * n.x},
+          {b, sign + n.y * n.y * a, -n.y},
+          n};
+}
+
+/// A neighbour's ray (paper eq. 3) and its squared distance, in scaled units.
+template <class T>
+struct Ray {
+  T sigma, tau, u, v, distance_squared;
+};
+
+/// The ray of neighbour `q` seen from vertex `p` in `f`; false where the CPU has none (normal
+/// outside the open hemisphere of n, or anything not finite).
+template <class T>
+FOCAL_HD inline bool ray_of(const Frame<T>& f, const VertexRecord<T>& p, const VertexRecord<T>& q,
+                            Ray<T>& r) {
+  const Vec3<T> m{q.normal_hi[0], q.normal_hi[1], q.normal_hi[2]};
+  const T mz = dot(f.n, m);
+  if (!(mz > T(0))) return false;  // also rejects NaN (invalid normals are NaN)
+  const Vec3<T> d = pair_difference(q.normal_hi, q.normal_lo, p.normal_hi, p.normal_lo);
+  const Vec3<T> o = pair_difference(q.position_hi, q.position_lo, p.position_hi, p.position_lo);
+  const T inv_mz = T(1) / mz;
+  r.sigma = dot(f.x, d) * inv_mz;
+  r.tau = dot(f.y, d) * inv_mz;
+  const T oz = dot(f.n, o);
+  r.u = dot(f.x, o) - oz * r.sigma;
+  r.v = dot(f.y, o) - oz * r.tau;
+  r.distance_squared = dot(o, o);
+  return std::isfinite(r.sigma + r.tau + r.u + r.v);
+}
+
+template <class T>
+FOCAL_HD inline T ray_weight(const VertexFitParams<T>& p, const Ray<T>& r) {
+  return p.gaussian ? std::exp(-r.distance_squared * p.inverse_two_width_squared) : T(1);
+}
+
+/// Sums of the normal equations of min sum w |W x - g|^2 over w = (a, b, c). Their matrix is
+/// [[Suu, Suv, 0], [Suv, Suu + Svv, Suv], [0, Suv, Svv]] (rows (u, v, 0) -> sigma and
+/// (0, u, v) -> tau per ray), so three sums describe it.
+template <class T>
+struct NormalSums {
+  T uu = 0, uv = 0, vv = 0;
+  T r0 = 0, r1 = 0, r2 = 0;  // right-hand side
+  int rays = 0;              // rays of positive weight
+};
+
+template <class T>
+FOCAL_HD inline void accumulate(NormalSums<T>& s, const Ray<T>& r, T w) {
+  if (!(w > T(0))) return;  // as the CPU: a zero weight is no equation
+  s.uu += w * r.u * r.u;
+  s.uv += w * r.u * r.v;
+  s.vv += w * r.v * r.v;
+  s.r0 += w * r.u * r.sigma;
+  s.r1 += w * (r.v * r.sigma + r.u * r.tau);
+  s.r2 += w * r.v * r.tau;
+  ++s.rays;
+}
+
+/// Solves the normal equations when well conditioned, as two_slit_detail.h's
+/// solve_well_conditioned: det / (trace/3)^3 above the threshold. det factors exactly as
+/// (Suu + Svv)(Suu Svv - Suv^2); in units of trace/3 the entries are O(1).
+template <class T>
+FOCAL_HD inline bool solve(const NormalSums<T>& s, T min_relative_determinant, T w[3]) {
+  if (s.rays < 2) return false;
+  const T scale = T(2) * (s.uu + s.vv) / T(3);
+  if (!(scale > T(0))) return false;
+  const T inv = T(1) / scale;
+  const T a = s.uu * inv, b = s.uv * inv, c = s.vv * inv;
+  const T r0 = s.r0 * inv, r1 = s.r1 * inv, r2 = s.r2 * inv;
+  const T trace_ac = a + c;
+  const T det = trace_ac * (a * c - b * b);
+  if (!(det > min_relative_determinant)) return false;
+  // Adjugate of the symmetric [[a, b, 0], [b, a + c, b], [0, b, c]].
+  const T inv_det = T(1) / det;
+  const T c00 = trace_ac * c - b * b, c01 = -b * c, c02 = b * b;
+  const T c11 = a * c, c12 = -a * b, c22 = a * trace_ac - b * b;
+  w[0] = (c00 * r0 + c01 * r1 + c02 * r2) * inv_det;
+  w[1] = (c01 * r0 + c11 * r1 + c12 * r2) * inv_det;
+  w[2] = (c02 * r0 + c12 * r1 + c22 * r2) * inv_det;
+  return std::isfinite(w[0] + w[1] + w[2]);
+}
+
+/// Eigenvalues k1 >= k2 of [a b; b c], unit d1 of k1, d2 = d1 turned by +90 degrees; the
+/// algebraic form of curvature_detail.h's principal_from_symmetric (no atan2, no hypot).
+template <class T>
+struct Principal {
+  T k1, k2, d1x, d1y;
+};
+
+template <class T>
+FOCAL_HD inline Principal<T> principal_of(T a, T b, T c) {
+  const T mean = T(0.5) * (a + c);
+  const T d = T(0.5) * (a - c);
+  const T s = std::fmax(std::fabs(d), std::fabs(b));
+  if (s == T(0)) return {mean, mean, T(1), T(0)};
+  const T inv = T(1) / s;
+  const T ds = d * inv, bs = b * inv;
+  const T r = std::sqrt(ds * ds + bs * bs);
+  T x = ds >= T(0) ? r + ds : std::fabs(bs);
+  T y = ds >= T(0) ? bs : std::copysign(r - ds, bs);
+  const T n = T(1) / std::sqrt(T(2) * r * (r + std::fabs(ds)));
+  x *= n;
+  y *= n;
+  return {mean + s * r, mean - s * r, x, y};
+}
+
+/// curvature.cpp's classify, in T.
+template <class T>
+FOCAL_HD inline std::uint8_t classify_point(T k1, T k2, T zero_tolerance, T umbilic_tolerance) {
+  if (!std::isfinite(k1) || !std::isfinite(k2)) return kUndefined;
+  const bool zero1 = std::fabs(k1) <= zero_tolerance, zero2 = std::fabs(k2) <= zero_tolerance;
+  if (zero1 && zero2) return kFlat;
+  if (zero1 || zero2) return kParabolic;
+  if (k1 - k2 <= umbilic_tolerance * std::fmax(std::fabs(k1), std::fabs(k2))) return kUmbilic;
+  return k1 * k2 > T(0) ? kElliptic : kHyperbolic;
+}
+
+template <class T>
+FOCAL_HD inline void store_undefined(const VertexFitOutput<T>& o, int i) {
+  const T nan = static_cast<T>(NAN);  // numeric_limits is not callable in device code
+  o.k1[i] = o.k2[i] = o.H[i] = o.K[i] = o.residual[i] = nan;
+  for (int c = 0; c < 3; ++c) o.d1[3 * i + c] = o.d2[3 * i + c] = nan;
+  o.point_class[i] = kUndefined;
+}
+
+/// Weighted sum of squared misfits |W x - g|^2 and of the weights: a second pass over the
+/// neighbours, since expanding E through the normal equations cancels catastrophically (it is 0
+/// on a sphere). The rays are recomputed: cheaper on a GPU than keeping a ring in local memory.
+template <class T>
+FOCAL_HD inline void misfit(const VertexFitParams<T>& p, int i, const Frame<T>& f, const T w[3],
+                            T& energy, T& weight_sum) {
+  energy = weight_sum = T(0);
+  const VertexRecord<T>& me = p.vertices[i];
+  for (int k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
+    Ray<T> r;
+    if (!ray_of(f, me, p.vertices[p.indices[k]], r)) continue;
+    const T wt = ray_weight(p, r);
+    const T eu = w[0] * r.u + w[1] * r.v - r.sigma;
+    const T ev = w[1] * r.u + w[2] * r.v - r.tau;
+    energy += wt * (eu * eu + ev * ev);
+    weight_sum += wt;
+  }
+}
+
+/// The whole fit of vertex i: writes every output field of row i.
+template <class T>
+FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
+  const VertexFitOutput<T>& o = p.out;
+  const VertexRecord<T>& me = p.vertices[i];
+  const Vec3<T> n{me.normal_hi[0], me.normal_hi[1], me.normal_hi[2]};
+  o.rays_used[i] = o.rays_excluded[i] = 0;
+  if (!std::isfinite(n.x + n.y + n.z)) return store_undefined(o, i);
+  const Frame<T> f = frame_of(n);
+  NormalSums<T> sums;
+  int used = 0, excluded = 0;
+  for (int k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
+    Ray<T> r;
+    if (!ray_of(f, me, p.vertices[p.indices[k]], r)) {
+      ++excluded;
+      continue;
+    }
+    ++used;
+    accumulate(sums, r, ray_weight(p, r));
+  }
+  o.rays_used[i] = used;
+  o.rays_excluded[i] = excluded;
+  T w[3];
+  if (!solve(sums, p.min_relative_determinant, w)) return store_undefined(o, i);
+  T energy, weight_sum;
+  misfit(p, i, f, w, energy, weight_sum);
+  const Principal<T> e = principal_of(w[0], w[1], w[2]);
+  const T k1 = e.k1 * p.curvature_unit, k2 = e.k2 * p.curvature_unit;
+  o.k1[i] = k1;
+  o.k2[i] = k2;
+  o.H[i] = T(0.5) * (k1 + k2);
+  o.K[i] = k1 * k2;
+  const Vec3<T> d1{e.d1x * f.x.x + e.d1y * f.y.x, e.d1x * f.x.y + e.d1y * f.y.y,
+                   e.d1x * f.x.z + e.d1y * f.y.z};
+  const Vec3<T> d2{-e.d1y * f.x.x + e.d1x * f.y.x, -e.d1y * f.x.y + e.d1x * f.y.y,
+                   -e.d1y * f.x.z + e.d1x * f.y.z};
+  o.d1[3 * i] = d1.x;
+  o.d1[3 * i + 1] = d1.y;
+  o.d1[3 * i + 2] = d1.z;
+  o.d2[3 * i] = d2.x;
+  o.d2[3 * i + 1] = d2.y;
+  o.d2[3 * i + 2] = d2.z;
+  o.residual[i] = std::sqrt(energy / weight_sum);
+  o.point_class[i] = classify_point(k1, k2, p.zero_tolerance, p.umbilic_tolerance);
+}
+
+}  // namespace focal::cuda

@@ -1,0 +1,141 @@
+#include "focal/mesh/check.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/normals.h"
+#include "mesh/topology.h"
+
+namespace focal {
+namespace {
+
+/// Tolerance on |n| - 1 below which a given normal counts as unit (the estimator's, curvature.h).
+constexpr double kUnitTolerance = 1e-6;
+
+/// Sums count(i) over [0, n) in parallel blocks (integers: exact for any split).
+template <class Count>
+int parallel_count(std::int64_t n, Count&& count) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<int> sums(static_cast<std::size_t>(blocks), 0);
+  detail::parallel_blocks(n, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+    int sum = 0;
+    for (auto i = begin; i < end; ++i) sum += count(i);
+    sums[static_cast<std::size_t>(b)] = sum;
+  });
+  int total = 0;
+  for (const int sum : sums) total += sum;
+  return total;
+}
+
+/// The findings about given normals: their rows, and their direction against the faces.
+void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshTopology& topology,
+                   const OrientationReport& report, MeshFindings& out) {
+  out.non_finite_normal_count =
+      parallel_count(N.rows(), [&](std::int64_t i) { return !N.row(i).allFinite(); });
+  out.zero_normal_count = parallel_count(
+      N.rows(), [&](std::int64_t i) { return N.row(i).allFinite() && N.row(i).norm() == 0.0; });
+  out.non_unit_normal_count = parallel_count(N.rows(), [&](std::int64_t i) {
+    const double length = N.row(i).norm();
+    return N.row(i).allFinite() && length != 0.0 && std::abs(length - 1.0) > kUnitTolerance;
+  });
+  // Area weights: the face normals' own average, NaN where it does not exist (no usable face).
+  const RowMatrixX3d from_faces =
+      detail::vertex_normals_from(V, F, topology.incidence, NormalWeighting::area);
+  const std::vector<int>& component = topology.components.vertex_component;
+  struct Tally {  // vertices with both normals, those against the faces, those pointing inside
+    int compared = 0, against = 0, inside = 0, judged = 0;
+    Tally& operator+=(const Tally& o) {
+      compared += o.compared, against += o.against, inside += o.inside, judged += o.judged;
+      return *this;
+    }
+  };
+  // Keyed by component; vertices in no face have no face normal and drop out with it.
+  std::vector<Tally> tally(report.components.size());
+  detail::add_by_key_runs(
+      N.rows(), [&](std::int64_t i) { return component[static_cast<std::size_t>(i)]; },
+      [&](Tally& t, std::int64_t i) {
+        const double dot = N.row(i).dot(from_faces.row(i));
+        if (!std::isfinite(dot)) return;
+        ++t.compared;
+        t.against += dot < 0.0 ? 1 : 0;
+        const auto& info =
+            report.components[static_cast<std::size_t>(component[static_cast<std::size_t>(i)])];
+        if (!info.closed || !info.consistent || !std::isfinite(info.signed_volume)) return;
+        // The faces of an inward component point inside, so a normal with them points inside.
+        const bool inside = info.signed_volume < 0.0 ? dot > 0.0 : dot < 0.0;
+        t.inside += inside ? 1 : 0;
+        ++t.judged;
+      },
+      tally);
+  for (const Tally& t : tally) {
+    out.normals_compared_count += t.compared;
+    out.normals_against_faces_count += t.against;
+    out.inward_normal_component_count += 2 * t.inside > t.judged ? 1 : 0;
+  }
+}
+
+void append(std::string& text, int count, const char* singular, const char* plural) {
+  if (count == 0) return;
+  if (!text.empty()) text += ", ";
+  text += std::to_string(count) + " " + (count == 1 ? singular : plural);
+}
+
+}  // namespace
+
+bool MeshFindings::has_problems() const { return !summary().empty(); }
+
+std::string MeshFindings::summary() const {
+  std::string s;
+  append(s, non_finite_vertex_count, "non-finite vertex", "non-finite vertices");
+  append(s, repeated_index_face_count, "face with a repeated vertex",
+         "faces with a repeated vertex");
+  append(s, degenerate_face_count, "zero-area face", "zero-area faces");
+  append(s, duplicate_face_count, "duplicate face", "duplicate faces");
+  append(s, unreferenced_vertex_count, "unreferenced vertex", "unreferenced vertices");
+  append(s, non_manifold_edge_count, "non-manifold edge", "non-manifold edges");
+  append(s, non_manifold_vertex_count, "non-manifold vertex", "non-manifold vertices");
+  append(s, inconsistent_component_count, "inconsistently oriented component",
+         "inconsistently oriented components");
+  append(s, inward_component_count, "inward-oriented component", "inward-oriented components");
+  append(s, non_finite_normal_count, "non-finite normal", "non-finite normals");
+  append(s, zero_normal_count, "zero normal", "zero normals");
+  append(s, non_unit_normal_count, "non-unit normal", "non-unit normals");
+  append(s, normals_against_faces_count, "normal against its faces", "normals against their faces");
+  append(s, inward_normal_component_count, "component with inward normals",
+         "components with inward normals");
+  return s;
+}
+
+MeshFindings check_mesh(PositionsRef V, FacesRef F, NormalsRef N) {
+  if (!detail::face_indices_in_range(V.rows(), F) || (N.rows() != 0 && N.rows() != V.rows())) {
+    validate_mesh_arrays(V, F, N, "check_mesh");  // throws, naming the first bad face
+  }
+  // One topology pass serves the statistics and the orientation report (each computed its own).
+  const detail::MeshTopology topology = detail::mesh_topology(V.rows(), F);
+  const OrientationReport report = detail::orientation_report_from(V, F, topology);
+  MeshFindings out;
+  out.non_finite_vertex_count =
+      parallel_count(V.rows(), [&](std::int64_t i) { return !V.row(i).allFinite(); });
+  out.repeated_index_face_count =
+      parallel_count(F.rows(), [&](std::int64_t f) { return detail::has_repeated_index(F, f); });
+  // degenerate_face_count counts faces with a repeated index as degenerate too.
+  out.degenerate_face_count = detail::degenerate_face_count(V, F) - out.repeated_index_face_count;
+  out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
+  out.unreferenced_vertex_count = static_cast<int>(topology.unreferenced_vertex_count);
+  out.non_manifold_edge_count = static_cast<int>(topology.non_manifold_edge_count);
+  out.non_manifold_vertex_count = static_cast<int>(topology.non_manifold_vertex_count);
+  for (const auto& c : report.components) out.inconsistent_component_count += c.consistent ? 0 : 1;
+  out.inward_component_count = report.inward_count();
+  out.boundary_edge_count = static_cast<int>(topology.boundary_edge_count);
+  out.component_count = topology.components.count;
+  if (N.rows() > 0) check_normals(V, F, N, topology, report, out);
+  return out;
+}
+
+}  // namespace focal

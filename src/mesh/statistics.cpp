@@ -1,0 +1,172 @@
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "focal/mesh/neighbourhood.h"
+#include "core/parallel.h"
+#include "mesh/topology.h"
+
+namespace focal {
+namespace detail {
+namespace {
+
+// What one vertex contributes to the counts: edges to higher-indexed neighbours (so each edge is
+// counted once), duplicate faces whose smallest index it is (so each face is examined once).
+struct VertexCounts {
+  int edges = 0;
+  int boundary_edges = 0;
+  int non_manifold_edges = 0;
+  int duplicate_faces = 0;
+  bool non_manifold_vertex = false;
+  std::uint8_t edge_flags = 0;
+};
+
+struct Scratch {
+  std::vector<EdgeSide> sides;
+  std::vector<int> fan_parent;
+  std::vector<std::uint64_t> pairs;  // (middle, largest index) of faces whose smallest is v
+};
+
+// Faces whose sorted index triple starts with v and repeats that of an earlier face. Only the
+// number of repeats is needed, so the pairs are sorted without their faces.
+int duplicate_faces_at(FacesRef F, const VertexFaces& inc, std::int64_t v,
+                       std::vector<std::uint64_t>& pairs) {
+  pairs.clear();
+  for (int j = inc.begin(v); j < inc.end(v); ++j) {
+    const int f = inc.faces[static_cast<std::size_t>(j)];
+    std::array<int, 3> t{F(f, 0), F(f, 1), F(f, 2)};
+    if (std::min({t[0], t[1], t[2]}) != v) continue;
+    std::sort(t.begin(), t.end());
+    pairs.push_back(static_cast<std::uint64_t>(t[1]) << 32 | static_cast<std::uint32_t>(t[2]));
+  }
+  sort_small(pairs.data(), pairs.data() + pairs.size(), std::less<>());
+  int duplicates = 0;
+  for (std::size_t i = 1; i < pairs.size(); ++i) duplicates += pairs[i] == pairs[i - 1] ? 1 : 0;
+  return duplicates;
+}
+
+// All of v's findings from one sorted list of its edge sides. Fans: v's faces without a
+// repeated index (direction != 0), joined whenever they share an edge at v; their number is the
+// faces less the joins that merged two fans.
+VertexCounts vertex_counts(FacesRef F, const VertexFaces& inc, std::int64_t v, bool statistics,
+                           Scratch& s) {
+  VertexCounts counts;
+  const int proper_faces = collect_edge_sides(F, inc, v, s.sides);
+  s.fan_parent.resize(statistics ? static_cast<std::size_t>(inc.size(v)) : 0);
+  for (std::size_t i = 0; i < s.fan_parent.size(); ++i) s.fan_parent[i] = static_cast<int>(i);
+  int joins = 0;
+  for_each_edge(s.sides, [&](int other, const EdgeSide* first, const EdgeSide* last) {
+    const EdgeSide* anchor = nullptr;
+    for (const auto* side = first; statistics && side < last; ++side) {
+      if (side->direction == 0) continue;
+      if (anchor) {
+        const int a = find_root(s.fan_parent, anchor->local_face);
+        const int b = find_root(s.fan_parent, side->local_face);
+        joins += a != b ? 1 : 0;
+        unite(s.fan_parent, a, b);
+      } else {
+        anchor = side;
+      }
+    }
+    if (other < v) return;
+    const auto faces = last - first;
+    ++counts.edges;
+    counts.boundary_edges += faces == 1 ? 1 : 0;
+    counts.non_manifold_edges += faces >= 3 ? 1 : 0;
+    if (faces != 2) {
+      counts.edge_flags |= kOpenEdge;
+    } else if (!is_consistent_interior_edge(first, last)) {
+      counts.edge_flags |= kInconsistentEdge;
+    }
+  });
+  if (!statistics) return counts;
+  counts.non_manifold_vertex = proper_faces - joins > 1;
+  counts.duplicate_faces = duplicate_faces_at(F, inc, v, s.pairs);
+  return counts;
+}
+
+}  // namespace
+
+MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F, TopologyDetail detail) {
+  const bool statistics = detail == TopologyDetail::statistics;
+  MeshTopology t;
+  t.incidence = vertex_face_incidence(vertex_count, F);
+  t.components = face_components(vertex_count, F);
+  t.edge_flags.resize(static_cast<std::size_t>(vertex_count));
+  // Per-block sums of integers: exact, so the totals do not depend on the split.
+  constexpr std::int64_t kBlock = 4096;
+  const std::int64_t blocks = (vertex_count + kBlock - 1) / kBlock;
+  std::vector<std::array<std::int64_t, 6>> sums(static_cast<std::size_t>(blocks));
+  PerThread<Scratch> scratch;
+  parallel_blocks(vertex_count, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+    Scratch& s = scratch.local();
+    std::array<std::int64_t, 6> sum{};
+    for (auto v = begin; v < end; ++v) {
+      const VertexCounts c = vertex_counts(F, t.incidence, v, statistics, s);
+      t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
+      sum[0] += c.edges;
+      sum[1] += c.boundary_edges;
+      sum[2] += c.non_manifold_edges;
+      sum[3] += c.non_manifold_vertex ? 1 : 0;
+      sum[4] += c.duplicate_faces;
+      sum[5] += t.incidence.size(v) == 0 ? 1 : 0;
+    }
+    sums[static_cast<std::size_t>(b)] = sum;
+  });
+  for (const auto& sum : sums) {
+    t.edge_count += sum[0];
+    t.boundary_edge_count += sum[1];
+    t.non_manifold_edge_count += sum[2];
+    t.non_manifold_vertex_count += sum[3];
+    t.duplicate_face_count += sum[4];
+    t.unreferenced_vertex_count += sum[5];
+  }
+  return t;
+}
+
+int degenerate_face_count(PositionsRef V, FacesRef F) {
+  constexpr std::int64_t kBlock = 1 << 14;
+  const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
+  std::vector<int> count(static_cast<std::size_t>(blocks), 0);
+  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+    int n = 0;
+    for (auto f = begin; f < end; ++f) {
+      n += has_repeated_index(F, f) ||
+           is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
+                                  V.row(F(f, 2)).transpose());
+    }
+    count[static_cast<std::size_t>(b)] = n;
+  });
+  int total = 0;
+  for (const int n : count) total += n;
+  return total;
+}
+
+}  // namespace detail
+
+MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
+  if (!detail::face_indices_in_range(V.rows(), F)) {
+    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "mesh_statistics");  // throws, naming the face
+  }
+  MeshStatistics stats;
+  stats.vertex_count = static_cast<int>(V.rows());
+  stats.face_count = static_cast<int>(F.rows());
+  if (V.rows() > 0) {
+    stats.min_corner = V.colwise().minCoeff().transpose();
+    stats.max_corner = V.colwise().maxCoeff().transpose();
+  }
+  stats.mean_edge_length = mean_edge_length(V, F);
+  stats.degenerate_face_count = detail::degenerate_face_count(V, F);
+  const detail::MeshTopology t = detail::mesh_topology(V.rows(), F);
+  stats.component_count = t.components.count;
+  stats.edge_count = static_cast<int>(t.edge_count);
+  stats.boundary_edge_count = static_cast<int>(t.boundary_edge_count);
+  stats.non_manifold_edge_count = static_cast<int>(t.non_manifold_edge_count);
+  stats.non_manifold_vertex_count = static_cast<int>(t.non_manifold_vertex_count);
+  stats.duplicate_face_count = static_cast<int>(t.duplicate_face_count);
+  stats.unreferenced_vertex_count = static_cast<int>(t.unreferenced_vertex_count);
+  return stats;
+}
+
+}  // namespace focal
