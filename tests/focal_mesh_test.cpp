@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/curvature/curvature.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 

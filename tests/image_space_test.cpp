@@ -4,6 +4,7 @@
 // The accuracy table of docs/IMAGE_SPACE.md is printed (not asserted: the tests below assert) by
 //   build/release/tests/image_space_test --gtest_also_run_disabled_tests --gtest_filter='*Table'
 #include "focal/image_space/image_space.h"
+#include "focal/surfaces/geometry_image.h"
 
 #include <gtest/gtest.h>
 

@@ -24,6 +24,7 @@
 #include "focal/cuda/device.h"
 #include "focal/core/error.h"
 #include "focal/image_space/image_space.h"
+#include "focal/surfaces/geometry_image.h"
 #include "focal/surfaces/surfaces.h"
 #include "focal/curvature/triangle_curvature.h"
 

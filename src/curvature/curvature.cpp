@@ -365,24 +365,6 @@ CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRe
 
 }  // namespace
 
-std::string_view class_name(PointClass c) {
-  switch (c) {
-    case PointClass::elliptic:
-      return "elliptic";
-    case PointClass::hyperbolic:
-      return "hyperbolic";
-    case PointClass::parabolic:
-      return "parabolic";
-    case PointClass::umbilic:
-      return "umbilic";
-    case PointClass::flat:
-      return "flat";
-    case PointClass::undefined:
-      return "undefined";
-  }
-  return "undefined";
-}
-
 PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_tolerance) {
   if (!std::isfinite(k1) || !std::isfinite(k2)) return PointClass::undefined;
   const bool zero1 = std::abs(k1) <= zero_tolerance, zero2 = std::abs(k2) <= zero_tolerance;

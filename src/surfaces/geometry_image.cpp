@@ -4,7 +4,7 @@
 #include <string>
 
 #include "focal/core/error.h"
-#include "focal/image_space/image_space.h"
+#include "focal/surfaces/geometry_image.h"
 #include "core/parallel.h"
 
 namespace focal {

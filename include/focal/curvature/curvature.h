@@ -7,27 +7,11 @@
 /// (sphere of radius r: k1 = k2 = +1/r); d1 belongs to k1; d1, d2 are unit 3D vectors tangent to
 /// the vertex normal, and (d1, d2, N) is right-handed.
 
-#include <cstdint>
-#include <string_view>
-
+#include "focal/core/fields.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/two_slit_fit.h"
 
 namespace focal {
-
-/// Classification of a vertex (or face) from its principal curvatures. The codes are stable:
-/// they are written to PLY files as a uchar property.
-enum class PointClass : std::uint8_t {
-  elliptic = 0,    ///< K > 0 and not umbilic
-  hyperbolic = 1,  ///< K < 0
-  parabolic = 2,   ///< exactly one principal curvature near zero
-  umbilic = 3,     ///< k1 ~ k2, not near zero (sphere-like)
-  flat = 4,        ///< both principal curvatures near zero
-  undefined = 5,   ///< no estimate: too few usable rays, singular fit or invalid input at the vertex
-};
-
-/// Lower-case name of a class (`elliptic`, ..., `undefined`).
-[[nodiscard]] std::string_view class_name(PointClass c);
 
 /// Classifies principal curvatures: |k| <= zero_tolerance counts as zero; k1 - k2 <=
 /// umbilic_tolerance * max(|k1|, |k2|) counts as umbilic. NaN gives `undefined`.
@@ -63,25 +47,6 @@ struct CurvatureOptions {
   /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
   double umbilic_tolerance = 1e-2;
   int threads = 0;  ///< 0: FOCAL_NUM_THREADS or all hardware threads
-};
-
-/// Per-vertex fields, #V rows each, row i for input vertex i. Vertices of class `undefined`
-/// have NaN in every numeric field (never zeros).
-struct CurvatureResult {
-  Eigen::VectorXd k1;  ///< larger principal curvature
-  Eigen::VectorXd k2;  ///< smaller principal curvature
-  Eigen::VectorXd H;   ///< mean curvature (k1 + k2) / 2
-  Eigen::VectorXd K;   ///< Gaussian curvature k1 k2
-  RowMatrixX3d d1;     ///< unit principal direction of k1
-  RowMatrixX3d d2;     ///< unit principal direction of k2
-  /// Root-mean-square residual of the fit, sqrt(E / sum of weights), in units of slope
-  /// (per-vertex method) or the spread of the incident faces' estimates (triangle method).
-  Eigen::VectorXd residual;
-  VectorXu8 point_class;        ///< PointClass codes
-  Eigen::VectorXi rays_used;     ///< neighbour rays that entered the fit
-  Eigen::VectorXi rays_excluded; ///< neighbours whose normal left the vertex normal's hemisphere
-
-  [[nodiscard]] PointClass class_of(int i) const { return static_cast<PointClass>(point_class[i]); }
 };
 
 /// Estimates the curvature fields of a triangle mesh from its vertex normals.

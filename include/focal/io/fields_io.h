@@ -4,8 +4,7 @@
 
 #include <filesystem>
 
-#include "focal/curvature/curvature.h"
-#include "focal/curvature/focal_mesh.h"
+#include "focal/core/fields.h"
 #include "focal/io/mesh_io.h"
 
 namespace focal {

@@ -24,7 +24,7 @@
 ///
 /// Results are gathered per vertex in fixed order: identical for any thread count.
 
-#include "focal/curvature/curvature.h"
+#include "focal/core/fields.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 
