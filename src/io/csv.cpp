@@ -4,6 +4,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
+#include "io/atomic_file.h"
 #include "io/detail.h"
 
 namespace focal {
@@ -60,13 +61,6 @@ void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> col
       out += '\n';
       sink.maybe_flush();
     }
-  });
-}
-
-void write_text_file(const std::filesystem::path& path, std::string_view text) {
-  io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    sink.buffer().append(text);
-    sink.maybe_flush();
   });
 }
 

@@ -1,16 +1,12 @@
 #pragma once
-/// \file io_detail.h
+/// \file detail.h
 /// Internal helpers shared by the mesh readers and writers: whole-file reading, error messages
-/// that name the file and the place, text scanning with line numbers, fan triangulation, number
-/// formatting and the atomic (temporary file + rename) writer.
+/// that name the file and the place, text scanning with line numbers, fan triangulation and
+/// number formatting. The writers write through io/atomic_file.h.
 
-#include <cerrno>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -105,39 +101,6 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
   }
   out += '\n';
 }
-
-/// Buffered output to the temporary file of write_atomically().
-class OutputSink {
- public:
-  OutputSink(std::FILE* file, const std::filesystem::path& target) : file_(file), target_(target) {}
-  /// The buffer to append to; call maybe_flush() now and then.
-  std::string& buffer() { return buffer_; }
-  void maybe_flush() {
-    if (buffer_.size() >= kFlushBytes) flush();
-  }
-  /// Writes the buffer out. \throw IoError naming the target on failure.
-  void flush();
-  /// Writes the buffer out, then `bytes` bytes from `data` without copying them into the buffer
-  /// (for writers that format large blocks themselves). \throw IoError as flush().
-  void write(const char* data, std::size_t bytes) {
-    flush();
-    if (std::fwrite(data, 1, bytes, file_) != bytes) {
-      fail(target_, std::string("write failed: ") + std::strerror(errno));
-    }
-  }
-
- private:
-  static constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
-  std::FILE* file_;
-  const std::filesystem::path& target_;
-  std::string buffer_;
-};
-
-/// Runs `body` on a temporary file in the folder of `path`, then renames it to `path`. On any
-/// failure (or exception from `body`) the temporary file is removed and `path` is left as it was.
-/// \throw IoError naming `path` when the file cannot be created, written or renamed.
-void write_atomically(const std::filesystem::path& path,
-                      const std::function<void(OutputSink&)>& body);
 
 /// One per-vertex column for write_ply_columns(): value i is f64[i * stride] or u8[i * stride],
 /// read in place, so that callers holding the values in other arrays (a matrix column, a uint8

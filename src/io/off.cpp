@@ -7,6 +7,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
+#include "io/atomic_file.h"
 #include "io/detail.h"
 
 namespace focal {

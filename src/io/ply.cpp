@@ -12,6 +12,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
+#include "io/atomic_file.h"
 #include "io/detail.h"
 #include "core/parallel.h"
 

@@ -1,0 +1,106 @@
+#include "io/atomic_file.h"
+
+#include <atomic>
+#include <cerrno>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <system_error>
+
+#include "focal/io/mesh_io.h"
+#include "io/detail.h"
+
+namespace focal {
+namespace io_detail {
+namespace {
+
+/// A name for the temporary file that no other writer (thread or process) picks at the same time.
+std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
+  static std::atomic<std::uint64_t> counter{0};
+  static const std::uint64_t seed = std::random_device{}();
+  const std::uint64_t tag = seed * 0x9E3779B97F4A7C15ull + counter.fetch_add(1);
+  char hex[17];
+  const auto result = std::to_chars(hex, hex + 16, tag, 16);
+  std::string name = ".";  // hidden, so that a crash leftover does not look like output
+  name += path.filename().string();
+  name += ".tmp-";
+  name.append(hex, result.ptr);
+  return path.parent_path() / name;
+}
+
+/// Opens a new temporary file; "x" makes the create exclusive so no existing file is reused.
+std::FILE* open_temporary(const std::filesystem::path& path, std::filesystem::path& temp) {
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    temp = temporary_path_for(path);
+    std::FILE* file = std::fopen(temp.c_str(), "wbx");
+    if (file != nullptr) return file;
+    if (errno != EEXIST) break;
+  }
+  fail(path, std::string("cannot create a temporary file in its folder: ") + std::strerror(errno));
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
+  if (target_.filename().empty()) fail(target_, "is not a file name");
+  file_ = open_temporary(target_, temporary_);
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  if (file_ != nullptr) std::fclose(file_);
+  std::error_code ignored;
+  std::filesystem::remove(temporary_, ignored);
+}
+
+void AtomicFile::commit() {
+  const bool write_failed = std::fflush(file_) != 0 || std::ferror(file_) != 0;
+  const int saved_errno = errno;
+  const bool close_failed = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (write_failed || close_failed) {
+    fail(target_, std::string("write failed: ") + std::strerror(saved_errno));
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary_, target_, ec);
+  if (ec) fail(target_, "cannot replace the file: " + ec.message());
+  committed_ = true;
+}
+
+void AtomicFile::write(const char* data, std::size_t bytes) {
+  if (std::fwrite(data, 1, bytes, file_) != bytes) {
+    fail(target_, std::string("write failed: ") + std::strerror(errno));
+  }
+}
+
+void OutputSink::flush() {
+  if (buffer_.empty()) return;
+  file_.write(buffer_.data(), buffer_.size());
+  buffer_.clear();
+}
+
+void OutputSink::write(const char* data, std::size_t bytes) {
+  flush();
+  file_.write(data, bytes);
+}
+
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(OutputSink&)>& body) {
+  AtomicFile file(path);
+  OutputSink sink(file);
+  body(sink);
+  sink.flush();
+  file.commit();
+}
+
+}  // namespace io_detail
+
+void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
+    sink.buffer().append(text);
+    sink.maybe_flush();
+  });
+}
+
+}  // namespace focal
