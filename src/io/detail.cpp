@@ -1,0 +1,179 @@
+#include "io/detail.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <system_error>
+
+#include "focal/core/error.h"
+
+namespace focal::io_detail {
+
+void fail(const std::filesystem::path& path, const std::string& what) {
+  throw IoError(path.string() + ": " + what);
+}
+
+void fail_at_line(const std::filesystem::path& path, std::size_t line, const std::string& what) {
+  throw IoError(path.string() + ": line " + std::to_string(line) + ": " + what);
+}
+
+void fail_at_offset(const std::filesystem::path& path, std::size_t offset,
+                    const std::string& what) {
+  throw IoError(path.string() + ": byte offset " + std::to_string(offset) + ": " + what);
+}
+
+std::string read_whole_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) fail(path, "no such file");
+  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a mesh file");
+
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) fail(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  // Read into a buffer one byte larger than the reported size, so that a file that grew (or a
+  // size query that is wrong, as for pipes) is noticed and the buffer extended.
+  std::string data;
+  const auto size_hint = std::filesystem::file_size(path, ec);
+  data.resize(ec ? std::size_t{1} << 20 : static_cast<std::size_t>(size_hint) + 1);
+  std::size_t used = 0;
+  for (;;) {
+    used += std::fread(data.data() + used, 1, data.size() - used, file);
+    if (used < data.size()) break;
+    data.resize(2 * data.size());
+  }
+  const bool failed = std::ferror(file) != 0;
+  std::fclose(file);
+  if (failed) fail(path, "read error");
+  data.resize(used);
+  return data;
+}
+
+void check_count_fits(const std::filesystem::path& path, std::string_view where,
+                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                      std::string_view what) {
+  // The last element of a text file may lack its separator, hence the +1.
+  if (min_bytes > 0 && count > (available + 1) / min_bytes) {
+    fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
+                   std::string(what) + " but the " + std::to_string(available) +
+                   " bytes that follow can hold at most " +
+                   std::to_string((available + 1) / min_bytes));
+  }
+  if (count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
+    fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
+                   std::string(what) + ", more than 32-bit indices can address");
+  }
+}
+
+std::string quoted(std::string_view text) {
+  std::string out;
+  out.reserve(text.size() + 2);
+  out += '\'';
+  out += text;
+  out += '\'';
+  return out;
+}
+
+std::string to_lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return out;
+}
+
+bool LineCursor::next(std::string_view& line) {
+  if (pos_ >= text_.size()) return false;
+  const std::size_t end = text_.find('\n', pos_);
+  const std::size_t stop = end == std::string_view::npos ? text_.size() : end;
+  line = text_.substr(pos_, stop - pos_);
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+  ++next_line_;
+  return true;
+}
+
+namespace {
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+}  // namespace
+
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+  tokens.clear();
+  std::size_t i = 0;
+  const std::size_t n = line.size();
+  while (i < n) {
+    while (i < n && is_blank(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < n && !is_blank(line[i])) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+}
+
+bool parse_double(std::string_view token, double& value) {
+  // from_chars rejects '+' but writers emit it ("+1.5e+00").
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  // Out-of-range values (1e999) come back as errc::result_out_of_range: not a number we can keep.
+  return ec == std::errc() && ptr == end && !token.empty();
+}
+
+bool parse_int(std::string_view token, std::int64_t& value) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return ec == std::errc() && ptr == end && !token.empty();
+}
+
+void TriangleCollector::reserve(std::size_t polygons) {
+  corners_.reserve(3 * polygons);
+  source_.reserve(polygons);
+}
+
+void TriangleCollector::add_polygon(const std::int32_t* corners, std::size_t count,
+                                    std::int32_t polygon) {
+  for (std::size_t k = 1; k + 1 < count; ++k) {
+    corners_.push_back(corners[0]);
+    corners_.push_back(corners[k]);
+    corners_.push_back(corners[k + 1]);
+    source_.push_back(polygon);
+  }
+}
+
+void TriangleCollector::move_into(Mesh& mesh) {
+  const auto triangles = static_cast<Eigen::Index>(source_.size());
+  mesh.F = Eigen::Map<const RowMatrixX3i>(corners_.data(), triangles, 3);
+  mesh.face_source = Eigen::Map<const Eigen::VectorXi>(source_.data(), triangles);
+  corners_ = {};
+  source_ = {};
+}
+
+namespace {
+template <class T>
+void append_floating(std::string& out, T value) {
+  if (std::isnan(value)) {
+    out += "nan";  // never "-nan": readers and spreadsheets agree on "nan"
+    return;
+  }
+  if (std::isinf(value)) {
+    out += value > 0 ? "inf" : "-inf";
+    return;
+  }
+  char buf[64];
+  const auto result = std::to_chars(buf, buf + sizeof buf, value);
+  out.append(buf, result.ptr);
+}
+}  // namespace
+
+void append_number(std::string& out, double value) { append_floating(out, value); }
+void append_number(std::string& out, float value) { append_floating(out, value); }
+
+void append_number(std::string& out, std::int64_t value) {
+  char buf[32];
+  const auto result = std::to_chars(buf, buf + sizeof buf, value);
+  out.append(buf, result.ptr);
+}
+
+}  // namespace focal::io_detail
