@@ -102,26 +102,6 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
   out += '\n';
 }
 
-/// One per-vertex column for write_ply_columns(): value i is f64[i * stride] or u8[i * stride],
-/// read in place, so that callers holding the values in other arrays (a matrix column, a uint8
-/// code vector) need not copy them into a VertexProperty first.
-struct PlyColumn {
-  std::string_view name;
-  PropertyType type = PropertyType::float32;
-  const double* f64 = nullptr;       ///< the values when they are doubles, else null
-  const std::uint8_t* u8 = nullptr;  ///< the values when they are uint8 codes, else null
-  Eigen::Index size = 0;             ///< number of values
-  Eigen::Index stride = 1;           ///< distance between consecutive values, in elements
-
-  [[nodiscard]] double value(Eigen::Index i) const {
-    return f64 != nullptr ? f64[i * stride] : static_cast<double>(u8[i * stride]);
-  }
-};
-
-/// write_ply() on columns: same file, same validation and exceptions.
-void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
-                       std::span<const PlyColumn> columns, const PlyWriteOptions& options);
-
 // The per-format readers, dispatched by read_mesh().
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path);

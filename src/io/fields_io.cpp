@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "io/detail.h"
+#include "io/ply.h"
 
 namespace focal {
 namespace {

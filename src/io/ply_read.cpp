@@ -1,20 +1,16 @@
-// PLY reading (ascii, binary little and big endian) and writing.
-// Format reference: Greg Turk, "The PLY Polygon File Format" (1994), and the type aliases
-// (int8..float64) added by later writers such as VTK and rply.
+// PLY reading: ascii, binary little and big endian. The types, names and byte order shared with
+// the writer are in io/ply.h.
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
-#include <cstring>
 #include <limits>
-#include <memory>
 #include <type_traits>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
-#include "io/atomic_file.h"
 #include "io/detail.h"
-#include "core/parallel.h"
+#include "io/ply.h"
 
 namespace focal {
 namespace {
@@ -22,50 +18,11 @@ namespace {
 using io_detail::fail;
 using io_detail::fail_at_line;
 using io_detail::fail_at_offset;
-
-enum class Scalar : std::uint8_t { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
-
-std::size_t scalar_size(Scalar t) {
-  switch (t) {
-    case Scalar::int8:
-    case Scalar::uint8:
-      return 1;
-    case Scalar::int16:
-    case Scalar::uint16:
-      return 2;
-    case Scalar::int32:
-    case Scalar::uint32:
-    case Scalar::float32:
-      return 4;
-    case Scalar::float64:
-      return 8;
-  }
-  return 0;
-}
-
-bool is_integer(Scalar t) { return t != Scalar::float32 && t != Scalar::float64; }
-
-bool parse_scalar_type(std::string_view name, Scalar& t) {
-  struct Alias {
-    std::string_view name;
-    Scalar type;
-  };
-  static constexpr Alias kAliases[] = {
-      {"char", Scalar::int8},       {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
-      {"uint8", Scalar::uint8},     {"short", Scalar::int16},     {"int16", Scalar::int16},
-      {"ushort", Scalar::uint16},   {"uint16", Scalar::uint16},   {"int", Scalar::int32},
-      {"int32", Scalar::int32},     {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
-      {"float", Scalar::float32},   {"float32", Scalar::float32}, {"double", Scalar::float64},
-      {"float64", Scalar::float64},
-  };
-  for (const auto& alias : kAliases) {
-    if (alias.name == name) {
-      t = alias.type;
-      return true;
-    }
-  }
-  return false;
-}
+using io_detail::ply::is_integer;
+using io_detail::ply::load;
+using io_detail::ply::parse_scalar_type;
+using io_detail::ply::Scalar;
+using io_detail::ply::scalar_size;
 
 struct PlyProperty {
   std::string name;
@@ -218,19 +175,6 @@ std::size_t face_list_property(const std::filesystem::path& path, const PlyEleme
 
 // ---------------------------------------------------------------------------------------------
 // Binary body
-
-template <class T>
-T load(const unsigned char* p, bool swap) {
-  unsigned char bytes[sizeof(T)];
-  if (swap) {
-    for (std::size_t i = 0; i < sizeof(T); ++i) bytes[i] = p[sizeof(T) - 1 - i];
-  } else {
-    std::memcpy(bytes, p, sizeof(T));
-  }
-  T value;
-  std::memcpy(&value, bytes, sizeof(T));
-  return value;
-}
 
 /// A binary scalar of type t converted to Out. Integer reads (indices, list counts) only see
 /// integer types: the header parser rejects float index and count types.
@@ -758,246 +702,6 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body&
   return mesh;
 }
 
-// ---------------------------------------------------------------------------------------------
-// Writing
-
-std::string_view ply_type_name(PropertyType t) {
-  switch (t) {
-    case PropertyType::float32:
-      return "float";
-    case PropertyType::float64:
-      return "double";
-    case PropertyType::uint8:
-      return "uchar";
-    case PropertyType::int32:
-      return "int";
-  }
-  return "double";
-}
-
-bool valid_property_name(std::string_view name) {
-  if (name.empty()) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char c) { return static_cast<unsigned char>(c) > ' ' && c != 127; });
-}
-
-using io_detail::PlyColumn;
-
-/// Throws InvalidInput for anything the file could not represent faithfully.
-void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
-                      std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
-  const std::string what = "write_ply: " + path.string();
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
-  std::vector<std::string_view> names = {"x", "y", "z"};
-  if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
-  for (const auto& column : columns) {
-    const std::string name(column.name);
-    if (!valid_property_name(name)) {
-      throw InvalidInput(what + ": property name '" + name + "' is empty or contains blanks");
-    }
-    if (std::find(names.begin(), names.end(), column.name) != names.end()) {
-      throw InvalidInput(what + ": property name '" + name + "' is used twice");
-    }
-    names.push_back(column.name);
-    if (column.size != mesh.V.rows()) {
-      throw InvalidInput(what + ": property '" + name + "' has " + std::to_string(column.size) +
-                         " values but the mesh has " + std::to_string(mesh.V.rows()) + " vertices");
-    }
-    // uint8 codes fit both integer types; only doubles need checking.
-    const bool is_int = column.type == PropertyType::uint8 || column.type == PropertyType::int32;
-    const double lo = column.type == PropertyType::uint8 ? 0.0 : -2147483648.0;
-    const double hi = column.type == PropertyType::uint8 ? 255.0 : 2147483647.0;
-    for (Eigen::Index i = 0; is_int && column.f64 != nullptr && i < column.size; ++i) {
-      const double v = column.value(i);
-      if (!(v >= lo && v <= hi && v == std::floor(v))) {
-        throw InvalidInput(what + ": property '" + name + "' value " + std::to_string(v) +
-                           " at vertex " + std::to_string(i) + " is not representable as " +
-                           std::string(ply_type_name(column.type)));
-      }
-    }
-  }
-  for (const auto& comment : options.comments) {
-    if (comment.find_first_of("\r\n") != std::string::npos) {
-      throw InvalidInput(what + ": a comment contains a line break");
-    }
-  }
-}
-
-std::string ply_header(const Mesh& mesh, std::span<const PlyColumn> columns,
-                       const PlyWriteOptions& options) {
-  std::string h = "ply\nformat ";
-  h += options.binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
-  for (const auto& comment : options.comments) h += "comment " + comment + "\n";
-  h += "element vertex " + std::to_string(mesh.V.rows()) + "\n";
-  h += "property double x\nproperty double y\nproperty double z\n";
-  if (mesh.has_normals()) h += "property double nx\nproperty double ny\nproperty double nz\n";
-  for (const auto& column : columns) {
-    h += "property ";
-    h += ply_type_name(column.type);
-    h += ' ';
-    h += column.name;
-    h += '\n';
-  }
-  h += "element face " + std::to_string(mesh.F.rows()) + "\n";
-  h += "property list uchar int vertex_indices\nend_header\n";
-  return h;
-}
-
-std::size_t property_bytes(PropertyType t) {
-  switch (t) {
-    case PropertyType::float32:
-    case PropertyType::int32:
-      return 4;
-    case PropertyType::float64:
-      return 8;
-    case PropertyType::uint8:
-      return 1;
-  }
-  return 8;
-}
-
-/// Stores `value` little endian at p; returns the byte after it.
-template <class T>
-char* put_little_endian(char* p, T value) {
-  std::memcpy(p, &value, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(p, p + sizeof(T));
-  return p + sizeof(T);
-}
-
-void append_property_ascii(std::string& out, PropertyType t, double v) {
-  switch (t) {
-    case PropertyType::float32:
-      io_detail::append_number(out, static_cast<float>(v));
-      break;
-    case PropertyType::float64:
-      io_detail::append_number(out, v);
-      break;
-    case PropertyType::uint8:
-    case PropertyType::int32:
-      io_detail::append_number(out, static_cast<std::int64_t>(v));
-      break;
-  }
-}
-
-void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
-                          std::span<const PlyColumn> columns) {
-  std::string& out = sink.buffer();
-  const bool normals = mesh.has_normals();
-  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-    for (int c = 0; c < (normals ? 6 : 3); ++c) {
-      if (c > 0) out += ' ';
-      io_detail::append_number(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3));
-    }
-    for (const auto& column : columns) {
-      out += ' ';
-      append_property_ascii(out, column.type, column.value(i));
-    }
-    out += '\n';
-    sink.maybe_flush();
-  }
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    io_detail::append_ascii_triangle(out, mesh.F, f);
-    sink.maybe_flush();
-  }
-}
-
-/// Writes `count` fixed-size records of `record` bytes in batches of about 8 MiB, each filled in
-/// parallel blocks by put(begin, end, out) (records [begin, end) stored from `out` on) and then
-/// written. Every record has its own place in the batch, so the bytes do not depend on the
-/// thread count.
-template <class Put>
-void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::size_t record,
-                         const Put& put) {
-  if (count == 0) return;
-  constexpr std::int64_t kBlock = 1 << 12;
-  const std::int64_t per_batch =
-      std::max<std::int64_t>(1,
-                             static_cast<std::int64_t>((std::size_t{8} << 20) / record / kBlock)) *
-      kBlock;
-  const std::int64_t batch = std::min(count, per_batch);
-  const std::unique_ptr<char[]> buffer(new char[static_cast<std::size_t>(batch) * record]);
-  for (std::int64_t first = 0; first < count; first += batch) {
-    const std::int64_t n = std::min(batch, count - first);
-    detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
-      put(first + begin, first + end, buffer.get() + static_cast<std::size_t>(begin) * record);
-    });
-    sink.write(buffer.get(), static_cast<std::size_t>(n) * record);
-  }
-}
-
-/// Stores column values for records [begin, end) at `offset` in each record of `out`.
-template <class T, class Source>
-void put_column(char* out, std::size_t record, std::int64_t begin, std::int64_t end,
-                const Source* values, Eigen::Index stride) {
-  for (std::int64_t i = begin; i < end; ++i) {
-    put_little_endian(out + static_cast<std::size_t>(i - begin) * record,
-                      static_cast<T>(static_cast<double>(values[i * stride])));
-  }
-}
-
-void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
-                           std::span<const PlyColumn> columns) {
-  const bool normals = mesh.has_normals();
-  std::size_t record = (normals ? 6 : 3) * sizeof(double);
-  for (const auto& column : columns) record += property_bytes(column.type);
-  // Column by column within a block, so that each type is dispatched once per block.
-  write_fixed_records(sink, mesh.V.rows(), record,
-                      [&](std::int64_t begin, std::int64_t end, char* out) {
-                        for (std::int64_t i = begin; i < end; ++i) {
-                          char* p = out + static_cast<std::size_t>(i - begin) * record;
-                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.V(i, c));
-                          if (normals) {
-                            for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.N(i, c));
-                          }
-                        }
-                        std::size_t offset = (normals ? 6 : 3) * sizeof(double);
-                        for (const auto& column : columns) {
-                          char* at = out + offset;
-                          const Eigen::Index s = column.stride;
-                          if (column.f64 != nullptr) {
-                            switch (column.type) {
-                              case PropertyType::float32:
-                                put_column<float>(at, record, begin, end, column.f64, s);
-                                break;
-                              case PropertyType::float64:
-                                put_column<double>(at, record, begin, end, column.f64, s);
-                                break;
-                              case PropertyType::uint8:
-                                put_column<std::uint8_t>(at, record, begin, end, column.f64, s);
-                                break;
-                              case PropertyType::int32:
-                                put_column<std::int32_t>(at, record, begin, end, column.f64, s);
-                                break;
-                            }
-                          } else {
-                            switch (column.type) {
-                              case PropertyType::float32:
-                                put_column<float>(at, record, begin, end, column.u8, s);
-                                break;
-                              case PropertyType::float64:
-                                put_column<double>(at, record, begin, end, column.u8, s);
-                                break;
-                              case PropertyType::uint8:
-                                put_column<std::uint8_t>(at, record, begin, end, column.u8, s);
-                                break;
-                              case PropertyType::int32:
-                                put_column<std::int32_t>(at, record, begin, end, column.u8, s);
-                                break;
-                            }
-                          }
-                          offset += property_bytes(column.type);
-                        }
-                      });
-  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t),
-                      [&](std::int64_t begin, std::int64_t end, char* out) {
-                        char* p = out;
-                        for (std::int64_t f = begin; f < end; ++f) {
-                          *p++ = static_cast<char>(3);
-                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.F(f, c));
-                        }
-                      });
-}
-
 }  // namespace
 
 namespace io_detail {
@@ -1017,32 +721,4 @@ Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
 }
 
 }  // namespace io_detail
-
-namespace io_detail {
-
-void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
-                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
-  validate_for_ply(path, mesh, columns, options);
-  write_atomically(path, [&](OutputSink& sink) {
-    sink.buffer() += ply_header(mesh, columns, options);
-    if (options.binary) {
-      write_ply_body_binary(sink, mesh, columns);
-    } else {
-      write_ply_body_ascii(sink, mesh, columns);
-    }
-  });
-}
-
-}  // namespace io_detail
-
-void write_ply(const std::filesystem::path& path, const Mesh& mesh,
-               std::span<const VertexProperty> properties, const PlyWriteOptions& options) {
-  std::vector<PlyColumn> columns;
-  columns.reserve(properties.size());
-  for (const auto& prop : properties) {
-    columns.push_back({prop.name, prop.type, prop.values.data(), nullptr, prop.values.size(), 1});
-  }
-  io_detail::write_ply_columns(path, mesh, columns, options);
-}
-
 }  // namespace focal
