@@ -240,24 +240,20 @@ void write_obj(const std::filesystem::path& path, const Mesh& mesh) {
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
     std::string& out = sink.buffer();
-    for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      out += 'v';
-      for (int c = 0; c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, mesh.V(i, c));
+    // `v x y z` lines, then `vn x y z` lines.
+    const auto append_rows = [&](std::string_view keyword, const RowMatrixX3d& rows) {
+      for (Eigen::Index i = 0; i < rows.rows(); ++i) {
+        out += keyword;
+        for (int c = 0; c < 3; ++c) {
+          out += ' ';
+          io_detail::append_number(out, rows(i, c));
+        }
+        out += '\n';
+        sink.maybe_flush();
       }
-      out += '\n';
-      sink.maybe_flush();
-    }
-    for (Eigen::Index i = 0; normals && i < mesh.N.rows(); ++i) {
-      out += "vn";
-      for (int c = 0; c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, mesh.N(i, c));
-      }
-      out += '\n';
-      sink.maybe_flush();
-    }
+    };
+    append_rows("v", mesh.V);
+    if (normals) append_rows("vn", mesh.N);
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
       out += 'f';
       for (int c = 0; c < 3; ++c) {
