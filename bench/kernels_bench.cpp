@@ -10,16 +10,17 @@
 #include <functional>
 
 #include "bench_meshes.h"
+#include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/curvature.h"
-#include "focal/io/fields_io.h"
 #include "focal/curvature/focal_mesh.h"
-#include "focal/mesh/check.h"
+#include "focal/curvature/triangle_curvature.h"
+#include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
+#include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
-#include "focal/curvature/triangle_curvature.h"
 
 namespace focal::bench {
 namespace {

@@ -7,21 +7,19 @@
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
-#include "focal/core/error.h"
-#include "focal/mesh/neighbourhood.h"
-#include "focal/curvature/normal_rays.h"
-#include "curvature/lanes.h"
-#include "curvature/normal_rays_detail.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
+#include "curvature/curvature_detail.h"
+#include "curvature/detail.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "curvature/triangle_curvature_detail.h"
 #include "curvature/two_slit_detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/mesh/neighbourhood.h"
 
 namespace focal {
-
-// Implemented in triangle_curvature.cpp: Method::triangle.
-CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
-                                                const CurvatureOptions& options);
 
 namespace {
 
@@ -385,7 +383,8 @@ CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                        "them with vertex_normals)");
   }
   validate_mesh_arrays(V, F, N, "curvature");
-  if (options.method == Method::triangle) return vertex_curvature_from_triangles(V, F, N, options);
+  if (options.method == Method::triangle)
+    return detail::vertex_curvature_from_triangles(V, F, N, options);
   return vertex_curvature_from_rays(V, F, N, options);
 }
 

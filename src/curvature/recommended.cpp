@@ -6,12 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "core/parallel.h"
+#include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/normals/jets.h"
 #include "focal/mesh/normals.h"
-#include "core/parallel.h"
+#include "focal/normals/jets.h"
 
 namespace focal {
 namespace {

@@ -9,13 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
-#include "focal/core/error.h"
-#include "focal/curvature/normal_rays.h"
-#include "curvature/lanes.h"
-#include "curvature/normal_rays_detail.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
+#include "curvature/detail.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "curvature/triangle_curvature_detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -394,8 +395,8 @@ void average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult
 
 }  // namespace
 
-CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
-                                                const CurvatureOptions& options) {
+CurvatureResult detail::vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
+                                                        const CurvatureOptions& options) {
   // Only what the averaging reads: the face operators, their normals and classes.
   TriangleFields needed;
   needed.coefficients = needed.curvatures = needed.focal_depths = false;

@@ -9,6 +9,8 @@
 
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
+#include "mesh/normals_detail.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {

@@ -9,8 +9,10 @@
 #include <utility>
 #include <vector>
 
-#include "focal/core/error.h"
 #include "core/parallel.h"
+#include "focal/core/error.h"
+#include "mesh/normals_detail.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {

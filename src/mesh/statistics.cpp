@@ -3,8 +3,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "focal/mesh/neighbourhood.h"
 #include "core/parallel.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {

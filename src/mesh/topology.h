@@ -1,6 +1,6 @@
 #pragma once
 // Internal, header-only: the vertex->face incidence that normals.cpp, neighbourhood.cpp and
-// mesh_statistics.cpp gather over. Every per-vertex loop built on it reads the faces of its own
+// statistics.cpp gather over. Every per-vertex loop built on it reads the faces of its own
 // vertex in ascending face order and writes only that vertex's slot, so results are identical for
 // any thread count (no scatter-adds, no atomics, no hash maps per edge).
 //
@@ -21,10 +21,9 @@
 #include <utility>
 #include <vector>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/core/mesh.h"
-#include "focal/mesh/normals.h"
-#include "core/parallel.h"
 
 namespace focal::detail {
 
@@ -398,45 +397,6 @@ inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F) {
   });
   return result;
 }
-
-/// Edge findings of one vertex for its edges to higher-indexed neighbours (each edge once).
-enum EdgeFlag : std::uint8_t {
-  kOpenEdge = 1,          ///< an edge without exactly two incident faces
-  kInconsistentEdge = 2,  ///< an interior edge traversed the same way by both faces
-};
-
-/// What mesh_statistics, orientation_report and check_mesh need of the connectivity, computed in
-/// one parallel pass over the vertices' edge sides (each was a pass of its own before).
-struct MeshTopology {
-  VertexFaces incidence;
-  FaceComponents components;
-  std::vector<std::uint8_t> edge_flags;  ///< #V, EdgeFlag bits
-  std::int64_t edge_count = 0;
-  std::int64_t boundary_edge_count = 0;
-  std::int64_t non_manifold_edge_count = 0;
-  std::int64_t non_manifold_vertex_count = 0;
-  std::int64_t duplicate_face_count = 0;
-  std::int64_t unreferenced_vertex_count = 0;
-};
-
-/// How much of MeshTopology to compute: `orientation` leaves out the fans (non-manifold
-/// vertices) and duplicate faces, which orientation_report does not need.
-enum class TopologyDetail { orientation, statistics };
-
-/// Defined in mesh_statistics.cpp. F must already be validated against vertex_count.
-MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F,
-                           TopologyDetail detail = TopologyDetail::statistics);
-
-/// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
-/// Defined in mesh_statistics.cpp; F must already be validated against V.
-int degenerate_face_count(PositionsRef V, FacesRef F);
-
-/// orientation_report from a topology already computed for (V, F). Defined in normals.cpp.
-OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t);
-
-/// vertex_normals from an incidence already computed for F. Defined in normals.cpp.
-RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting);
 
 /// True when every index of F lies in [0, vertex_count), checked in parallel; callers then call
 /// validate_mesh_arrays only to produce its message for the first bad face.
