@@ -8,6 +8,7 @@
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal::detail {
 
@@ -26,5 +27,13 @@ struct VertexFitInput {
 /// the same bits).
 CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
                              SimdIsa isa = SimdIsa::best);
+
+/// Throws InvalidInput for CurvatureOptions out of range (estimate_curvature's check).
+void validate_curvature_options(const CurvatureOptions& options);
+
+/// estimate_curvature's per-vertex fit (Method::vertex) on a mesh with normals, with its 1-ring
+/// at hand; the options already validated.
+CurvatureResult vertex_curvature_from_rays(const PreparedMesh& mesh, const Neighbourhoods& one_ring,
+                                           const CurvatureOptions& options);
 
 }  // namespace focal::detail

@@ -12,6 +12,7 @@
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
+#include "mesh/prepared_detail.h"  // unit_rows
 
 namespace focal::detail {
 
@@ -39,19 +40,6 @@ inline Principal2 principal_from_symmetric(double a, double b, double c) {
                                  : Eigen::Vector2d(std::abs(bs), std::copysign(r - ds, bs));
   d1 /= std::sqrt(2.0 * r * (r + std::abs(ds)));
   return {mean + s * r, mean - s * r, d1, Eigen::Vector2d(-d1.y(), d1.x())};
-}
-
-/// Unit copies of the rows of N; `valid[i]` is false where a row is zero or not finite.
-/// Rows are independent, so any thread count gives the same result.
-inline RowMatrixX3d unit_rows(NormalsRef N, std::vector<char>& valid, int threads = 0) {
-  RowMatrixX3d unit(N.rows(), 3);
-  valid.resize(static_cast<std::size_t>(N.rows()));
-  parallel_for(N.rows(), threads, [&](std::int64_t i) {
-    const double len = N.row(i).norm();
-    valid[static_cast<std::size_t>(i)] = std::isfinite(len) && len > 0.0;
-    unit.row(i) = N.row(i) / len;
-  });
-  return unit;
 }
 
 /// A result of n vertices with every field allocated but not written: the caller writes each

@@ -261,12 +261,13 @@ Out load_as(const unsigned char* p, Scalar t, bool swap) {
 class BinaryBody {
  public:
   BinaryBody(const std::filesystem::path& path, std::string_view data, std::size_t offset,
-             bool swap)
+             bool swap, int threads)
       : path_(path),
         begin_(reinterpret_cast<const unsigned char*>(data.data())),
         p_(begin_ + offset),
         end_(begin_ + data.size()),
-        swap_(swap) {}
+        swap_(swap),
+        threads_(threads) {}
 
   /// Rejects a count that cannot fit in the rest of the file, before anything is allocated.
   void check_fits(const PlyElement& e) const {
@@ -352,7 +353,7 @@ class BinaryBody {
     // both checks and converts, so a valid file is read once.
     constexpr std::int64_t kBlock = 1 << 14;
     std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
-    detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    detail::parallel_for_blocks(faces, kBlock, threads_, [&](std::int64_t begin, std::int64_t end) {
       bool ok = true;
       if (common) {
         for (std::int64_t f = begin; f < end; ++f) {
@@ -473,7 +474,7 @@ class BinaryBody {
     const std::size_t stride = offset;
     const unsigned char* first = p_;
     detail::parallel_for_blocks(
-        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, 0,
+        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, threads_,
         [&](std::int64_t begin, std::int64_t end) {
           // Field by field, so that the type switch is decided once per block and field.
           for (int k = 0; k < used; ++k) {
@@ -543,6 +544,7 @@ class BinaryBody {
   const unsigned char* p_;
   const unsigned char* end_;
   bool swap_;
+  int threads_;  ///< of the parallel passes over fixed-size records
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -786,7 +788,7 @@ using io_detail::PlyColumn;
 void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   const std::string what = "write_ply: " + path.string();
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str(), options.threads);
   std::vector<std::string_view> names = {"x", "y", "z"};
   if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
   for (const auto& column : columns) {
@@ -906,7 +908,7 @@ void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
 /// thread count.
 template <class Put>
 void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::size_t record,
-                         const Put& put) {
+                         int threads, const Put& put) {
   if (count == 0) return;
   constexpr std::int64_t kBlock = 1 << 12;
   const std::int64_t per_batch =
@@ -917,7 +919,7 @@ void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::s
   const std::unique_ptr<char[]> buffer(new char[static_cast<std::size_t>(batch) * record]);
   for (std::int64_t first = 0; first < count; first += batch) {
     const std::int64_t n = std::min(batch, count - first);
-    detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
       put(first + begin, first + end, buffer.get() + static_cast<std::size_t>(begin) * record);
     });
     sink.write(buffer.get(), static_cast<std::size_t>(n) * record);
@@ -935,12 +937,12 @@ void put_column(char* out, std::size_t record, std::int64_t begin, std::int64_t 
 }
 
 void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
-                           std::span<const PlyColumn> columns) {
+                           std::span<const PlyColumn> columns, int threads) {
   const bool normals = mesh.has_normals();
   std::size_t record = (normals ? 6 : 3) * sizeof(double);
   for (const auto& column : columns) record += property_bytes(column.type);
   // Column by column within a block, so that each type is dispatched once per block.
-  write_fixed_records(sink, mesh.V.rows(), record,
+  write_fixed_records(sink, mesh.V.rows(), record, threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         for (std::int64_t i = begin; i < end; ++i) {
                           char* p = out + static_cast<std::size_t>(i - begin) * record;
@@ -987,7 +989,7 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
                           offset += property_bytes(column.type);
                         }
                       });
-  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t),
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         char* p = out;
                         for (std::int64_t f = begin; f < end; ++f) {
@@ -1001,9 +1003,15 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
 
 namespace io_detail {
 
-Mesh read_ply(const std::filesystem::path& path) { return parse_ply(path, read_whole_file(path)); }
+Mesh read_ply(const std::filesystem::path& path, int threads) {
+  return parse_ply(path, read_whole_file(path), threads);
+}
 
 Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
+  return parse_ply(path, data, 0);
+}
+
+Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads) {
   const PlyHeader header = parse_header(path, data);
   if (header.encoding == PlyEncoding::ascii) {
     AsciiBody body(path, data.substr(header.body_offset), header.body_line);
@@ -1011,7 +1019,7 @@ Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
   }
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
   const bool host_big = std::endian::native == std::endian::big;
-  BinaryBody body(path, data, header.body_offset, file_big != host_big);
+  BinaryBody body(path, data, header.body_offset, file_big != host_big, threads);
   return read_body(path, header, body);
 }
 
@@ -1025,7 +1033,7 @@ void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
   write_atomically(path, [&](OutputSink& sink) {
     sink.buffer() += ply_header(mesh, columns, options);
     if (options.binary) {
-      write_ply_body_binary(sink, mesh, columns);
+      write_ply_body_binary(sink, mesh, columns, options.threads);
     } else {
       write_ply_body_ascii(sink, mesh, columns);
     }

@@ -10,10 +10,11 @@
 namespace focal::detail {
 
 /// orientation_report from a topology already computed for (V, F).
-OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t);
+OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t,
+                                          int threads);
 
 /// vertex_normals from an incidence already computed for F.
 RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting);
+                                 NormalWeighting weighting, int threads);
 
 }  // namespace focal::detail

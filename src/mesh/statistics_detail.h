@@ -16,10 +16,10 @@ enum EdgeFlag : std::uint8_t {
   kInconsistentEdge = 2,  ///< an interior edge traversed the same way by both faces
 };
 
-/// What mesh_statistics, orientation_report and check_mesh need of the connectivity, computed in
-/// one parallel pass over the vertices' edge sides (each was a pass of its own before).
+/// What mesh_statistics, orientation_report and check_mesh need of the connectivity beyond the
+/// incidence, computed in one parallel pass over the vertices' edge sides (each was a pass of its
+/// own before).
 struct MeshTopology {
-  VertexFaces incidence;
   FaceComponents components;
   std::vector<std::uint8_t> edge_flags;  ///< #V, EdgeFlag bits
   std::int64_t edge_count = 0;
@@ -34,12 +34,12 @@ struct MeshTopology {
 /// vertices) and duplicate faces, which orientation_report does not need.
 enum class TopologyDetail { orientation, statistics };
 
-/// F must already be validated against vertex_count.
-MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F,
-                           TopologyDetail detail = TopologyDetail::statistics);
+/// The topology of F from its incidence `inc` (vertex_face_incidence of F, whose vertex count is
+/// the mesh's).
+MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads);
 
 /// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
 /// F must already be validated against V.
-int degenerate_face_count(PositionsRef V, FacesRef F);
+int degenerate_face_count(PositionsRef V, FacesRef F, int threads);
 
 }  // namespace focal::detail
