@@ -53,9 +53,9 @@ struct EstimateOptions {
   Estimator estimator = Estimator::recommended;
   NormalsSource normals = NormalsSource::automatic;
   /// Estimator::paper: its options (the paper with the closed-form solver by default).
-  CurvatureOptions paper;
+  CurvatureOptions paper{};
   /// Estimator::recommended: its options.
-  RecommendedOptions recommended;
+  RecommendedOptions recommended{};
 };
 
 /// What prepare_normals did, for a caller to report.
