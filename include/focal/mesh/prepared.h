@@ -12,6 +12,8 @@
 /// are as large as the incidence, and a run often needs them once). Copies of a PreparedMesh, and
 /// with_normals(), share what is built for V and F. Nothing built changes a result: every function
 /// gives the same bits with a PreparedMesh as with its arrays, for any thread count.
+/// Its const functions may be called from several threads at once: each thing is built once,
+/// under a lock.
 ///
 /// V, F and N are viewed, not copied: they must outlive the PreparedMesh (and its copies) and
 /// stay unchanged. Pass arrays in the layout of the views (row-major `n x 3` doubles, int32
