@@ -57,6 +57,4 @@ const Mesh* bunny() {
   return cached;
 }
 
-void use_threads(int threads) { setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1); }
-
 }  // namespace focal::bench

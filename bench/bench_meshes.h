@@ -16,7 +16,4 @@ const Mesh& torus(int vertices);
 /// there from Debian's libcgal-demo data when missing; nullptr when neither exists.
 const Mesh* bunny();
 
-/// Sets FOCAL_NUM_THREADS, which every library loop without a `threads` option reads.
-void use_threads(int threads);
-
 }  // namespace focal::bench

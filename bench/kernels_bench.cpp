@@ -10,16 +10,17 @@
 #include <functional>
 
 #include "bench_meshes.h"
+#include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/curvature.h"
-#include "focal/io/fields_io.h"
 #include "focal/curvature/focal_mesh.h"
-#include "focal/mesh/check.h"
+#include "focal/curvature/triangle_curvature.h"
+#include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
+#include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
-#include "focal/curvature/triangle_curvature.h"
 
 namespace focal::bench {
 namespace {
@@ -32,10 +33,10 @@ void sizes_and_threads(benchmark::internal::Benchmark* b) {
   b->ArgNames({"vertices", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 
-const Mesh& setup(benchmark::State& state) {
-  use_threads(static_cast<int>(state.range(1)));
-  return torus(static_cast<int>(state.range(0)));
-}
+const Mesh& setup(benchmark::State& state) { return torus(static_cast<int>(state.range(0))); }
+
+/// The benchmark's thread count, passed to every call.
+int threads_of(const benchmark::State& state) { return static_cast<int>(state.range(1)); }
 
 void per_vertex(benchmark::State& state, const Mesh& m) {
   state.counters["vertices/s"] = benchmark::Counter(static_cast<double>(m.V.rows()),
@@ -44,7 +45,9 @@ void per_vertex(benchmark::State& state, const Mesh& m) {
 
 void BM_Normals(benchmark::State& state) {
   const Mesh& m = setup(state);
-  for (auto _ : state) benchmark::DoNotOptimize(vertex_normals(m.V, m.F, NormalWeighting::max));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(vertex_normals(m.V, m.F, NormalWeighting::max, threads_of(state)));
+  }
   per_vertex(state, m);
 }
 BENCHMARK(BM_Normals)->Apply(sizes_and_threads);
@@ -52,7 +55,8 @@ BENCHMARK(BM_Normals)->Apply(sizes_and_threads);
 void BM_Adjacency(benchmark::State& state) {
   const Mesh& m = setup(state);
   for (auto _ : state)
-    benchmark::DoNotOptimize(vertex_adjacency(static_cast<int>(m.V.rows()), m.F));
+    benchmark::DoNotOptimize(
+        vertex_adjacency(static_cast<int>(m.V.rows()), m.F, threads_of(state)));
   per_vertex(state, m);
 }
 BENCHMARK(BM_Adjacency)->Apply(sizes_and_threads);
@@ -60,7 +64,7 @@ BENCHMARK(BM_Adjacency)->Apply(sizes_and_threads);
 void BM_TwoRing(benchmark::State& state) {
   const Mesh& m = setup(state);
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
-  for (auto _ : state) benchmark::DoNotOptimize(k_ring(one, 2));
+  for (auto _ : state) benchmark::DoNotOptimize(k_ring(one, 2, threads_of(state)));
   per_vertex(state, m);
 }
 BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
@@ -70,12 +74,12 @@ BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
 void fit_step(benchmark::State& state, CurvatureOptions o,
               detail::SimdIsa isa = detail::SimdIsa::best) {
   const Mesh& m = setup(state);
-  o.threads = static_cast<int>(state.range(1));
+  o.threads = threads_of(state);
   std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
-  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
-  const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings);
-  const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F)};
+  const RowMatrixX3d unit = detail::unit_rows(m.N, ok, o.threads);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F, o.threads);
+  const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings, o.threads);
+  const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F, o.threads)};
   for (auto _ : state) benchmark::DoNotOptimize(detail::fit_vertices(in, o, isa));
   per_vertex(state, m);
 }
@@ -121,7 +125,7 @@ BENCHMARK(BM_FitLevenbergMarquardt)
 void BM_EstimateCurvature(benchmark::State& state) {
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = static_cast<int>(state.range(1));
+  o.threads = threads_of(state);
   for (auto _ : state) benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, m.N, o));
   per_vertex(state, m);
 }
@@ -131,7 +135,7 @@ BENCHMARK(BM_EstimateCurvature)->Apply(sizes_and_threads);
 void BM_TriangleCurvature(benchmark::State& state) {
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = static_cast<int>(state.range(1));
+  o.threads = threads_of(state);
   for (auto _ : state) benchmark::DoNotOptimize(triangle_curvature(m.V, m.F, m.N, o));
   state.counters["faces/s"] = benchmark::Counter(static_cast<double>(m.F.rows()),
                                                  benchmark::Counter::kIsIterationInvariantRate);
@@ -143,7 +147,7 @@ BENCHMARK(BM_TriangleCurvature)->Apply(sizes_and_threads);
 void BM_TriangleCurvatureCurvaturesOnly(benchmark::State& state) {
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = static_cast<int>(state.range(1));
+  o.threads = threads_of(state);
   TriangleFields fields;
   fields.coefficients = fields.focal_depths = fields.directions = fields.slits = false;
   fields.face_normal = fields.shape_operator = false;
@@ -157,7 +161,7 @@ BENCHMARK(BM_TriangleCurvatureCurvaturesOnly)->Apply(sizes_and_threads);
 void BM_EstimateCurvatureTriangleMethod(benchmark::State& state) {
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = static_cast<int>(state.range(1));
+  o.threads = threads_of(state);
   o.method = Method::triangle;
   for (auto _ : state) benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, m.N, o));
   per_vertex(state, m);
@@ -167,14 +171,16 @@ BENCHMARK(BM_EstimateCurvatureTriangleMethod)->Apply(sizes_and_threads);
 // The robustness check of `focal curvature` (check stage): statistics, orientation, normals.
 void BM_CheckMesh(benchmark::State& state) {
   const Mesh& m = setup(state);
-  for (auto _ : state) benchmark::DoNotOptimize(check_mesh(m.V, m.F, m.N));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(check_mesh(m.V, m.F, m.normals(), threads_of(state)));
+  }
   per_vertex(state, m);
 }
 BENCHMARK(BM_CheckMesh)->Apply(sizes_and_threads);
 
 void BM_OrientationReport(benchmark::State& state) {
   const Mesh& m = setup(state);
-  for (auto _ : state) benchmark::DoNotOptimize(orientation_report(m.V, m.F));
+  for (auto _ : state) benchmark::DoNotOptimize(orientation_report(m.V, m.F, threads_of(state)));
   per_vertex(state, m);
 }
 BENCHMARK(BM_OrientationReport)->Apply(sizes_and_threads);
@@ -182,7 +188,8 @@ BENCHMARK(BM_OrientationReport)->Apply(sizes_and_threads);
 void BM_FocalMeshes(benchmark::State& state) {
   const Mesh& m = setup(state);
   const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
-  for (auto _ : state) benchmark::DoNotOptimize(focal_meshes(m.V, m.F, m.N, c));
+  const FocalMeshOptions o{.threads = threads_of(state)};
+  for (auto _ : state) benchmark::DoNotOptimize(focal_meshes(m.V, m.F, m.N, c, o));
   per_vertex(state, m);
 }
 BENCHMARK(BM_FocalMeshes)->Apply(sizes_and_threads);
@@ -191,7 +198,8 @@ void BM_WriteCurvaturePly(benchmark::State& state) {
   const Mesh& m = setup(state);
   const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
   const auto path = std::filesystem::temp_directory_path() / "focal-bench-write.ply";
-  for (auto _ : state) write_curvature_ply(path, m, c);
+  for (auto _ : state)
+    write_curvature_ply(path, m, c, {.binary = true, .comments = {}, .threads = threads_of(state)});
   std::filesystem::remove(path);
   per_vertex(state, m);
 }
@@ -201,7 +209,7 @@ void BM_ReadPly(benchmark::State& state) {
   const Mesh& m = setup(state);
   const auto path = std::filesystem::temp_directory_path() / "focal-bench-read.ply";
   write_ply(path, m);
-  for (auto _ : state) benchmark::DoNotOptimize(read_mesh(path));
+  for (auto _ : state) benchmark::DoNotOptimize(read_mesh(path, {.threads = threads_of(state)}));
   std::filesystem::remove(path);
   per_vertex(state, m);
 }
@@ -227,14 +235,13 @@ double best_seconds(int runs, const std::function<void()>& work) {
 
 void compare_with_focal(benchmark::State& state, const Mesh& m, const Estimator& baseline) {
   CurvatureOptions o;
-  o.threads = static_cast<int>(state.range(1));
-  use_threads(o.threads);
-  const RowMatrixX3d N = vertex_normals(m.V, m.F, NormalWeighting::max);
+  o.threads = threads_of(state);
+  const RowMatrixX3d N = vertex_normals(m.V, m.F, NormalWeighting::max, o.threads);
   const double fit =
       best_seconds(5, [&] { benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, N, o)); });
   const double with_normals = best_seconds(5, [&] {
     benchmark::DoNotOptimize(
-        estimate_curvature(m.V, m.F, vertex_normals(m.V, m.F, NormalWeighting::max), o));
+        estimate_curvature(m.V, m.F, vertex_normals(m.V, m.F, NormalWeighting::max, o.threads), o));
   });
   const auto start = std::chrono::steady_clock::now();
   for (auto _ : state) benchmark::DoNotOptimize(baseline(m, o));

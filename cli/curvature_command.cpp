@@ -31,29 +31,33 @@ struct FocalMeshFlags {
 };
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
-  Input input = read_input(f.input, f.estimator, log);
-  Estimate e = estimate(input, f.input, f.estimator, log);
-  Mesh& mesh = input.mesh;
+  Input input(f.input, f.estimator, log);
+  Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
-    write_curvature_csv(f.output, e.fields);
-  } else {
-    mesh.N = std::move(e.normals);
-    write_curvature_ply(f.output, mesh, e.fields, {.binary = !f.ascii, .comments = {}});
+    write_curvature_csv(f.output, e.curvature);
+    return;
   }
+  // The mesh as the estimator saw it (input.prepared is not used after this).
+  Mesh& mesh = input.mesh;
+  if (e.F) mesh.F = std::move(*e.F);
+  if (e.N) mesh.N = std::move(*e.N);
+  write_curvature_ply(f.output, mesh, e.curvature,
+                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
 }
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
-  Input input = read_input(f.input, f.estimator, log);
-  const Estimate e = estimate(input, f.input, f.estimator, log);
-  const Mesh& mesh = input.mesh;
+  const Input input(f.input, f.estimator, log);
+  const Estimate e = run_estimate(input, f.input, f.estimator, log);
   FocalMeshes meshes;
   {
     Stage stage(log, "focal meshes");
-    meshes = focal_meshes(mesh.V, mesh.F, e.normals, e.fields, f.focal);
+    FocalMeshOptions o = f.focal;
+    o.threads = f.estimator.threads;
+    meshes = focal_meshes(estimated_mesh(input, e), e.curvature, o);
   }
   Stage stage(log, "write");
-  const PlyWriteOptions o{.binary = !f.ascii, .comments = {}};
+  const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads};
   write_focal_mesh_ply(f.prefix + ".focal1.ply", meshes.gamma1, o);
   try {
     write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);

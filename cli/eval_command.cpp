@@ -61,10 +61,12 @@ std::vector<Estimator> methods() {
                    }});
   };
   // "focal default" first: the markdown summary counts its wins from rows 0 and 1 of each case.
-  out.push_back({"focal default / file normals",
-                 [](const Mesh& m) { return estimate_curvature_recommended(m.V, m.F, m.N); }});
-  out.push_back({"focal default / no normals",
-                 [](const Mesh& m) { return estimate_curvature_recommended(m.V, m.F); }});
+  out.push_back({"focal default / file normals", [](const Mesh& m) {
+                   return estimate_curvature_recommended(m.V, m.F, m.normals()).curvature;
+                 }});
+  out.push_back({"focal default / no normals", [](const Mesh& m) {
+                   return estimate_curvature_recommended(m.V, m.F, std::nullopt).curvature;
+                 }});
   CurvatureOptions o;
   focal_method("focal closed-form 1-ring", o);
   o.rings = 2;
@@ -266,11 +268,13 @@ void run_eval(const EvalFlags& f, const Log& log) {
 std::vector<Estimator> scan_methods(bool file_normals) {
   std::vector<Estimator> out;
   if (file_normals) {
-    out.push_back({"focal default / file normals",
-                   [](const Mesh& m) { return estimate_curvature_recommended(m.V, m.F, m.N); }});
+    out.push_back({"focal default / file normals", [](const Mesh& m) {
+                     return estimate_curvature_recommended(m.V, m.F, m.normals()).curvature;
+                   }});
   }
-  out.push_back({"focal default / no normals",
-                 [](const Mesh& m) { return estimate_curvature_recommended(m.V, m.F); }});
+  out.push_back({"focal default / no normals", [](const Mesh& m) {
+                   return estimate_curvature_recommended(m.V, m.F, std::nullopt).curvature;
+                 }});
   out.push_back({"focal closed-form 1-ring / Max normals", [](const Mesh& m) {
                    return estimate_curvature(m.V, m.F,
                                              vertex_normals(m.V, m.F, NormalWeighting::max));

@@ -5,10 +5,10 @@
 
 namespace focal::cli {
 
-MeshFindings check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name,
-                         bool strict, const Log& log) {
+MeshFindings check_input(const PreparedMesh& mesh, const std::string& mesh_name, bool strict,
+                         const Log& log) {
   Stage stage(log, "check");
-  const MeshFindings findings = check_mesh(mesh.V, mesh.F, normals);
+  const MeshFindings findings = check_mesh(mesh);
   log.info("  " + std::to_string(findings.component_count) + " component(s), " +
            std::to_string(findings.boundary_edge_count) + " boundary edge(s)");
   if (!findings.has_problems()) return findings;

@@ -6,15 +6,17 @@
 
 #include "focal/core/mesh.h"
 #include "focal/mesh/check.h"
+#include "focal/mesh/prepared.h"
 #include "log.h"
 
 namespace focal::cli {
 
-/// Checks the mesh (and the normals the run will use, `normals` with 0 rows when they are
+/// Checks the mesh (with the normals the run will use, when it has them: not when they are
 /// estimated from the faces) and prints "Warning: <file>: <counts>" when anything was found.
-/// Returns the findings, which the normals stage reuses (orientation, the normals' direction).
+/// Returns the findings, which the mesh keeps for the normals stage (orientation, the normals'
+/// direction).
 /// \throw InvalidInput naming the file and the counts when `strict` and anything was found.
-MeshFindings check_input(const Mesh& mesh, NormalsRef normals, const std::string& mesh_name,
-                         bool strict, const Log& log);
+MeshFindings check_input(const PreparedMesh& mesh, const std::string& mesh_name, bool strict,
+                         const Log& log);
 
 }  // namespace focal::cli

@@ -106,17 +106,18 @@ Eigen::VectorXd field_values(const CurvatureResult& c, const std::string& field)
 }
 
 void run_render(RenderFlags& f, const Log& log) {
-  Input input = read_input(f.input, f.estimator, log);
-  const Estimate e = estimate(input, f.input, f.estimator, log);
-  const Mesh& mesh = input.mesh;
-  const RowMatrixX3d& normals = e.normals;
-  const CurvatureResult& fields = e.fields;
+  const Input input(f.input, f.estimator, log);
+  const Estimate e = run_estimate(input, f.input, f.estimator, log);
+  const PreparedMesh mesh = estimated_mesh(input, e);
+  const CurvatureResult& fields = e.curvature;
   FieldPictureOptions& p = f.picture;
+  p.threads = f.estimator.threads;
   if (f.focal_meshes) {
     Stage stage(log, "focal meshes");
     // Faces reaching a focal point at infinity would only draw long slivers across the view.
-    p.focal_meshes = focal_meshes(mesh.V, mesh.F, normals, fields,
-                                  {.max_distance = 0.0, .drop_faces_at_infinity = true});
+    p.focal_meshes = focal_meshes(
+        mesh, fields,
+        {.max_distance = 0.0, .drop_faces_at_infinity = true, .threads = f.estimator.threads});
   }
   if (f.directions == "d1") p.directions = fields.d1;
   if (f.directions == "d2") p.directions = fields.d2;
@@ -126,7 +127,7 @@ void run_render(RenderFlags& f, const Log& log) {
   Image image;
   {
     Stage stage(log, "render");
-    image = render_field_picture(mesh.V, mesh.F, normals, field_values(fields, f.field), p);
+    image = render_field_picture(mesh.V(), mesh.F(), mesh.N(), field_values(fields, f.field), p);
   }
   Stage stage(log, "write");
   write_png(f.output, image);

@@ -1177,12 +1177,10 @@ TEST_F(MeshIo, BytesThatAreNotUtf8) {
 // ---------------------------------------------------------------------------------------------
 // Parallel binary reading and writing: the same bytes and meshes for any thread count
 
-using focal::test::ScopedThreads;
-
 /// The read_mesh() message for p, or "" when it reads.
-std::string read_error(const fs::path& p) {
+std::string read_error(const fs::path& p, int threads = 0) {
   try {
-    (void)focal::read_mesh(p);
+    (void)focal::read_mesh(p, {.threads = threads});
   } catch (const focal::IoError& e) {
     return e.what();
   }
@@ -1265,8 +1263,7 @@ TEST_F(MeshIo, PlyBinaryReadIsTheSameForAnyThreadCount) {
     for (const int threads : {1, 2, 3}) {
       SCOPED_TRACE("big endian " + std::to_string(big_endian) + ", threads " +
                    std::to_string(threads));
-      const ScopedThreads scoped(threads);
-      expect_same_mesh(ply.expected, focal::read_mesh(p));
+      expect_same_mesh(ply.expected, focal::read_mesh(p, {.threads = threads}));
     }
   }
 }
@@ -1290,8 +1287,8 @@ TEST_F(MeshIo, PlyBinaryParallelReadFallsBackWithTheSameResultsAndErrors) {
   const fs::path pc = write("cut.ply", cut);
   std::vector<std::string> first;
   for (const int threads : {1, 2}) {
-    const ScopedThreads scoped(threads);
-    const std::vector<std::string> messages = {read_error(pr), read_error(pt), read_error(pc)};
+    const std::vector<std::string> messages = {read_error(pr, threads), read_error(pt, threads),
+                                               read_error(pc, threads)};
     EXPECT_NE(messages[0].find("byte offset " + std::to_string(bad) +
                                ": face 70000 refers to vertex 50000 but there are 50000 vertices"),
               std::string::npos)
@@ -1318,9 +1315,8 @@ TEST_F(MeshIo, PlyBinaryParallelReadFallsBackWithTheSameResultsAndErrors) {
   q.put(std::uint8_t{4}).put(0).put(1).put(2).put(3);
   q.put(std::uint8_t{3}).put(3).put(2).put(1);
   for (const int threads : {1, 2}) {
-    const ScopedThreads scoped(threads);
-    expect_faces(focal::read_mesh(write("quad.ply", q.data)), {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}},
-                 {0, 0, 1});
+    expect_faces(focal::read_mesh(write("quad.ply", q.data), {.threads = threads}),
+                 {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}}, {0, 0, 1});
   }
 }
 
@@ -1388,9 +1384,8 @@ TEST_F(MeshIo, PlyBinaryWriteIsTheSameForAnyThreadCount) {
     std::string first;
     for (const int threads : {1, 2, 3}) {
       SCOPED_TRACE("threads " + std::to_string(threads));
-      const ScopedThreads scoped(threads);
       const fs::path p = file("out.ply");
-      focal::write_ply(p, m, props);
+      focal::write_ply(p, m, props, {.binary = true, .comments = {}, .threads = threads});
       const std::string bytes = slurp(p);
       EXPECT_TRUE(body_of(bytes) == reference);
       if (first.empty()) {
@@ -1443,8 +1438,8 @@ TEST_F(MeshIo, CurvaturePlyIsWritePlyOfTheFields) {
       focal::write_ply(file("plain.ply"), m, props, {.binary = false, .comments = {comment}});
     }
     for (const int threads : {1, 2}) {
-      const ScopedThreads scoped(threads);
-      focal::write_curvature_ply(file("fields.ply"), m, r, {.binary = binary, .comments = {}});
+      focal::write_curvature_ply(file("fields.ply"), m, r,
+                                 {.binary = binary, .comments = {}, .threads = threads});
       EXPECT_TRUE(slurp(file("fields.ply")) == slurp(file("plain.ply"))) << binary << threads;
     }
   }

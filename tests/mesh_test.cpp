@@ -70,11 +70,13 @@ TEST(MeanEdgeLength, IsTheSameForAnyThreadCount) {
   const std::string saved = env != nullptr ? env : "";
   double first = 0.0;
   for (const int threads : {1, 2, 3}) {
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
-    const double mean = mean_edge_length(V, F);
+    const double mean = mean_edge_length(V, F, threads);
     EXPECT_NEAR(mean, expected, 1e-12 * expected) << threads;
     if (threads == 1) first = mean;
     EXPECT_EQ(mean, first) << threads;  // bit for bit
+    // threads = 0: FOCAL_NUM_THREADS.
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    EXPECT_EQ(mean_edge_length(V, F), first) << threads;
   }
   if (saved.empty()) {
     unsetenv("FOCAL_NUM_THREADS");
@@ -92,13 +94,15 @@ TEST(ValidateMeshArrays, NamesTheFirstBadFaceForAnyThreadCount) {
   const char* env = std::getenv("FOCAL_NUM_THREADS");
   const std::string saved = env != nullptr ? env : "";
   for (const int threads : {1, 2, 3}) {
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
     try {
-      validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test");
+      validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test", threads);
       ADD_FAILURE() << "no exception";
     } catch (const InvalidInput& e) {
       EXPECT_STREQ(e.what(), "test: face 70000 refers to vertex 10, but there are 10 vertices");
     }
+    // threads = 0: FOCAL_NUM_THREADS.
+    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    EXPECT_THROW(validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test"), InvalidInput);
   }
   F(70000, 2) = 9;
   F(90000, 0) = 9;

@@ -47,10 +47,10 @@ double paper_max(const AnalyticSurface& s) {
   return rel_h(s, estimate_curvature(s.mesh.V, s.mesh.F, n));
 }
 double recommended_file(const AnalyticSurface& s) {
-  return rel_h(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N));
+  return rel_h(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N).curvature);
 }
 double recommended_none(const AnalyticSurface& s) {
-  return rel_h(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F));
+  return rel_h(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt).curvature);
 }
 
 constexpr auto irregular = Triangulation::irregular;
@@ -138,10 +138,12 @@ void expect_same(const CurvatureResult& a, const CurvatureResult& b) {
 TEST(Recommended, SameResultForAnyThreadCount) {
   for (Noise noise : {Noise::normals, Noise::positions}) {
     const AnalyticSurface s = suite_case(SurfaceKind::saddle, irregular, noise, 3000);
-    expect_same(estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, 1),
-                estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, 3));
-    expect_same(estimate_curvature_recommended(s.mesh.V, s.mesh.F, 1),
-                estimate_curvature_recommended(s.mesh.V, s.mesh.F, 3));
+    expect_same(
+        estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, {.threads = 1}).curvature,
+        estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, {.threads = 3}).curvature);
+    expect_same(
+        estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt, {.threads = 1}).curvature,
+        estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt, {.threads = 3}).curvature);
   }
 }
 
@@ -150,9 +152,11 @@ TEST(Recommended, BoundaryVerticesAreEstimated) {
   // H within two rings of the boundary, measured: noisy normals 0.224 (paper: 3.89), no normals
   // 0.161 (paper with Max normals: 0.539).
   const AnalyticSurface s = suite_case(SurfaceKind::saddle, irregular, Noise::normals);
-  const Evaluation rec = evaluate(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N));
+  const Evaluation rec =
+      evaluate(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N).curvature);
   const Evaluation paper = evaluate(s, estimate_curvature(s.mesh.V, s.mesh.F, s.mesh.N));
-  const Evaluation none = evaluate(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F));
+  const Evaluation none =
+      evaluate(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt).curvature);
   const Evaluation max =
       evaluate(s, estimate_curvature(s.mesh.V, s.mesh.F,
                                      vertex_normals(s.mesh.V, s.mesh.F, NormalWeighting::max)));
@@ -172,18 +176,18 @@ TEST(Recommended, UndefinedCasesAndMissingNormals) {
   m.N.conservativeResize(n + 1, 3);
   m.N.row(n) << 0, 0, 1;
   m.N.row(0).setZero();  // no file normal: the jet normal takes its place
-  const CurvatureResult r = estimate_curvature_recommended(m.V, m.F, m.N);
+  const CurvatureResult r = estimate_curvature_recommended(m.V, m.F, m.N).curvature;
   EXPECT_EQ(r.class_of(static_cast<int>(n)), PointClass::undefined);
   EXPECT_TRUE(std::isnan(r.H[n]));
   EXPECT_NEAR(r.H[0], 1.0, 0.02);
-  const CurvatureResult none = estimate_curvature_recommended(m.V, m.F);
+  const CurvatureResult none = estimate_curvature_recommended(m.V, m.F, std::nullopt).curvature;
   EXPECT_EQ(none.class_of(static_cast<int>(n)), PointClass::undefined);
   // A lone triangle: too few rays for a fit anywhere, NaN rather than zeros.
   RowMatrixX3d V(3, 3);
   V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
   RowMatrixX3i F(1, 3);
   F << 0, 1, 2;
-  const CurvatureResult tri = estimate_curvature_recommended(V, F);
+  const CurvatureResult tri = estimate_curvature_recommended(V, F, std::nullopt).curvature;
   for (int i = 0; i < 3; ++i) EXPECT_FALSE(tri.H[i] == 0.0 && tri.class_of(i) != PointClass::flat);
 }
 
@@ -194,12 +198,13 @@ TEST(Recommended, NoisyFileNormalsAreIgnoredAsAWhole) {
   for (auto [kind, t] : {std::pair{SurfaceKind::torus, irregular},
                          std::pair{SurfaceKind::helix_tube, Triangulation::regular}}) {
     const AnalyticSurface s = suite_case(kind, t, Noise::normals, 3000);
-    const RecommendedResult file =
-        estimate_curvature_recommended_full(s.mesh.V, s.mesh.F, s.mesh.N);
+    const RecommendedResult file = estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N);
     EXPECT_FALSE(file.file_normals_used) << surface_name(kind);
-    expect_same(file.curvature, estimate_curvature_recommended(s.mesh.V, s.mesh.F));
+    expect_same(file.curvature,
+                estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt).curvature);
     const RowMatrixX3d inward = -s.mesh.N;
-    const CurvatureResult flipped = estimate_curvature_recommended(s.mesh.V, s.mesh.F, inward);
+    const CurvatureResult flipped =
+        estimate_curvature_recommended(s.mesh.V, s.mesh.F, inward).curvature;
     for (Eigen::Index i = 0; i < flipped.H.size(); ++i) {
       if (std::isnan(file.curvature.H[i])) continue;
       ASSERT_EQ(flipped.H[i], -file.curvature.H[i]) << i;
@@ -215,7 +220,7 @@ TEST(Recommended, ExactFileNormalsAreKept) {
        {std::pair{SurfaceKind::ellipsoid, Noise::clean}, std::pair{SurfaceKind::pear, Noise::clean},
         std::pair{SurfaceKind::torus, Noise::positions}}) {
     const AnalyticSurface s = suite_case(kind, irregular, noise, 3000);
-    const RecommendedResult r = estimate_curvature_recommended_full(s.mesh.V, s.mesh.F, s.mesh.N);
+    const RecommendedResult r = estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N);
     EXPECT_TRUE(r.file_normals_used) << surface_name(kind);
     EXPECT_LT(r.file_disagreement, 2.0 * r.plan.noise) << surface_name(kind);
     for (Eigen::Index i = 0; i < s.mesh.N.rows(); ++i) {
@@ -239,7 +244,7 @@ TEST(Recommended, IsolatedBadFileNormalsAreReplaced) {
     bad.N.row(i) = (corrupted.size() % 2 == 0 ? Eigen::Vector3d(-n) : turned).transpose();
     corrupted.push_back(i);
   }
-  const RecommendedResult r = estimate_curvature_recommended_full(bad.V, bad.F, bad.N);
+  const RecommendedResult r = estimate_curvature_recommended(bad.V, bad.F, bad.N);
   EXPECT_TRUE(r.file_normals_used);
   for (Eigen::Index i : corrupted) {
     EXPECT_GT((r.N.row(i) - bad.N.row(i).normalized()).norm(), 0.5) << "vertex " << i;
@@ -253,11 +258,14 @@ TEST(Recommended, IsolatedBadFileNormalsAreReplaced) {
 TEST(Recommended, RejectsInvalidInput) {
   const Mesh m = suite_case(SurfaceKind::sphere, irregular, Noise::clean, 200).mesh;
   EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, m.N.topRows(5)), InvalidInput);
-  EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, m.N, -1), InvalidInput);
-  EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, -1), InvalidInput);
+  EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, m.N, {.threads = -1}).curvature,
+               InvalidInput);
+  EXPECT_THROW(
+      (void)estimate_curvature_recommended(m.V, m.F, std::nullopt, {.threads = -1}).curvature,
+      InvalidInput);
   RowMatrixX3i F = m.F;
   F(0, 0) = static_cast<int>(m.V.rows());
-  EXPECT_THROW((void)estimate_curvature_recommended(m.V, F), InvalidInput);
+  EXPECT_THROW((void)estimate_curvature_recommended(m.V, F, std::nullopt).curvature, InvalidInput);
 }
 
 // The table of docs/ESTIMATOR.md: build/release/tests/recommended_test

@@ -100,7 +100,7 @@ TEST(Robustness, NonFiniteCoordinateLeavesItsVertexUndefinedAndTheRestExact) {
     const int v = 17;
     m.V(v, 1) = bad;
     EXPECT_TRUE(std::isfinite(mean_edge_length(m.V, m.F)));
-    EXPECT_EQ(check_mesh(m.V, m.F, m.N).non_finite_vertex_count, 1);
+    EXPECT_EQ(check_mesh(m.V, m.F, m.normals()).non_finite_vertex_count, 1);
     for (const auto& options : {CurvatureOptions{}, gaussian()}) {
       const CurvatureResult r = estimate_curvature(m.V, m.F, m.N, options);
       expect_undefined(r, v);
@@ -248,7 +248,7 @@ TEST(Robustness, NeedleTrianglesKeepTheSphereExact) {
   for (const double t : {1e-4, 1e-8}) {
     const Mesh m = split_edge(base, b, c, t);
     ASSERT_EQ(m.F.rows(), base.F.rows() + 2);
-    const MeshFindings f = check_mesh(m.V, m.F, m.N);
+    const MeshFindings f = check_mesh(m.V, m.F, m.normals());
     EXPECT_FALSE(f.has_problems()) << "t " << t << ": " << f.summary();
     expect_sphere_values(estimate_curvature(m.V, m.F, m.N), 1.0, {});
     // Max's weights stay exact on needles up to the rounding of the input: the corners are
@@ -266,7 +266,7 @@ TEST(Robustness, ZeroAreaFacesAreCountedAndChangeNothing) {
   m.F.conservativeResize(m.F.rows() + 2, 3);
   m.F.row(m.F.rows() - 2) << 2, 1, 0;  // three grid points on one line, oriented like the grid
   m.F.row(m.F.rows() - 1) << 6, 7, 6;  // a repeated index
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.degenerate_face_count, 1);
   EXPECT_EQ(f.repeated_index_face_count, 1);
   EXPECT_EQ(f.summary(), "1 face with a repeated vertex, 1 zero-area face, 1 non-manifold edge");
@@ -289,7 +289,7 @@ TEST(Robustness, DuplicateAndRepeatedIndexFacesLeaveTheVertexMethodUnchanged) {
   m.F.row(n) = clean.F.row(5);                                       // the same face again
   m.F.row(n + 1) << clean.F(9, 2), clean.F(9, 0), clean.F(9, 1);     // rotated: same vertex set
   m.F.row(n + 2) << clean.F(20, 0), clean.F(20, 0), clean.F(20, 1);  // repeated index
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.duplicate_face_count, 2);
   EXPECT_EQ(f.repeated_index_face_count, 1);
   // The rings are sets of neighbours, so the vertex method sees exactly the clean mesh.
@@ -310,9 +310,9 @@ TEST(Robustness, DuplicateAndRepeatedIndexFacesLeaveTheVertexMethodUnchanged) {
 TEST(Robustness, OutOfRangeIndicesAreRejectedNotRead) {
   Mesh m = sphere();
   m.F(3, 1) = static_cast<int>(m.V.rows());
-  EXPECT_THROW((void)check_mesh(m.V, m.F, m.N), InvalidInput);
+  EXPECT_THROW((void)check_mesh(m.V, m.F, m.normals()), InvalidInput);
   m.F(3, 1) = -1;
-  EXPECT_THROW((void)check_mesh(m.V, m.F, m.N), InvalidInput);
+  EXPECT_THROW((void)check_mesh(m.V, m.F, m.normals()), InvalidInput);
   EXPECT_THROW((void)estimate_curvature(m.V, m.F, m.N), InvalidInput);
 }
 
@@ -330,7 +330,7 @@ TEST(Robustness, NonManifoldEdgeFinIsFittedExactly) {
   m.N.row(a) = apex.normalized();
   m.F.conservativeResize(m.F.rows() + 1, 3);
   m.F.row(m.F.rows() - 1) << b, c, a;
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.non_manifold_edge_count, 1);
   EXPECT_EQ(f.non_manifold_vertex_count, 0);
   EXPECT_EQ(f.boundary_edge_count, 2);
@@ -367,7 +367,7 @@ TEST(Robustness, SpheresTouchingAtOneVertexAreFittedExactly) {
       if (m.F(f, k) == n + touch) m.F(f, k) = touch;
     }
   }
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.non_manifold_vertex_count, 1);
   EXPECT_EQ(f.unreferenced_vertex_count, 1);  // B's own copy of the touching vertex
   EXPECT_EQ(f.component_count, 1);
@@ -386,7 +386,7 @@ TEST(Robustness, HoleBoundaryVerticesAreStillExact) {
   RowMatrixX3i kept(m.F.rows() - 1, 3);
   kept << m.F.topRows(7), m.F.bottomRows(m.F.rows() - 8);
   m.F = kept;
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.boundary_edge_count, 3);
   EXPECT_FALSE(f.has_problems()) << f.summary();
   expect_sphere_values(estimate_curvature(m.V, m.F, m.N), 1.0, {});
@@ -394,7 +394,7 @@ TEST(Robustness, HoleBoundaryVerticesAreStillExact) {
 
 TEST(Robustness, SeveralComponentsAreEstimatedIndependently) {
   const Mesh m = join(sphere(1.0), sphere(2.0), Eigen::RowVector3d(10, 0, 0));
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.component_count, 2);
   EXPECT_FALSE(f.has_problems()) << f.summary();
   const CurvatureResult r = estimate_curvature(m.V, m.F, m.N);
@@ -413,7 +413,7 @@ TEST(Robustness, InwardAndInconsistentOrientationIsFoundPerComponent) {
   // The second sphere turned inside out, one face of the first flipped on its own.
   for (Eigen::Index f = n; f < m.F.rows(); ++f) std::swap(m.F(f, 1), m.F(f, 2));
   std::swap(m.F(4, 1), m.F(4, 2));
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.inward_component_count, 1);
   EXPECT_EQ(f.inconsistent_component_count, 1);
   // The file's normals are outward: against the second sphere's faces, and the flipped face
@@ -443,7 +443,7 @@ TEST(Robustness, BadNormalRowsAreCountedByKind) {
   m.N.row(4) *= 2.0;
   m.N.row(5) *= 1.0 + 1e-7;  // within the estimator's 1e-6: unit
   m.N.row(6) *= -1.0;        // inward
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.zero_normal_count, 1);
   EXPECT_EQ(f.non_finite_normal_count, 2);
   EXPECT_EQ(f.non_unit_normal_count, 1);
@@ -467,7 +467,7 @@ TEST(Robustness, InwardNormalsAreDetectedPerComponentAndGiveNegativeCurvature) {
   Mesh m = join(sphere(1.0), sphere(2.0), Eigen::RowVector3d(10, 0, 0));
   const Eigen::Index n = sphere(1.0).V.rows();
   m.N.bottomRows(m.V.rows() - n) *= -1.0;
-  const MeshFindings f = check_mesh(m.V, m.F, m.N);
+  const MeshFindings f = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(f.inward_normal_component_count, 1);
   EXPECT_EQ(f.normals_against_faces_count, m.V.rows() - n);
   EXPECT_EQ(f.inward_component_count, 0);
@@ -479,7 +479,7 @@ TEST(Robustness, InwardNormalsAreDetectedPerComponentAndGiveNegativeCurvature) {
   // normals agree with them.
   for (Eigen::Index f2 = sphere(1.0).F.rows(); f2 < m.F.rows(); ++f2)
     std::swap(m.F(f2, 1), m.F(f2, 2));
-  const MeshFindings g = check_mesh(m.V, m.F, m.N);
+  const MeshFindings g = check_mesh(m.V, m.F, m.normals());
   EXPECT_EQ(g.inward_component_count, 1);
   EXPECT_EQ(g.inward_normal_component_count, 1);
   EXPECT_EQ(g.normals_against_faces_count, 0);
@@ -491,17 +491,19 @@ TEST(Robustness, SingleTriangleAndEmptyMeshHaveNoProblems) {
   m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
   m.F.resize(1, 3);
   m.F << 0, 1, 2;
-  const MeshFindings f = check_mesh(m.V, m.F, RowMatrixX3d(0, 3));
+  const MeshFindings f = check_mesh(m.V, m.F, std::nullopt);
   EXPECT_FALSE(f.has_problems()) << f.summary();
   EXPECT_EQ(f.boundary_edge_count, 3);
   EXPECT_EQ(f.component_count, 1);
-  const MeshFindings e = check_mesh(RowMatrixX3d(0, 3), RowMatrixX3i(0, 3), RowMatrixX3d(0, 3));
+  const MeshFindings e = check_mesh(RowMatrixX3d(0, 3), RowMatrixX3i(0, 3), std::nullopt);
   EXPECT_FALSE(e.has_problems());
   EXPECT_EQ(e.summary(), "");
   // Three unreferenced vertices and nothing else.
-  const MeshFindings p = check_mesh(m.V, RowMatrixX3i(0, 3), RowMatrixX3d(0, 3));
+  const MeshFindings p = check_mesh(m.V, RowMatrixX3i(0, 3), std::nullopt);
   EXPECT_EQ(p.summary(), "3 unreferenced vertices");
   EXPECT_THROW((void)check_mesh(m.V, m.F, RowMatrixX3d::Zero(2, 3)), InvalidInput);
+  // No normals is std::nullopt, not a matrix of 0 rows.
+  EXPECT_THROW((void)check_mesh(m.V, m.F, RowMatrixX3d(0, 3)), InvalidInput);
 }
 
 // ---- The parallel topology pass (check stage) against a serial reference ----------------------
@@ -594,8 +596,7 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
   ASSERT_GT(against, 10000);
 
   for (const int threads : {1, 2, 3}) {
-    const test::ScopedThreads scoped(threads);
-    const MeshStatistics s = mesh_statistics(m.V, m.F);
+    const MeshStatistics s = mesh_statistics(m.V, m.F, threads);
     EXPECT_EQ(s.edge_count, static_cast<int>(faces_of_edge.size()));
     EXPECT_EQ(s.boundary_edge_count, boundary);
     EXPECT_EQ(s.non_manifold_edge_count, non_manifold);
@@ -604,12 +605,12 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     EXPECT_EQ(s.unreferenced_vertex_count, 1);
     EXPECT_EQ(s.non_manifold_vertex_count, 1);  // vertex 0: its grid fan and the joining face
     EXPECT_EQ(s.component_count, 2);            // the joining face makes one of the first two
-    const OrientationReport r = orientation_report(m.V, m.F);
+    const OrientationReport r = orientation_report(m.V, m.F, threads);
     ASSERT_EQ(r.face_component.size(), static_cast<Eigen::Index>(components.size()));
     for (std::size_t f = 0; f < components.size(); ++f) {
       ASSERT_EQ(r.face_component[static_cast<Eigen::Index>(f)], components[f]) << "face " << f;
     }
-    const MeshFindings findings = check_mesh(m.V, m.F, m.N);
+    const MeshFindings findings = check_mesh(m.V, m.F, m.normals(), threads);
     EXPECT_EQ(findings.component_count, 2);
     EXPECT_EQ(findings.duplicate_face_count, 1);
     EXPECT_EQ(findings.repeated_index_face_count, 2);
@@ -635,8 +636,7 @@ TEST(Robustness, InwardNormalComponentsAreCountedAlikeForAnyThreadCount) {
   m.N.middleRows(n, n) *= -1.0;  // the second torus: most normals inward
   m.N.topRows(n / 3) *= -1.0;    // a third of the first: a minority, still outward
   for (const int threads : {1, 2, 3}) {
-    const test::ScopedThreads scoped(threads);
-    const MeshFindings f = check_mesh(m.V, m.F, m.N);
+    const MeshFindings f = check_mesh(m.V, m.F, m.normals(), threads);
     EXPECT_EQ(f.component_count, 3);
     EXPECT_EQ(f.inward_normal_component_count, 1) << threads << " threads";
     EXPECT_EQ(f.normals_against_faces_count, n + n / 3) << threads << " threads";

@@ -9,13 +9,15 @@
 #include <span>
 #include <vector>
 
+#include "core/simd_lanes.h"
+#include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
-#include "focal/mesh/neighbourhood.h"
+#include "curvature/triangle_curvature_detail.h"
 #include "focal/curvature/normal_rays.h"
-#include "focal/surfaces/surfaces.h"
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/curvature/two_slit_fit.h"
-#include "core/simd_lanes.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
 namespace focal {

@@ -13,27 +13,6 @@
 
 namespace focal::test {
 
-/// Sets FOCAL_NUM_THREADS for the lifetime of the object.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int threads) {
-    if (const char* old = std::getenv("FOCAL_NUM_THREADS")) old_ = old;
-    setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
-  }
-  ~ScopedThreads() {
-    if (old_) {
-      setenv("FOCAL_NUM_THREADS", old_->c_str(), 1);
-    } else {
-      unsetenv("FOCAL_NUM_THREADS");
-    }
-  }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  std::optional<std::string> old_;
-};
-
 /// An n x n grid of unit squares in the plane z = 0, two triangles each, normals +z.
 inline Mesh flat_grid(int n, double spacing = 1.0) {
   Mesh m;

@@ -12,14 +12,14 @@
 
 namespace focal {
 
-void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what) {
+void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what, int threads) {
   const auto n = V.rows();
   // Checked in parallel blocks; only a mesh with a bad index is scanned again, in order, for the
   // first one.
   constexpr std::int64_t kBlock = 1 << 15;
   const std::int64_t faces = F.rows();
   std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
-  detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+  detail::parallel_for_blocks(faces, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
     bool ok = true;
     for (std::int64_t f = begin; f < end; ++f) {
       for (int c = 0; c < 3; ++c) ok &= F(f, c) >= 0 && F(f, c) < n;
@@ -43,7 +43,7 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
   }
 }
 
-double mean_edge_length(PositionsRef V, FacesRef F) {
+double mean_edge_length(PositionsRef V, FacesRef F, int threads) {
   // Edges with a NaN or infinite end are left out: one bad coordinate would otherwise make the
   // tolerances derived from this length NaN for the whole mesh, not just near the bad vertex.
   // Summed per block of faces, the blocks' sums then added in block order: blocks do not depend
@@ -53,7 +53,7 @@ double mean_edge_length(PositionsRef V, FacesRef F) {
   const std::int64_t blocks = (faces + kBlock - 1) / kBlock;
   std::vector<double> sums(static_cast<std::size_t>(blocks), 0.0);
   std::vector<std::int64_t> counts(static_cast<std::size_t>(blocks), 0);
-  detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+  detail::parallel_for_blocks(faces, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
     double sum = 0.0;
     std::int64_t count = 0;
     for (std::int64_t f = begin; f < end; ++f) {

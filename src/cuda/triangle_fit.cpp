@@ -26,7 +26,7 @@ TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
     throw InvalidInput(std::string(what) + ": " + std::to_string(N.rows()) + " normals for " +
                        std::to_string(V.rows()) + " vertices");
   }
-  validate_mesh_arrays(V, F, N, what);
+  validate_mesh_arrays(V, F, N, what, options.threads);
   TriangleInput in;
   in.faces = static_cast<int>(F.rows());
   in.V.resize(3 * static_cast<std::size_t>(V.rows()));
@@ -40,7 +40,8 @@ TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
     for (int c = 0; c < 3; ++c) in.F[3 * f + c] = F(f, c);
   }
   // The thresholds of triangle_curvature (detail::class_tolerances), rounded to float.
-  in.zero_tolerance = static_cast<float>(options.zero_tolerance / mean_edge_length(V, F));
+  in.zero_tolerance =
+      static_cast<float>(options.zero_tolerance / mean_edge_length(V, F, options.threads));
   in.umbilic_tolerance = static_cast<float>(options.umbilic_tolerance);
   return in;
 }

@@ -45,7 +45,7 @@ inline void validate_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N,
                        std::to_string(V.rows()) +
                        " vertices (normals are required; estimate them with vertex_normals)");
   }
-  validate_mesh_arrays(V, F, N, "estimate_curvature_cuda");
+  validate_mesh_arrays(V, F, N, "estimate_curvature_cuda", o.threads);
 }
 
 /// Threshold of det / (trace/3)^3 below which a fit is `undefined`. The CPU (double) uses 1e-12.
@@ -93,7 +93,7 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
   validate_vertex_fit(V, F, N, options);
   PreparedVertexFit<T> p;
   const Eigen::Index n = V.rows();
-  const double h = mean_edge_length(V, F);
+  const double h = mean_edge_length(V, F, options.threads);
   const double unit = length_unit(h, options.rings);
   p.vertices.resize(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -105,8 +105,8 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
       split(normal_ok ? N(i, c) / length : NAN, r.normal_hi[c], r.normal_lo[c]);
     }
   }
-  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(n), F);
-  p.rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
+  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(n), F, options.threads);
+  p.rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings, options.threads);
   // As curvature.cpp: Gaussian width = mean edge length x rings unless given; class_tolerances.
   const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
   VertexFitParams<T>& q = p.params;

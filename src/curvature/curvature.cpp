@@ -4,28 +4,26 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
-#include "focal/core/error.h"
-#include "focal/mesh/neighbourhood.h"
-#include "focal/curvature/normal_rays.h"
-#include "curvature/lanes.h"
-#include "curvature/normal_rays_detail.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
+#include "curvature/curvature_detail.h"
+#include "curvature/detail.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "curvature/triangle_curvature_detail.h"
 #include "curvature/two_slit_detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/prepared_detail.h"
 
 namespace focal {
 
-// Implemented in triangle_curvature.cpp: Method::triangle.
-CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
-                                                const CurvatureOptions& options);
-
-namespace {
-
-void validate_options(const CurvatureOptions& o) {
+void detail::validate_curvature_options(const CurvatureOptions& o) {
   if (o.rings < 1)
     throw InvalidInput("curvature: rings must be >= 1, got " + std::to_string(o.rings));
   if (!(o.gaussian_width >= 0.0)) throw InvalidInput("curvature: gaussian_width must be >= 0");
@@ -34,6 +32,8 @@ void validate_options(const CurvatureOptions& o) {
     throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
   if (o.threads < 0) throw InvalidInput("curvature: threads must be >= 0");
 }
+
+namespace {
 
 /// Everything one vertex's fit reads, shared by all vertices.
 struct FitContext {
@@ -354,16 +354,19 @@ FitBlock fit_block_for(detail::SimdIsa isa) {
   return detail::kernel_for(isa, fit_block_avx512, fit_block_avx2, fit_block_baseline);
 }
 
-CurvatureResult vertex_curvature_from_rays(PositionsRef V, FacesRef F, NormalsRef N,
-                                           const CurvatureOptions& options) {
-  std::vector<char> normal_ok;
-  const RowMatrixX3d unit = detail::unit_rows(N, normal_ok, options.threads);
-  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(V.rows()), F);
-  const Neighbourhoods rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
-  return detail::fit_vertices({V, unit, normal_ok, rings, mean_edge_length(V, F)}, options);
-}
-
 }  // namespace
+
+CurvatureResult detail::vertex_curvature_from_rays(const PreparedMesh& mesh,
+                                                   const Neighbourhoods& one_ring,
+                                                   const CurvatureOptions& options) {
+  CurvatureOptions o = options;
+  o.threads = threads_for(mesh, options.threads);
+  const UnitNormals& unit = unit_normals(mesh);
+  const VertexFitInput in{mesh.V(), unit.N, unit.ok, one_ring, mesh.mean_edge_length()};
+  if (o.rings == 1) return fit_vertices(in, o);
+  const Neighbourhoods rings = k_ring(one_ring, o.rings, o.threads);
+  return fit_vertices({in.V, unit.N, unit.ok, rings, in.mean_edge_length}, o);
+}
 
 PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_tolerance) {
   if (!std::isfinite(k1) || !std::isfinite(k2)) return PointClass::undefined;
@@ -375,18 +378,24 @@ PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_
   return k1 * k2 > 0.0 ? PointClass::elliptic : PointClass::hyperbolic;
 }
 
+CurvatureResult estimate_curvature(const PreparedMesh& mesh, const CurvatureOptions& options) {
+  detail::validate_curvature_options(options);
+  if (!mesh.has_normals()) {
+    throw InvalidInput(
+        "curvature: the mesh has no normals (they are required; estimate them with "
+        "vertex_normals)");
+  }
+  if (options.method == Method::triangle) {
+    return detail::vertex_curvature_from_triangles(mesh, options);
+  }
+  return detail::vertex_curvature_from_rays(mesh, *detail::one_ring(mesh), options);
+}
+
 CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                    const CurvatureOptions& options) {
-  validate_options(options);
-  if (N.rows() != V.rows()) {
-    throw InvalidInput("curvature: " + std::to_string(N.rows()) + " normals for " +
-                       std::to_string(V.rows()) +
-                       " vertices (normals are required; estimate "
-                       "them with vertex_normals)");
-  }
-  validate_mesh_arrays(V, F, N, "curvature");
-  if (options.method == Method::triangle) return vertex_curvature_from_triangles(V, F, N, options);
-  return vertex_curvature_from_rays(V, F, N, options);
+  detail::validate_curvature_options(options);
+  return estimate_curvature(
+      detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "curvature"), options);
 }
 
 namespace detail {

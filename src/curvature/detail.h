@@ -7,12 +7,12 @@
 #include <limits>
 #include <vector>
 
-#include "focal/curvature/curvature.h"
-#include "focal/mesh/neighbourhood.h"
-#include "focal/curvature/normal_rays.h"
-#include "focal/curvature/triangle_curvature.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
+#include "focal/curvature/curvature.h"
+#include "focal/curvature/normal_rays.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/prepared_detail.h"  // unit_rows
 
 namespace focal::detail {
 
@@ -40,19 +40,6 @@ inline Principal2 principal_from_symmetric(double a, double b, double c) {
                                  : Eigen::Vector2d(std::abs(bs), std::copysign(r - ds, bs));
   d1 /= std::sqrt(2.0 * r * (r + std::abs(ds)));
   return {mean + s * r, mean - s * r, d1, Eigen::Vector2d(-d1.y(), d1.x())};
-}
-
-/// Unit copies of the rows of N; `valid[i]` is false where a row is zero or not finite.
-/// Rows are independent, so any thread count gives the same result.
-inline RowMatrixX3d unit_rows(NormalsRef N, std::vector<char>& valid, int threads = 0) {
-  RowMatrixX3d unit(N.rows(), 3);
-  valid.resize(static_cast<std::size_t>(N.rows()));
-  parallel_for(N.rows(), threads, [&](std::int64_t i) {
-    const double len = N.row(i).norm();
-    valid[static_cast<std::size_t>(i)] = std::isfinite(len) && len > 0.0;
-    unit.row(i) = N.row(i) / len;
-  });
-  return unit;
 }
 
 /// A result of n vertices with every field allocated but not written: the caller writes each
@@ -116,27 +103,5 @@ inline void store_vertex(CurvatureResult& r, Eigen::Index i, const TangentFrame&
   r.residual[i] = residual;
   r.point_class[i] = static_cast<std::uint8_t>(classify(p.k1, p.k2, tol.zero, tol.umbilic));
 }
-
-/// What the per-vertex fit reads besides the options. Split from estimate_curvature so that
-/// bench/ can time the fit step alone (normals and neighbourhoods already at hand).
-struct VertexFitInput {
-  PositionsRef V;
-  const RowMatrixX3d& unit_normals;    ///< from unit_rows
-  const std::vector<char>& normal_ok;  ///< from unit_rows
-  const Neighbourhoods& rings;
-  double mean_edge_length;  ///< scale of the Gaussian weights and the class tolerances
-};
-
-/// The per-vertex two-slit fit of every vertex (Method::vertex); defined in curvature.cpp. The
-/// closed form runs one vertex per lane, compiled for `isa` (simd_lanes.h; tests compare the
-/// instruction sets, which give the same bits).
-CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
-                             SimdIsa isa = SimdIsa::best);
-
-/// focal::triangle_curvature with the faces solved by the lane kernel compiled for `isa`
-/// (tests compare the instruction sets); defined in triangle_curvature.cpp.
-TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
-                                           const CurvatureOptions& options,
-                                           const TriangleFields& fields, SimdIsa isa);
 
 }  // namespace focal::detail

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
 #include "focal/core/error.h"
+#include "mesh/prepared_detail.h"
 
 namespace focal {
 namespace {
@@ -51,24 +51,32 @@ void keep_faces(FacesRef F, bool drop_at_infinity, FocalMesh& m) {
 
 }  // namespace
 
-FocalMeshes focal_meshes(PositionsRef V, FacesRef F, NormalsRef N, const CurvatureResult& curvature,
+FocalMeshes focal_meshes(const PreparedMesh& mesh, const CurvatureResult& curvature,
                          const FocalMeshOptions& options) {
-  if (N.rows() != V.rows() || curvature.k1.size() != V.rows() || curvature.k2.size() != V.rows()) {
+  const PositionsRef& V = mesh.V();
+  if (!mesh.has_normals() || curvature.k1.size() != V.rows() || curvature.k2.size() != V.rows()) {
     throw InvalidInput("focal meshes: " + std::to_string(V.rows()) + " vertices, but " +
-                       std::to_string(N.rows()) + " normals and " +
+                       (mesh.has_normals() ? "" : "no normals and ") +
                        std::to_string(curvature.k1.size()) + " curvature values");
   }
   if (!(options.max_distance >= 0.0)) throw InvalidInput("focal meshes: max_distance must be >= 0");
-  validate_mesh_arrays(V, F, N, "focal meshes");
+  if (options.threads < 0) throw InvalidInput("focal meshes: threads must be >= 0");
   const double max_distance =
       options.max_distance > 0.0 ? options.max_distance : 10.0 * bounding_box_diagonal(V);
-  std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(N, ok);
-  FocalMeshes out{focal_points(V, unit, ok, curvature.k1, max_distance),
-                  focal_points(V, unit, ok, curvature.k2, max_distance)};
-  keep_faces(F, options.drop_faces_at_infinity, out.gamma1);
-  keep_faces(F, options.drop_faces_at_infinity, out.gamma2);
+  const detail::UnitNormals& unit = detail::unit_normals(mesh);
+  FocalMeshes out{focal_points(V, unit.N, unit.ok, curvature.k1, max_distance),
+                  focal_points(V, unit.N, unit.ok, curvature.k2, max_distance)};
+  keep_faces(mesh.F(), options.drop_faces_at_infinity, out.gamma1);
+  keep_faces(mesh.F(), options.drop_faces_at_infinity, out.gamma2);
   return out;
+}
+
+FocalMeshes focal_meshes(PositionsRef V, FacesRef F, NormalsRef N, const CurvatureResult& curvature,
+                         const FocalMeshOptions& options) {
+  if (options.threads < 0) throw InvalidInput("focal meshes: threads must be >= 0");
+  return focal_meshes(
+      detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "focal meshes"),
+      curvature, options);
 }
 
 }  // namespace focal

@@ -3,51 +3,88 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/parallel.h"
+#include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/normals/jets.h"
 #include "focal/mesh/normals.h"
-#include "core/parallel.h"
+#include "focal/normals/jets.h"
+#include "mesh/normals_detail.h"
+#include "mesh/prepared_detail.h"
+#include "normals/jets_detail.h"
 
 namespace focal {
 namespace {
 
-/// Everything the steps share: the mesh, its 1-ring (built once), its edge length and Max's
+void validate_options(const RecommendedOptions& o, const char* what) {
+  const auto non_negative = [&](double x, const char* name) {
+    if (!(x >= 0.0)) throw InvalidInput(std::string(what) + ": " + name + " must be >= 0");
+  };
+  non_negative(o.noise_for_two_rings, "noise_for_two_rings");
+  non_negative(o.noise_for_three_rings, "noise_for_three_rings");
+  non_negative(o.file_agreement, "file_agreement");
+  non_negative(o.outlier_disagreement, "outlier_disagreement");
+  non_negative(o.zero_tolerance, "zero_tolerance");
+  non_negative(o.umbilic_tolerance, "umbilic_tolerance");
+  if (o.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
+}
+
+/// Everything the steps share: the mesh (its incidence and edge length kept there), its 1-ring
+/// (the mesh's if kept, else built here once and dropped before the per-triangle pass) and Max's
 /// normals (the jets' starting frames, and a candidate field of their own).
 struct Context {
-  PositionsRef V;
-  FacesRef F;
-  Neighbourhoods one_ring;
-  double edge_length;
+  const PreparedMesh& mesh;
+  const RecommendedOptions& options;
   int threads;
+  double edge_length;
+  std::shared_ptr<const Neighbourhoods> one_ring;
   RowMatrixX3d max;
 };
 
-Context make_context(PositionsRef V, FacesRef F, int threads) {
-  return {V,
-          F,
-          vertex_adjacency(static_cast<int>(V.rows()), F),
-          mean_edge_length(V, F),
+Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options) {
+  const int threads = detail::threads_for(mesh, options.threads);
+  return {mesh,
+          options,
           threads,
-          vertex_normals(V, F, NormalWeighting::max)};
+          mesh.mean_edge_length(),
+          detail::one_ring(mesh),
+          detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh),
+                                      NormalWeighting::max, threads)};
 }
 
-/// The paper's per-vertex closed-form two-slit fit of `normals` over `rings` rings, on the
-/// 1-ring built once (estimate_curvature would rebuild it per call).
-CurvatureResult two_slit_fit(const Context& c, NormalsRef normals, int rings, bool gaussian) {
+/// The paper's estimator options with the recommended estimator's classes and threads.
+CurvatureOptions paper_options(const Context& c) {
   CurvatureOptions o;
+  o.zero_tolerance = c.options.zero_tolerance;
+  o.umbilic_tolerance = c.options.umbilic_tolerance;
+  o.threads = c.threads;
+  return o;
+}
+
+/// The paper's per-vertex closed-form two-slit fit of the normals of `normals` (the mesh with
+/// some normal field) over `rings` rings, on the context's 1-ring (estimate_curvature would build
+/// the k-ring from scratch per call).
+CurvatureResult two_slit_fit(const Context& c, const PreparedMesh& normals, int rings,
+                             bool gaussian) {
+  CurvatureOptions o = paper_options(c);
   o.rings = rings;
   o.weighting = gaussian && rings > 1 ? RayWeighting::gaussian : RayWeighting::uniform;
-  o.threads = c.threads;
-  std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(normals, ok, c.threads);
-  if (rings == 1) return detail::fit_vertices({c.V, unit, ok, c.one_ring, c.edge_length}, o);
-  const Neighbourhoods ring = k_ring(c.one_ring, rings);
-  return detail::fit_vertices({c.V, unit, ok, ring, c.edge_length}, o);
+  const detail::UnitNormals& unit = detail::unit_normals(normals);
+  const PositionsRef& V = c.mesh.V();
+  if (rings == 1) return detail::fit_vertices({V, unit.N, unit.ok, *c.one_ring, c.edge_length}, o);
+  const Neighbourhoods ring = k_ring(*c.one_ring, rings, c.threads);
+  return detail::fit_vertices({V, unit.N, unit.ok, ring, c.edge_length}, o);
+}
+
+/// two_slit_fit of another normal field: its unit rows live only as long as the fit needs them.
+CurvatureResult two_slit_fit(const Context& c, NormalsRef normals, int rings, bool gaussian) {
+  return two_slit_fit(c, c.mesh.with_normals(normals), rings, gaussian);
 }
 
 /// How rough a normal field is at each vertex: the RMS misfit (residual, slope units) of its
@@ -78,13 +115,14 @@ double finite_median(const Eigen::VectorXd& x) {
   return *mid;
 }
 
+/// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
 JetNormals local_jets(const Context& c, int rings, int degree) {
   JetOptions o;
   o.rings = rings;
   o.degree = degree;
   o.iterations = 1;
   o.threads = c.threads;
-  return jet_normals(c.V, c.F, c.one_ring, c.max, o);
+  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o);
 }
 
 /// Per vertex, the primary normal unless the secondary field is clearly smoother there: its
@@ -153,23 +191,19 @@ Eigen::VectorXd angles_between(NormalsRef A, NormalsRef B, double side, int thre
 }
 
 /// The file's normals agree with the positions when their median angle to the jet normals is
-/// within kAgreement times the position noise. The jets' own normal error is about the noise
-/// (median angle / noise measured 0.8 to 1.05 with exact file normals under 10% vertex noise, 0.09
-/// to 0.95 on clean meshes), so a median angle beyond twice it means file normals whose own
-/// error is larger than the jets' (measured 5.3 to 4600 under 5% normal noise).
-constexpr double kAgreement = 2.0;
-
-/// replace_outliers: a file normal that agrees with the positions as a whole is an outlier
-/// candidate where it is more than this many times the noise from the jet normal: an order of
+/// within `agreement` (RecommendedOptions::file_agreement, 2) times the position noise. The jets'
+/// own normal error is about the noise (median angle / noise measured 0.8 to 1.05 with exact file
+/// normals under 10% vertex noise, 0.09 to 0.95 on clean meshes), so a median angle beyond twice
+/// it means file normals whose own error is larger than the jets' (measured 5.3 to 4600 under 5%
+/// normal noise). Outliers among agreeing normals (replace_outliers) are those more than
+/// RecommendedOptions::outlier_disagreement (10) times the noise from the jet normal: an order of
 /// magnitude beyond the jets' own error. (The suite's results are the same for 4, 10 and no
 /// replacement at all; the factor matters for files with isolated bad normals.)
-constexpr double kOutlierDisagreement = 10.0;
-
-bool file_normals_agree(double median_angle, double noise) {
+bool file_normals_agree(double median_angle, double noise, double agreement) {
   if (!std::isfinite(median_angle)) return false;  // no normal of the file is usable
   if (!std::isfinite(noise)) return true;          // no jets to judge them by
   // Angles at rounding level agree whatever the noise (a plane has noise 0).
-  return median_angle <= std::max(kAgreement * noise, 1e-12);
+  return median_angle <= std::max(agreement * noise, 1e-12);
 }
 
 /// A 1-ring fit residual (RMS ray misfit, slope units) at or below this is rounding: the rays
@@ -193,12 +227,11 @@ void copy_vertex(const CurvatureResult& from, Eigen::Index i, CurvatureResult& t
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
 /// exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
 /// triangles give no estimate, and takes the triangles' elsewhere.
-void prefer_triangles(PositionsRef V, FacesRef F, NormalsRef N, int threads, CurvatureResult& fit) {
-  CurvatureOptions o;
+void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureResult& fit) {
+  CurvatureOptions o = paper_options(c);
   o.method = Method::triangle;
-  o.threads = threads;
-  const CurvatureResult triangles = estimate_curvature(V, F, N, o);
-  detail::parallel_for(V.rows(), threads, [&](std::int64_t i) {
+  const CurvatureResult triangles = estimate_curvature(fitted, o);
+  detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
     const bool exact_fit = fit.residual[i] <= kExactFitResidual;
     const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
     if (!exact_fit && triangles_defined) copy_vertex(triangles, i, fit);
@@ -206,18 +239,20 @@ void prefer_triangles(PositionsRef V, FacesRef F, NormalsRef N, int threads, Cur
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
-/// normals are used, and the normals to fit, into `out`. N has 0 rows without file normals.
-void choose_normals(const Context& c, NormalsRef N, RecommendedResult& out) {
-  const bool has_normals = N.rows() > 0;
+/// normals (the mesh's, if any) are used, and the normals to fit, into `out`.
+void choose_normals(const Context& c, RecommendedResult& out) {
+  const std::optional<NormalsRef> file = c.mesh.normals();
+  const bool has_normals = file.has_value();
   const JetNormals jets = local_jets(c, 2, 3);
-  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length);
+  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, c.options);
   // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
   // normals from the positions take the side of the faces until turned.
-  const double side = has_normals ? majority_side(N, jets.N) : 1.0;
+  const double side = has_normals ? majority_side(*file, jets.N) : 1.0;
   const Eigen::VectorXd disagreement =
-      has_normals ? angles_between(N, jets.N, side, c.threads) : Eigen::VectorXd();
+      has_normals ? angles_between(*file, jets.N, side, c.threads) : Eigen::VectorXd();
   out.file_disagreement = has_normals ? finite_median(disagreement) : NAN;
-  out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise);
+  out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise,
+                                                            c.options.file_agreement);
   Eigen::VectorXd roughness;
   if (!out.file_normals_used && out.plan.rings > 1) {
     // Noisy positions: normals from wider, lower-degree jets that average the noise.
@@ -233,64 +268,66 @@ void choose_normals(const Context& c, NormalsRef N, RecommendedResult& out) {
   if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
   if (out.file_normals_used) {
     // The file's normals, except outliers where the positions' choice is clearly smoother.
-    const CurvatureResult with_file = two_slit_fit(c, N, 1, false);
-    out.N = replace_outliers(N, roughness_of(with_file), disagreement, out.N, roughness,
-                             kOutlierDisagreement * out.plan.noise, c.threads);
+    const CurvatureResult with_file = two_slit_fit(c, *file, 1, false);
+    out.N = replace_outliers(*file, roughness_of(with_file), disagreement, out.N, roughness,
+                             c.options.outlier_disagreement * out.plan.noise, c.threads);
   }
 }
 
 }  // namespace
 
-RecommendedPlan recommended_plan_for_noise(double noise) {
+RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOptions& options) {
   RecommendedPlan plan;
   plan.noise = noise;
-  if (!(noise > kNoiseForTwoRings)) return plan;  // also NaN: no estimate, keep the 1-ring
-  plan.rings = noise > kNoiseForThreeRings ? 3 : 2;
+  // Also NaN: no estimate, keep the 1-ring.
+  if (!(noise > options.noise_for_two_rings)) return plan;
+  plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
   plan.gaussian = true;
   plan.jet_rings = plan.rings + 1;
   plan.jet_degree = 2;
   return plan;
 }
 
-RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, int threads) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "recommended_plan");
-  if (threads < 0) throw InvalidInput("recommended_plan: threads must be >= 0");
-  const Context c = make_context(V, F, threads);
+RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOptions& options) {
+  validate_options(options, "recommended_plan");
+  const Context c = make_context(mesh, options);
   const JetNormals jets = local_jets(c, 2, 3);
-  return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length);
+  return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, options);
 }
 
-RecommendedResult estimate_curvature_recommended_full(PositionsRef V, FacesRef F, NormalsRef N,
-                                                      int threads) {
-  const bool has_normals = N.rows() > 0;
-  if (has_normals && N.rows() != V.rows())
-    throw InvalidInput("estimate_curvature_recommended: " + std::to_string(N.rows()) +
-                       " normals for " + std::to_string(V.rows()) + " vertices");
-  validate_mesh_arrays(V, F, N, "estimate_curvature_recommended");
-  if (threads < 0) throw InvalidInput("estimate_curvature_recommended: threads must be >= 0");
-  Context c = make_context(V, F, threads);
+RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
+  validate_options(options, "recommended_plan");
+  return recommended_plan(detail::PreparedAccess::make(
+                              V, F, std::nullopt, {.threads = options.threads}, "recommended_plan"),
+                          options);
+}
+
+RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
+                                                 const RecommendedOptions& options) {
+  validate_options(options, "estimate_curvature_recommended");
+  Context c = make_context(mesh, options);
   RecommendedResult out;
-  choose_normals(c, N, out);
-  out.curvature = two_slit_fit(c, out.N, out.plan.rings, out.plan.gaussian);
+  choose_normals(c, out);
+  // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
+  const PreparedMesh fitted = mesh.with_normals(out.N);
+  out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
   if (out.plan.rings == 1) {
     // Memory the per-triangle pass can use (the peak of a run is in it).
-    c.one_ring = Neighbourhoods{};
+    c.one_ring.reset();
     c.max.resize(0, 3);
-    prefer_triangles(V, F, out.N, threads, out.curvature);
+    prefer_triangles(c, fitted, out.curvature);
   }
   return out;
 }
 
-CurvatureResult estimate_curvature_recommended(PositionsRef V, FacesRef F, NormalsRef N,
-                                               int threads) {
-  if (N.rows() != V.rows())
-    throw InvalidInput("estimate_curvature_recommended: " + std::to_string(N.rows()) +
-                       " normals for " + std::to_string(V.rows()) + " vertices");
-  return estimate_curvature_recommended_full(V, F, N, threads).curvature;
-}
-
-CurvatureResult estimate_curvature_recommended(PositionsRef V, FacesRef F, int threads) {
-  return estimate_curvature_recommended_full(V, F, RowMatrixX3d(0, 3), threads).curvature;
+RecommendedResult estimate_curvature_recommended(PositionsRef V, FacesRef F,
+                                                 std::optional<NormalsRef> N,
+                                                 const RecommendedOptions& options) {
+  validate_options(options, "estimate_curvature_recommended");
+  return estimate_curvature_recommended(
+      detail::PreparedAccess::make(V, F, std::move(N), {.threads = options.threads},
+                                   "estimate_curvature_recommended"),
+      options);
 }
 
 }  // namespace focal

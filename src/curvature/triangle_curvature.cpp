@@ -6,16 +6,19 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
-#include "focal/core/error.h"
-#include "focal/curvature/normal_rays.h"
-#include "curvature/lanes.h"
-#include "curvature/normal_rays_detail.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
+#include "curvature/detail.h"
+#include "curvature/lanes.h"
+#include "curvature/normal_rays_detail.h"
+#include "curvature/triangle_curvature_detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/normal_rays.h"
+#include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -322,6 +325,12 @@ double face_area(PositionsRef V, FacesRef F, int f) {
 
 }  // namespace
 
+TriangleCurvatureResult triangle_curvature(const PreparedMesh& mesh,
+                                           const CurvatureOptions& options,
+                                           const TriangleFields& fields) {
+  return detail::triangle_curvature(mesh, options, fields, detail::SimdIsa::best);
+}
+
 TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                            const CurvatureOptions& options) {
   return triangle_curvature(V, F, N, options, TriangleFields{});
@@ -336,21 +345,25 @@ TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRe
 TriangleCurvatureResult detail::triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                    const CurvatureOptions& options,
                                                    const TriangleFields& fields, SimdIsa isa) {
-  if (N.rows() != V.rows()) {
-    throw InvalidInput("triangle curvature: " + std::to_string(N.rows()) + " normals for " +
-                       std::to_string(V.rows()) + " vertices");
-  }
-  validate_mesh_arrays(V, F, N, "triangle curvature");
-  std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(N, ok, options.threads);
-  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
-  TriangleCurvatureResult r = unwritten_faces(F.rows(), fields);
-  const FaceInput in{V, unit, ok, F, tol, fields};
+  return triangle_curvature(
+      PreparedAccess::make(V, F, N, {.threads = options.threads}, "triangle curvature"), options,
+      fields, isa);
+}
+
+TriangleCurvatureResult detail::triangle_curvature(const PreparedMesh& mesh,
+                                                   const CurvatureOptions& options,
+                                                   const TriangleFields& fields, SimdIsa isa) {
+  if (!mesh.has_normals()) throw InvalidInput("triangle curvature: the mesh has no normals");
+  const int threads = threads_for(mesh, options.threads);
+  const UnitNormals& unit = unit_normals(mesh);
+  const ClassTolerances tol = class_tolerances(options, mesh.mean_edge_length());
+  TriangleCurvatureResult r = unwritten_faces(mesh.face_count(), fields);
+  const FaceInput in{mesh.V(), unit.N, unit.ok, mesh.F(), tol, fields};
   const FaceBlock solve_block = solve_face_block_for(isa);
   // Blocks are whole groups of every lane width, so each face's row is written by one thread.
-  detail::parallel_for_blocks(
-      F.rows(), 1024, options.threads,
-      [&](std::int64_t begin, std::int64_t end) { solve_block(in, begin, end, r); });
+  parallel_for_blocks(mesh.face_count(), 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    solve_block(in, begin, end, r);
+  });
   return r;
 }
 
@@ -394,31 +407,35 @@ void average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult
 
 }  // namespace
 
-CurvatureResult vertex_curvature_from_triangles(PositionsRef V, FacesRef F, NormalsRef N,
-                                                const CurvatureOptions& options) {
+CurvatureResult detail::vertex_curvature_from_triangles(const PreparedMesh& mesh,
+                                                        const CurvatureOptions& options) {
   // Only what the averaging reads: the face operators, their normals and classes.
   TriangleFields needed;
   needed.coefficients = needed.curvatures = needed.focal_depths = false;
   needed.directions = needed.slits = false;
-  const TriangleCurvatureResult faces = triangle_curvature(V, F, N, options, needed);
-  std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(N, ok, options.threads);
-  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F);
-  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
+  const TriangleCurvatureResult faces = triangle_curvature(mesh, options, needed, SimdIsa::best);
+  const PositionsRef& V = mesh.V();
+  const FacesRef& F = mesh.F();
+  const int threads = threads_for(mesh, options.threads);
+  const UnitNormals& unit_normals = detail::unit_normals(mesh);
+  const RowMatrixX3d& unit = unit_normals.N;
+  const std::vector<char>& ok = unit_normals.ok;
+  const std::shared_ptr<const VertexFaces> incidence = detail::incidence(mesh);
+  const VertexFaces& inc = *incidence;
+  const ClassTolerances tol = class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult r = detail::unwritten_result(V.rows());
   // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
-  detail::parallel_for_blocks(V.rows(), 256, options.threads,
-                              [&](std::int64_t begin, std::int64_t end) {
-                                std::vector<FacePart> parts;
-                                for (auto i = begin; i < end; ++i) {
-                                  if (ok[static_cast<std::size_t>(i)]) {
-                                    average_at_vertex(V, F, faces, inc, unit, tol, i, parts, r);
-                                  } else {
-                                    detail::store_undefined(r, i);
-                                    r.rays_used[i] = r.rays_excluded[i] = 0;
-                                  }
-                                }
-                              });
+  detail::parallel_for_blocks(V.rows(), 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<FacePart> parts;
+    for (auto i = begin; i < end; ++i) {
+      if (ok[static_cast<std::size_t>(i)]) {
+        average_at_vertex(V, F, faces, inc, unit, tol, i, parts, r);
+      } else {
+        detail::store_undefined(r, i);
+        r.rays_used[i] = r.rays_excluded[i] = 0;
+      }
+    }
+  });
   return r;
 }
 

@@ -104,7 +104,7 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
 
 // The per-format readers, dispatched by read_mesh().
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
-[[nodiscard]] Mesh read_ply(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
 
@@ -113,6 +113,8 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
 // in fuzz/ call these directly. \throw IoError as the readers.
 [[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data);
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
+/// parse_ply with its parallel passes on `threads` threads (0: the default).
+[[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
 [[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
 [[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
 

@@ -2,6 +2,7 @@
 
 #include "focal/io/mesh_io.h"
 
+#include "focal/core/error.h"
 #include "io/detail.h"
 
 namespace focal {
@@ -16,12 +17,13 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
                             "' (expected .obj, .ply, .off or .stl)");
 }
 
-Mesh read_mesh(const std::filesystem::path& path) {
+Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
+  if (options.threads < 0) throw InvalidInput("read_mesh: threads must be >= 0");
   switch (mesh_format_from_path(path)) {
     case MeshFormat::obj:
       return io_detail::read_obj(path);
     case MeshFormat::ply:
-      return io_detail::read_ply(path);
+      return io_detail::read_ply(path, options.threads);
     case MeshFormat::off:
       return io_detail::read_off(path);
     case MeshFormat::stl:

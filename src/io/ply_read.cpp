@@ -206,12 +206,13 @@ Out load_as(const unsigned char* p, Scalar t, bool swap) {
 class BinaryBody {
  public:
   BinaryBody(const std::filesystem::path& path, std::string_view data, std::size_t offset,
-             bool swap)
+             bool swap, int threads)
       : path_(path),
         begin_(reinterpret_cast<const unsigned char*>(data.data())),
         p_(begin_ + offset),
         end_(begin_ + data.size()),
-        swap_(swap) {}
+        swap_(swap),
+        threads_(threads) {}
 
   /// Rejects a count that cannot fit in the rest of the file, before anything is allocated.
   void check_fits(const PlyElement& e) const {
@@ -297,7 +298,7 @@ class BinaryBody {
     // both checks and converts, so a valid file is read once.
     constexpr std::int64_t kBlock = 1 << 14;
     std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
-    detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    detail::parallel_for_blocks(faces, kBlock, threads_, [&](std::int64_t begin, std::int64_t end) {
       bool ok = true;
       if (common) {
         for (std::int64_t f = begin; f < end; ++f) {
@@ -418,7 +419,7 @@ class BinaryBody {
     const std::size_t stride = offset;
     const unsigned char* first = p_;
     detail::parallel_for_blocks(
-        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, 0,
+        static_cast<std::int64_t>(e.count), std::int64_t{1} << 14, threads_,
         [&](std::int64_t begin, std::int64_t end) {
           // Field by field, so that the type switch is decided once per block and field.
           for (int k = 0; k < used; ++k) {
@@ -488,6 +489,7 @@ class BinaryBody {
   const unsigned char* p_;
   const unsigned char* end_;
   bool swap_;
+  int threads_;  ///< of the parallel passes over fixed-size records
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -706,9 +708,15 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body&
 
 namespace io_detail {
 
-Mesh read_ply(const std::filesystem::path& path) { return parse_ply(path, read_whole_file(path)); }
+Mesh read_ply(const std::filesystem::path& path, int threads) {
+  return parse_ply(path, read_whole_file(path), threads);
+}
 
 Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
+  return parse_ply(path, data, 0);
+}
+
+Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads) {
   const PlyHeader header = parse_header(path, data);
   if (header.encoding == PlyEncoding::ascii) {
     AsciiBody body(path, data.substr(header.body_offset), header.body_line);
@@ -716,7 +724,7 @@ Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
   }
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
   const bool host_big = std::endian::native == std::endian::big;
-  BinaryBody body(path, data, header.body_offset, file_big != host_big);
+  BinaryBody body(path, data, header.body_offset, file_big != host_big, threads);
   return read_body(path, header, body);
 }
 

@@ -38,7 +38,7 @@ bool valid_property_name(std::string_view name) {
 void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   const std::string what = "write_ply: " + path.string();
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str(), options.threads);
   std::vector<std::string_view> names = {"x", "y", "z"};
   if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
   for (const auto& column : columns) {
@@ -137,7 +137,7 @@ void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
 /// thread count.
 template <class Put>
 void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::size_t record,
-                         const Put& put) {
+                         int threads, const Put& put) {
   if (count == 0) return;
   constexpr std::int64_t kBlock = 1 << 12;
   const std::int64_t per_batch =
@@ -148,7 +148,7 @@ void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::s
   const std::unique_ptr<char[]> buffer(new char[static_cast<std::size_t>(batch) * record]);
   for (std::int64_t first = 0; first < count; first += batch) {
     const std::int64_t n = std::min(batch, count - first);
-    detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
       put(first + begin, first + end, buffer.get() + static_cast<std::size_t>(begin) * record);
     });
     sink.write(buffer.get(), static_cast<std::size_t>(n) * record);
@@ -186,12 +186,12 @@ void put_column_as(PropertyType type, char* out, std::size_t record, std::int64_
 }
 
 void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
-                           std::span<const PlyColumn> columns) {
+                           std::span<const PlyColumn> columns, int threads) {
   const bool normals = mesh.has_normals();
   std::size_t record = (normals ? 6 : 3) * sizeof(double);
   for (const auto& column : columns) record += property_bytes(column.type);
   // Column by column within a block, so that each type is dispatched once per block.
-  write_fixed_records(sink, mesh.V.rows(), record,
+  write_fixed_records(sink, mesh.V.rows(), record, threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         for (std::int64_t i = begin; i < end; ++i) {
                           char* p = out + static_cast<std::size_t>(i - begin) * record;
@@ -212,7 +212,7 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
                           offset += property_bytes(column.type);
                         }
                       });
-  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t),
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         char* p = out;
                         for (std::int64_t f = begin; f < end; ++f) {
@@ -232,7 +232,7 @@ void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
   write_atomically(path, [&](OutputSink& sink) {
     sink.buffer() += ply_header(mesh, columns, options);
     if (options.binary) {
-      write_ply_body_binary(sink, mesh, columns);
+      write_ply_body_binary(sink, mesh, columns, options.threads);
     } else {
       write_ply_body_ascii(sink, mesh, columns);
     }

@@ -5,10 +5,15 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
+#include "mesh/normals_detail.h"
+#include "mesh/prepared_detail.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -19,34 +24,37 @@ constexpr double kUnitTolerance = 1e-6;
 
 /// Sums count(i) over [0, n) in parallel blocks (integers: exact for any split).
 template <class Count>
-int parallel_count(std::int64_t n, Count&& count) {
+int parallel_count(std::int64_t n, int threads, Count&& count) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<int> sums(static_cast<std::size_t>(blocks), 0);
-  detail::parallel_blocks(n, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    int sum = 0;
-    for (auto i = begin; i < end; ++i) sum += count(i);
-    sums[static_cast<std::size_t>(b)] = sum;
-  });
+  detail::parallel_blocks(n, kBlock, threads,
+                          [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+                            int sum = 0;
+                            for (auto i = begin; i < end; ++i) sum += count(i);
+                            sums[static_cast<std::size_t>(b)] = sum;
+                          });
   int total = 0;
   for (const int sum : sums) total += sum;
   return total;
 }
 
 /// The findings about given normals: their rows, and their direction against the faces.
-void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshTopology& topology,
-                   const OrientationReport& report, MeshFindings& out) {
+void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::VertexFaces& incidence,
+                   const detail::MeshTopology& topology, const OrientationReport& report,
+                   int threads, MeshFindings& out) {
   out.non_finite_normal_count =
-      parallel_count(N.rows(), [&](std::int64_t i) { return !N.row(i).allFinite(); });
-  out.zero_normal_count = parallel_count(
-      N.rows(), [&](std::int64_t i) { return N.row(i).allFinite() && N.row(i).norm() == 0.0; });
-  out.non_unit_normal_count = parallel_count(N.rows(), [&](std::int64_t i) {
+      parallel_count(N.rows(), threads, [&](std::int64_t i) { return !N.row(i).allFinite(); });
+  out.zero_normal_count = parallel_count(N.rows(), threads, [&](std::int64_t i) {
+    return N.row(i).allFinite() && N.row(i).norm() == 0.0;
+  });
+  out.non_unit_normal_count = parallel_count(N.rows(), threads, [&](std::int64_t i) {
     const double length = N.row(i).norm();
     return N.row(i).allFinite() && length != 0.0 && std::abs(length - 1.0) > kUnitTolerance;
   });
   // Area weights: the face normals' own average, NaN where it does not exist (no usable face).
   const RowMatrixX3d from_faces =
-      detail::vertex_normals_from(V, F, topology.incidence, NormalWeighting::area);
+      detail::vertex_normals_from(V, F, incidence, NormalWeighting::area, threads);
   const std::vector<int>& component = topology.components.vertex_component;
   struct Tally {  // vertices with both normals, those against the faces, those pointing inside
     int compared = 0, against = 0, inside = 0, judged = 0;
@@ -58,7 +66,7 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshT
   // Keyed by component; vertices in no face have no face normal and drop out with it.
   std::vector<Tally> tally(report.components.size());
   detail::add_by_key_runs(
-      N.rows(), [&](std::int64_t i) { return component[static_cast<std::size_t>(i)]; },
+      N.rows(), threads, [&](std::int64_t i) { return component[static_cast<std::size_t>(i)]; },
       [&](Tally& t, std::int64_t i) {
         const double dot = N.row(i).dot(from_faces.row(i));
         if (!std::isfinite(dot)) return;
@@ -78,6 +86,38 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::MeshT
     out.normals_against_faces_count += t.against;
     out.inward_normal_component_count += 2 * t.inside > t.judged ? 1 : 0;
   }
+}
+
+/// check_mesh's counts, computed.
+MeshFindings find_problems(const PreparedMesh& mesh) {
+  const PositionsRef& V = mesh.V();
+  const FacesRef& F = mesh.F();
+  const int threads = mesh.threads();
+  const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
+  // One topology pass serves the statistics and the orientation report (each computed its own).
+  const detail::MeshTopology topology =
+      detail::mesh_topology(*incidence, F, detail::TopologyDetail::statistics, threads);
+  const OrientationReport report = detail::orientation_report_from(V, F, topology, threads);
+  MeshFindings out;
+  out.non_finite_vertex_count =
+      parallel_count(V.rows(), threads, [&](std::int64_t i) { return !V.row(i).allFinite(); });
+  out.repeated_index_face_count = parallel_count(
+      F.rows(), threads, [&](std::int64_t f) { return detail::has_repeated_index(F, f); });
+  // degenerate_face_count counts faces with a repeated index as degenerate too.
+  out.degenerate_face_count =
+      detail::degenerate_face_count(V, F, threads) - out.repeated_index_face_count;
+  out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
+  out.unreferenced_vertex_count = static_cast<int>(topology.unreferenced_vertex_count);
+  out.non_manifold_edge_count = static_cast<int>(topology.non_manifold_edge_count);
+  out.non_manifold_vertex_count = static_cast<int>(topology.non_manifold_vertex_count);
+  for (const auto& c : report.components) out.inconsistent_component_count += c.consistent ? 0 : 1;
+  out.inward_component_count = report.inward_count();
+  out.boundary_edge_count = static_cast<int>(topology.boundary_edge_count);
+  out.component_count = topology.components.count;
+  if (mesh.has_normals()) {
+    check_normals(V, F, mesh.N(), *incidence, topology, report, threads, out);
+  }
+  return out;
 }
 
 void append(std::string& text, int count, const char* singular, const char* plural) {
@@ -112,30 +152,12 @@ std::string MeshFindings::summary() const {
   return s;
 }
 
-MeshFindings check_mesh(PositionsRef V, FacesRef F, NormalsRef N) {
-  if (!detail::face_indices_in_range(V.rows(), F) || (N.rows() != 0 && N.rows() != V.rows())) {
-    validate_mesh_arrays(V, F, N, "check_mesh");  // throws, naming the first bad face
-  }
-  // One topology pass serves the statistics and the orientation report (each computed its own).
-  const detail::MeshTopology topology = detail::mesh_topology(V.rows(), F);
-  const OrientationReport report = detail::orientation_report_from(V, F, topology);
-  MeshFindings out;
-  out.non_finite_vertex_count =
-      parallel_count(V.rows(), [&](std::int64_t i) { return !V.row(i).allFinite(); });
-  out.repeated_index_face_count =
-      parallel_count(F.rows(), [&](std::int64_t f) { return detail::has_repeated_index(F, f); });
-  // degenerate_face_count counts faces with a repeated index as degenerate too.
-  out.degenerate_face_count = detail::degenerate_face_count(V, F) - out.repeated_index_face_count;
-  out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
-  out.unreferenced_vertex_count = static_cast<int>(topology.unreferenced_vertex_count);
-  out.non_manifold_edge_count = static_cast<int>(topology.non_manifold_edge_count);
-  out.non_manifold_vertex_count = static_cast<int>(topology.non_manifold_vertex_count);
-  for (const auto& c : report.components) out.inconsistent_component_count += c.consistent ? 0 : 1;
-  out.inward_component_count = report.inward_count();
-  out.boundary_edge_count = static_cast<int>(topology.boundary_edge_count);
-  out.component_count = topology.components.count;
-  if (N.rows() > 0) check_normals(V, F, N, topology, report, out);
-  return out;
+MeshFindings check_mesh(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, int threads) {
+  return check_mesh(detail::PreparedAccess::make(V, F, N, {.threads = threads}, "check_mesh"));
+}
+
+MeshFindings check_mesh(const PreparedMesh& mesh) {
+  return detail::PreparedAccess::findings(mesh, [&] { return find_problems(mesh); });
 }
 
 }  // namespace focal

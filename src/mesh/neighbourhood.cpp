@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "focal/core/error.h"
 #include "core/parallel.h"
+#include "focal/core/error.h"
+#include "mesh/neighbourhood_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -58,19 +59,24 @@ Eigen::VectorXi offsets_from_counts(const std::vector<int>& counts, const char* 
 
 }  // namespace
 
-Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F) {
+Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F, int threads) {
   // The parallel test first; the serial one only to name the first bad face.
-  if (vertex_count < 0 || !detail::face_indices_in_range(vertex_count, F)) {
+  if (vertex_count < 0 || !detail::face_indices_in_range(vertex_count, F, threads)) {
     detail::check_face_indices(vertex_count, F, "vertex_adjacency");
   }
-  const auto inc = detail::vertex_face_incidence(vertex_count, F);
+  return detail::vertex_adjacency_from(detail::vertex_face_incidence(vertex_count, F, threads), F,
+                                       threads);
+}
+
+Neighbourhoods detail::vertex_adjacency_from(const VertexFaces& inc, FacesRef F, int threads) {
+  const auto vertex_count = static_cast<int>(inc.vertex_count());
   // Each incident face adds at most two neighbours, so vertex v owns the slot starting at
   // 2 * inc.begin(v) of a scratch buffer: one pass fills it, a second compacts it.
   // Uninitialised: every slot is written before it is read, and zeroing it serially took a
   // quarter of the run time on a 1 M-vertex grid.
   const auto buffer = std::make_unique_for_overwrite<int[]>(2 * inc.faces.size());
   std::vector<int> counts(static_cast<std::size_t>(vertex_count));
-  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  detail::parallel_for(vertex_count, threads, [&](std::int64_t v) {
     int* const first = buffer.get() + 2 * static_cast<std::size_t>(inc.begin(v));
     int* last = first;
     for (int j = inc.begin(v); j < inc.end(v); ++j) {
@@ -85,7 +91,7 @@ Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F) {
   Neighbourhoods result;
   result.offsets = offsets_from_counts(counts, "vertex_adjacency");
   result.indices.resize(result.offsets[vertex_count]);
-  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  detail::parallel_for(vertex_count, threads, [&](std::int64_t v) {
     const int* first = buffer.get() + 2 * static_cast<std::size_t>(inc.begin(v));
     std::copy(first, first + counts[static_cast<std::size_t>(v)],
               result.indices.data() + result.offsets[v]);
@@ -149,7 +155,7 @@ constexpr int kRingBlocks = 2048;
 
 }  // namespace
 
-Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k) {
+Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
   if (k < 1) throw InvalidInput("k_ring: k must be at least 1, got " + std::to_string(k));
   check_csr(one_ring, "k_ring");
   if (k == 1) return one_ring;
@@ -160,8 +166,8 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k) {
   };
   std::vector<std::vector<int>> block_rings(static_cast<std::size_t>(blocks));
   std::vector<int> counts(static_cast<std::size_t>(n));
-  detail::PerThread<BfsScratch> scratch;
-  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
+  detail::PerThread<BfsScratch> scratch(threads);
+  detail::parallel_for(blocks, threads, [&](std::int64_t b) {
     BfsScratch& s = scratch.local();
     s.prepare(n);
     auto& out = block_rings[static_cast<std::size_t>(b)];
@@ -172,7 +178,7 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k) {
   Neighbourhoods result;
   result.offsets = offsets_from_counts(counts, "k_ring");
   result.indices.resize(result.offsets[n]);
-  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
+  detail::parallel_for(blocks, threads, [&](std::int64_t b) {
     auto& ring = block_rings[static_cast<std::size_t>(b)];
     std::copy(ring.begin(), ring.end(), result.indices.data() + result.offsets[block_begin(b)]);
     std::vector<int>().swap(ring);  // frees memory early: the result is as large again
@@ -180,14 +186,14 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k) {
   return result;
 }
 
-std::vector<bool> boundary_vertices(int vertex_count, FacesRef F) {
+std::vector<bool> boundary_vertices(int vertex_count, FacesRef F, int threads) {
   detail::check_face_indices(vertex_count, F, "boundary_vertices");
-  const auto inc = detail::vertex_face_incidence(vertex_count, F);
+  const auto inc = detail::vertex_face_incidence(vertex_count, F, threads);
   // Bytes, not std::vector<bool>: neighbouring bits of a vector<bool> share a word, so writing
   // them from different threads would race.
   std::vector<std::uint8_t> flags(static_cast<std::size_t>(vertex_count), 0);
-  detail::PerThread<std::vector<detail::EdgeSide>> scratch;
-  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  detail::PerThread<std::vector<detail::EdgeSide>> scratch(threads);
+  detail::parallel_for(vertex_count, threads, [&](std::int64_t v) {
     auto& sides = scratch.local();
     detail::collect_edge_sides(F, inc, v, sides);
     bool boundary = false;

@@ -9,8 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include "focal/core/error.h"
 #include "core/parallel.h"
+#include "focal/core/error.h"
+#include "mesh/normals_detail.h"
+#include "mesh/prepared_detail.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -95,35 +98,40 @@ Eigen::Vector3d gathered_normal(PositionsRef V, FacesRef F, const detail::Vertex
 }
 
 template <NormalWeighting weighting>
-void gather_normals(PositionsRef V, FacesRef F, const detail::VertexFaces& inc, RowMatrixX3d& N) {
-  detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
+void gather_normals(PositionsRef V, FacesRef F, const detail::VertexFaces& inc, int threads,
+                    RowMatrixX3d& N) {
+  detail::parallel_for(V.rows(), threads, [&](std::int64_t v) {
     N.row(v) = gathered_normal<weighting>(V, F, inc, v).transpose();
   });
 }
 
 }  // namespace
 
-RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F, NormalWeighting weighting) {
-  if (!detail::face_indices_in_range(V.rows(), F)) {
-    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "vertex_normals");  // throws, naming the face
-  }
-  return detail::vertex_normals_from(V, F, detail::vertex_face_incidence(V.rows(), F), weighting);
+RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F, NormalWeighting weighting, int threads) {
+  return vertex_normals(
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "vertex_normals"),
+      weighting);
+}
+
+RowMatrixX3d vertex_normals(const PreparedMesh& mesh, NormalWeighting weighting) {
+  return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh), weighting,
+                                     mesh.threads());
 }
 
 namespace detail {
 
 RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting) {
+                                 NormalWeighting weighting, int threads) {
   RowMatrixX3d N(V.rows(), 3);
   switch (weighting) {
     case NormalWeighting::area:
-      gather_normals<NormalWeighting::area>(V, F, inc, N);
+      gather_normals<NormalWeighting::area>(V, F, inc, threads, N);
       break;
     case NormalWeighting::angle:
-      gather_normals<NormalWeighting::angle>(V, F, inc, N);
+      gather_normals<NormalWeighting::angle>(V, F, inc, threads, N);
       break;
     case NormalWeighting::max:
-      gather_normals<NormalWeighting::max>(V, F, inc, N);
+      gather_normals<NormalWeighting::max>(V, F, inc, threads, N);
       break;
   }
   return N;
@@ -170,24 +178,30 @@ struct FaceTally {
 
 }  // namespace
 
-OrientationReport orientation_report(PositionsRef V, FacesRef F) {
-  if (!detail::face_indices_in_range(V.rows(), F)) {
-    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "orientation_report");  // throws
-  }
+OrientationReport orientation_report(PositionsRef V, FacesRef F, int threads) {
+  return orientation_report(
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "orientation_report"));
+}
+
+OrientationReport orientation_report(const PreparedMesh& mesh) {
+  const int threads = mesh.threads();
   return detail::orientation_report_from(
-      V, F, detail::mesh_topology(V.rows(), F, detail::TopologyDetail::orientation));
+      mesh.V(), mesh.F(),
+      detail::mesh_topology(*detail::incidence(mesh), mesh.F(), detail::TopologyDetail::orientation,
+                            threads),
+      threads);
 }
 
 // Signed volumes are taken per component about its vertex centroid: for a surface far from the
 // origin the determinants would otherwise be large terms that cancel. Both passes are parallel
 // (detail::add_by_key_runs: per-block runs added in block order, the same for any thread count).
-OrientationReport detail::orientation_report_from(PositionsRef V, FacesRef F,
-                                                  const MeshTopology& t) {
+OrientationReport detail::orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t,
+                                                  int threads) {
   const FaceComponents& comp = t.components;
   const auto count = static_cast<std::size_t>(comp.count);
   std::vector<VertexTally> vertices(count);
   add_by_key_runs(
-      static_cast<std::int64_t>(t.edge_flags.size()),
+      static_cast<std::int64_t>(t.edge_flags.size()), threads,
       [&](std::int64_t v) { return comp.vertex_component[static_cast<std::size_t>(v)]; },
       [&](VertexTally& tally, std::int64_t v) {
         const std::uint8_t flags = t.edge_flags[static_cast<std::size_t>(v)];
@@ -204,7 +218,8 @@ OrientationReport detail::orientation_report_from(PositionsRef V, FacesRef F,
   }
   std::vector<FaceTally> faces(count);
   add_by_key_runs(
-      F.rows(), [&](std::int64_t f) { return comp.face_component[static_cast<std::size_t>(f)]; },
+      F.rows(), threads,
+      [&](std::int64_t f) { return comp.face_component[static_cast<std::size_t>(f)]; },
       [&](FaceTally& tally, std::int64_t f) {
         const Vec3& o =
             centroid[static_cast<std::size_t>(comp.face_component[static_cast<std::size_t>(f)])];
@@ -268,12 +283,13 @@ std::size_t edge_slot(FacesRef F, int f, int a, int b) {
 
 // Each interior edge is linked by its lower vertex only and each slot belongs to one edge, so the
 // parallel writes never collide and the result does not depend on the thread count.
-FaceLinks face_links(std::int64_t vertex_count, FacesRef F, const detail::VertexFaces& inc) {
+FaceLinks face_links(std::int64_t vertex_count, FacesRef F, const detail::VertexFaces& inc,
+                     int threads) {
   FaceLinks links;
   links.across.assign(3 * static_cast<std::size_t>(F.rows()), -1);
   links.same.assign(3 * static_cast<std::size_t>(F.rows()), 0);
-  detail::PerThread<std::vector<detail::EdgeSide>> scratch;
-  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  detail::PerThread<std::vector<detail::EdgeSide>> scratch(threads);
+  detail::parallel_for(vertex_count, threads, [&](std::int64_t v) {
     auto& sides = scratch.local();
     detail::collect_edge_sides(F, inc, v, sides);
     detail::for_each_edge(sides, [&](int other, const detail::EdgeSide* first,
@@ -328,10 +344,10 @@ std::vector<std::uint8_t> consistent_flips(const FaceLinks& links, std::size_t f
 
 }  // namespace
 
-ConsistentFaces orient_consistently(int vertex_count, FacesRef F) {
+ConsistentFaces orient_consistently(int vertex_count, FacesRef F, int threads) {
   detail::check_face_indices(vertex_count, F, "orient_consistently");
-  const auto inc = detail::vertex_face_incidence(vertex_count, F);
-  const FaceLinks links = face_links(vertex_count, F, inc);
+  const auto inc = detail::vertex_face_incidence(vertex_count, F, threads);
+  const FaceLinks links = face_links(vertex_count, F, inc, threads);
   const auto face_count = static_cast<std::size_t>(F.rows());
   const std::vector<std::uint8_t> flip = consistent_flips(links, face_count);
 
@@ -354,14 +370,11 @@ ConsistentFaces orient_consistently(int vertex_count, FacesRef F) {
   return result;
 }
 
-double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N) {
-  validate_mesh_arrays(V, F, N, "fraction_against_faces");
-  if (N.rows() != V.rows()) {
-    throw InvalidInput("fraction_against_faces: " + std::to_string(N.rows()) + " normals for " +
-                       std::to_string(V.rows()) + " vertices");
-  }
+double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N, int threads) {
+  const PreparedMesh mesh =
+      detail::PreparedAccess::make(V, F, N, {.threads = threads}, "fraction_against_faces");
   // NaN rows (no face, or a vanishing sum) drop out through the finiteness test below.
-  const RowMatrixX3d face_normals = vertex_normals(V, F, NormalWeighting::area);
+  const RowMatrixX3d face_normals = vertex_normals(mesh, NormalWeighting::area);
   std::int64_t counted = 0;
   std::int64_t against = 0;
   for (Eigen::Index v = 0; v < V.rows(); ++v) {

@@ -3,8 +3,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "focal/mesh/neighbourhood.h"
 #include "core/parallel.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/prepared.h"
+#include "mesh/prepared_detail.h"
+#include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 
 namespace focal {
@@ -88,32 +91,33 @@ VertexCounts vertex_counts(FacesRef F, const VertexFaces& inc, std::int64_t v, b
 
 }  // namespace
 
-MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F, TopologyDetail detail) {
+MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads) {
   const bool statistics = detail == TopologyDetail::statistics;
+  const std::int64_t vertex_count = inc.vertex_count();
   MeshTopology t;
-  t.incidence = vertex_face_incidence(vertex_count, F);
-  t.components = face_components(vertex_count, F);
+  t.components = face_components(vertex_count, F, threads);
   t.edge_flags.resize(static_cast<std::size_t>(vertex_count));
   // Per-block sums of integers: exact, so the totals do not depend on the split.
   constexpr std::int64_t kBlock = 4096;
   const std::int64_t blocks = (vertex_count + kBlock - 1) / kBlock;
   std::vector<std::array<std::int64_t, 6>> sums(static_cast<std::size_t>(blocks));
-  PerThread<Scratch> scratch;
-  parallel_blocks(vertex_count, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    Scratch& s = scratch.local();
-    std::array<std::int64_t, 6> sum{};
-    for (auto v = begin; v < end; ++v) {
-      const VertexCounts c = vertex_counts(F, t.incidence, v, statistics, s);
-      t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
-      sum[0] += c.edges;
-      sum[1] += c.boundary_edges;
-      sum[2] += c.non_manifold_edges;
-      sum[3] += c.non_manifold_vertex ? 1 : 0;
-      sum[4] += c.duplicate_faces;
-      sum[5] += t.incidence.size(v) == 0 ? 1 : 0;
-    }
-    sums[static_cast<std::size_t>(b)] = sum;
-  });
+  PerThread<Scratch> scratch(threads);
+  parallel_blocks(vertex_count, kBlock, threads,
+                  [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+                    Scratch& s = scratch.local();
+                    std::array<std::int64_t, 6> sum{};
+                    for (auto v = begin; v < end; ++v) {
+                      const VertexCounts c = vertex_counts(F, inc, v, statistics, s);
+                      t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
+                      sum[0] += c.edges;
+                      sum[1] += c.boundary_edges;
+                      sum[2] += c.non_manifold_edges;
+                      sum[3] += c.non_manifold_vertex ? 1 : 0;
+                      sum[4] += c.duplicate_faces;
+                      sum[5] += inc.size(v) == 0 ? 1 : 0;
+                    }
+                    sums[static_cast<std::size_t>(b)] = sum;
+                  });
   for (const auto& sum : sums) {
     t.edge_count += sum[0];
     t.boundary_edge_count += sum[1];
@@ -125,19 +129,20 @@ MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F, TopologyDetail
   return t;
 }
 
-int degenerate_face_count(PositionsRef V, FacesRef F) {
+int degenerate_face_count(PositionsRef V, FacesRef F, int threads) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
   std::vector<int> count(static_cast<std::size_t>(blocks), 0);
-  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    int n = 0;
-    for (auto f = begin; f < end; ++f) {
-      n += has_repeated_index(F, f) ||
-           is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
-                                  V.row(F(f, 2)).transpose());
-    }
-    count[static_cast<std::size_t>(b)] = n;
-  });
+  parallel_blocks(
+      F.rows(), kBlock, threads, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+        int n = 0;
+        for (auto f = begin; f < end; ++f) {
+          n += has_repeated_index(F, f) ||
+               is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
+                                      V.row(F(f, 2)).transpose());
+        }
+        count[static_cast<std::size_t>(b)] = n;
+      });
   int total = 0;
   for (const int n : count) total += n;
   return total;
@@ -145,10 +150,9 @@ int degenerate_face_count(PositionsRef V, FacesRef F) {
 
 }  // namespace detail
 
-MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
-  if (!detail::face_indices_in_range(V.rows(), F)) {
-    validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "mesh_statistics");  // throws, naming the face
-  }
+MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads) {
+  const PreparedMesh mesh =
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "mesh_statistics");
   MeshStatistics stats;
   stats.vertex_count = static_cast<int>(V.rows());
   stats.face_count = static_cast<int>(F.rows());
@@ -156,9 +160,10 @@ MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
     stats.min_corner = V.colwise().minCoeff().transpose();
     stats.max_corner = V.colwise().maxCoeff().transpose();
   }
-  stats.mean_edge_length = mean_edge_length(V, F);
-  stats.degenerate_face_count = detail::degenerate_face_count(V, F);
-  const detail::MeshTopology t = detail::mesh_topology(V.rows(), F);
+  stats.mean_edge_length = mesh.mean_edge_length();
+  stats.degenerate_face_count = detail::degenerate_face_count(V, F, threads);
+  const detail::MeshTopology t = detail::mesh_topology(*detail::incidence(mesh), F,
+                                                       detail::TopologyDetail::statistics, threads);
   stats.component_count = t.components.count;
   stats.edge_count = static_cast<int>(t.edge_count);
   stats.boundary_edge_count = static_cast<int>(t.boundary_edge_count);

@@ -1,6 +1,6 @@
 #pragma once
 // Internal, header-only: the vertex->face incidence that normals.cpp, neighbourhood.cpp and
-// mesh_statistics.cpp gather over. Every per-vertex loop built on it reads the faces of its own
+// statistics.cpp gather over. Every per-vertex loop built on it reads the faces of its own
 // vertex in ascending face order and writes only that vertex's slot, so results are identical for
 // any thread count (no scatter-adds, no atomics, no hash maps per edge).
 //
@@ -21,21 +21,21 @@
 #include <utility>
 #include <vector>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/core/mesh.h"
-#include "focal/mesh/normals.h"
-#include "core/parallel.h"
 
 namespace focal::detail {
 
 /// Calls body(b, begin, end) for the blocks [begin, end) = [b block, min(n, (b + 1) block)) of
-/// [0, n), in parallel on all threads (thread_count(0)). For loops that keep a result per block:
-/// parallel_for(blocks, ...) sees only the block count, and its serial cutoff (1024 iterations)
-/// had every such loop run on one thread for meshes below 4M vertices.
+/// [0, n), in parallel on `threads` threads (see thread_count). For loops that keep a result per
+/// block: parallel_for(blocks, ...) sees only the block count, and its serial cutoff (1024
+/// iterations) had every such loop run on one thread for meshes below 4M vertices.
 template <class Body>
-void parallel_blocks(std::int64_t n, std::int64_t block, Body&& body) {
-  parallel_for_blocks(
-      n, block, 0, [&](std::int64_t begin, std::int64_t end) { body(begin / block, begin, end); });
+void parallel_blocks(std::int64_t n, std::int64_t block, int threads, Body&& body) {
+  parallel_for_blocks(n, block, threads, [&](std::int64_t begin, std::int64_t end) {
+    body(begin / block, begin, end);
+  });
 }
 
 /// Per-key totals over [0, n) in parallel: totals[key(i)] += item i (add(total, i)), for the
@@ -44,11 +44,12 @@ void parallel_blocks(std::int64_t n, std::int64_t block, Body&& body) {
 /// count, exact for integers. For per-component sums, since a mesh's vertices and faces mostly
 /// come in runs by component; a per-thread array per key would cost #threads x #keys.
 template <class Total, class Key, class Add>
-void add_by_key_runs(std::int64_t n, Key&& key, Add&& add, std::vector<Total>& totals) {
+void add_by_key_runs(std::int64_t n, int threads, Key&& key, Add&& add,
+                     std::vector<Total>& totals) {
   constexpr std::int64_t kBlock = 1 << 14;
   std::vector<std::vector<std::pair<int, Total>>> runs(
       static_cast<std::size_t>((n + kBlock - 1) / kBlock));
-  parallel_blocks(n, kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+  parallel_blocks(n, kBlock, threads, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
     auto& block_runs = runs[static_cast<std::size_t>(b)];
     for (auto i = begin; i < end; ++i) {
       const int k = key(i);
@@ -112,14 +113,17 @@ struct VertexFaces {
   [[nodiscard]] int begin(std::int64_t v) const { return offsets[static_cast<std::size_t>(v)]; }
   [[nodiscard]] int end(std::int64_t v) const { return offsets[static_cast<std::size_t>(v) + 1]; }
   [[nodiscard]] int size(std::int64_t v) const { return end(v) - begin(v); }
+  [[nodiscard]] std::int64_t vertex_count() const {
+    return static_cast<std::int64_t>(offsets.size()) - 1;
+  }
 };
 
 /// Face chunks of the parallel counting sort below: each chunk counts into an #V array of its
 /// own, so more chunks cost memory (4 #V bytes each) and a longer prefix pass.
-inline int incidence_chunks(std::int64_t face_count) {
+inline int incidence_chunks(std::int64_t face_count, int threads) {
   constexpr std::int64_t kMinFacesPerChunk = 1 << 16;
   const std::int64_t by_size = std::max<std::int64_t>(1, face_count / kMinFacesPerChunk);
-  return static_cast<int>(std::min<std::int64_t>({by_size, thread_count(0), 8}));
+  return static_cast<int>(std::min<std::int64_t>({by_size, thread_count(threads), 8}));
 }
 
 /// Visits the distinct corners of face f, so that (a, a, b) is listed once under a.
@@ -136,13 +140,13 @@ void for_each_distinct_corner(FacesRef F, Eigen::Index f, Fn&& fn) {
 /// list, so every list is ascending and the result is the same for any thread count.
 /// F must already be validated against vertex_count.
 /// \throw InvalidInput when 3 #F exceeds 32-bit offsets.
-inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F) {
+inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F, int threads) {
   if (3 * static_cast<std::int64_t>(F.rows()) > kMaxCsrEntries) {
     throw InvalidInput("too many faces (" + std::to_string(F.rows()) +
                        ") for 32-bit neighbourhood offsets");
   }
   const auto n = static_cast<std::size_t>(vertex_count);
-  const int chunks = incidence_chunks(F.rows());
+  const int chunks = incidence_chunks(F.rows(), threads);
   const auto chunk_begin = [&](std::int64_t k) { return k * F.rows() / chunks; };
   // cursor[k][v]: first counts of chunk k's faces at v, then where chunk k writes its next face.
   std::vector<std::vector<int>> cursor(static_cast<std::size_t>(chunks));
@@ -261,7 +265,7 @@ inline bool is_consistent_interior_edge(const EdgeSide* first, const EdgeSide* l
 template <class T>
 class PerThread {
  public:
-  explicit PerThread(int threads = 0) : slots_(static_cast<std::size_t>(thread_count(threads))) {}
+  explicit PerThread(int threads) : slots_(static_cast<std::size_t>(thread_count(threads))) {}
   T& local() { return slots_[static_cast<std::size_t>(omp_get_thread_num())]; }
 
  private:
@@ -329,10 +333,10 @@ inline void unite_shared(int* parent, int a, int b) {
 /// Numbers the sets of `root` (#V, each vertex's set root) in order of their first face:
 /// label[r] for each root r of a face's corners, -1 elsewhere. Returns the number of sets.
 inline int label_components_by_first_face(FacesRef F, const std::vector<int>& root,
-                                          std::vector<int>& label) {
+                                          std::vector<int>& label, int threads) {
   // first[r]: the smallest face of set r, by an atomic minimum (the same for any schedule).
   std::vector<int> first(root.size(), std::numeric_limits<int>::max());
-  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+  parallel_for(F.rows(), threads, [&](std::int64_t f) {
     std::atomic_ref<int> slot(
         first[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])]);
     int current = slot.load(std::memory_order_relaxed);
@@ -347,110 +351,74 @@ inline int label_components_by_first_face(FacesRef F, const std::vector<int>& ro
     return first[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] == f;
   };
   std::vector<int> block_start(static_cast<std::size_t>(blocks) + 1, 0);
-  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    int n = 0;
-    for (auto f = begin; f < end; ++f) n += starts_set(f);
-    block_start[static_cast<std::size_t>(b) + 1] = n;
-  });
+  parallel_blocks(F.rows(), kBlock, threads,
+                  [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+                    int n = 0;
+                    for (auto f = begin; f < end; ++f) n += starts_set(f);
+                    block_start[static_cast<std::size_t>(b) + 1] = n;
+                  });
   for (std::size_t b = 0; b < static_cast<std::size_t>(blocks); ++b) {
     block_start[b + 1] += block_start[b];
   }
   label.assign(root.size(), -1);
-  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    int next = block_start[static_cast<std::size_t>(b)];
-    for (auto f = begin; f < end; ++f) {
-      if (starts_set(f))
-        label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] = next++;
-    }
-  });
+  parallel_blocks(
+      F.rows(), kBlock, threads, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+        int next = block_start[static_cast<std::size_t>(b)];
+        for (auto f = begin; f < end; ++f) {
+          if (starts_set(f))
+            label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])] = next++;
+        }
+      });
   return block_start.back();
 }
 
 /// Union-find over vertices, in parallel (shared forest, see unite_shared). The sets do not
 /// depend on the order of the unions and each is numbered by its first face, so the result is
 /// the same for any thread count. F must already be validated against vertex_count.
-inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F) {
+inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F, int threads) {
   const auto n = static_cast<std::size_t>(vertex_count);
   std::vector<int> parent(n);
-  parallel_for(vertex_count, 0,
+  parallel_for(vertex_count, threads,
                [&](std::int64_t v) { parent[static_cast<std::size_t>(v)] = static_cast<int>(v); });
-  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+  parallel_for(F.rows(), threads, [&](std::int64_t f) {
     unite_shared(parent.data(), F(f, 0), F(f, 1));
     unite_shared(parent.data(), F(f, 0), F(f, 2));
   });
   std::vector<int> root(n);
-  parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  parallel_for(vertex_count, threads, [&](std::int64_t v) {
     root[static_cast<std::size_t>(v)] = find_shared_root(parent.data(), static_cast<int>(v));
   });
   FaceComponents result;
   std::vector<int> label;
-  result.count = label_components_by_first_face(F, root, label);
+  result.count = label_components_by_first_face(F, root, label, threads);
   result.face_component.resize(static_cast<std::size_t>(F.rows()));
-  parallel_for(F.rows(), 0, [&](std::int64_t f) {
+  parallel_for(F.rows(), threads, [&](std::int64_t f) {
     result.face_component[static_cast<std::size_t>(f)] =
         label[static_cast<std::size_t>(root[static_cast<std::size_t>(F(f, 0))])];
   });
   // An unreferenced vertex is its own, never labelled root, hence -1.
   result.vertex_component.resize(n);
-  parallel_for(vertex_count, 0, [&](std::int64_t v) {
+  parallel_for(vertex_count, threads, [&](std::int64_t v) {
     result.vertex_component[static_cast<std::size_t>(v)] =
         label[static_cast<std::size_t>(root[static_cast<std::size_t>(v)])];
   });
   return result;
 }
 
-/// Edge findings of one vertex for its edges to higher-indexed neighbours (each edge once).
-enum EdgeFlag : std::uint8_t {
-  kOpenEdge = 1,          ///< an edge without exactly two incident faces
-  kInconsistentEdge = 2,  ///< an interior edge traversed the same way by both faces
-};
-
-/// What mesh_statistics, orientation_report and check_mesh need of the connectivity, computed in
-/// one parallel pass over the vertices' edge sides (each was a pass of its own before).
-struct MeshTopology {
-  VertexFaces incidence;
-  FaceComponents components;
-  std::vector<std::uint8_t> edge_flags;  ///< #V, EdgeFlag bits
-  std::int64_t edge_count = 0;
-  std::int64_t boundary_edge_count = 0;
-  std::int64_t non_manifold_edge_count = 0;
-  std::int64_t non_manifold_vertex_count = 0;
-  std::int64_t duplicate_face_count = 0;
-  std::int64_t unreferenced_vertex_count = 0;
-};
-
-/// How much of MeshTopology to compute: `orientation` leaves out the fans (non-manifold
-/// vertices) and duplicate faces, which orientation_report does not need.
-enum class TopologyDetail { orientation, statistics };
-
-/// Defined in mesh_statistics.cpp. F must already be validated against vertex_count.
-MeshTopology mesh_topology(std::int64_t vertex_count, FacesRef F,
-                           TopologyDetail detail = TopologyDetail::statistics);
-
-/// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
-/// Defined in mesh_statistics.cpp; F must already be validated against V.
-int degenerate_face_count(PositionsRef V, FacesRef F);
-
-/// orientation_report from a topology already computed for (V, F). Defined in normals.cpp.
-OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t);
-
-/// vertex_normals from an incidence already computed for F. Defined in normals.cpp.
-RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting);
-
 /// True when every index of F lies in [0, vertex_count), checked in parallel; callers then call
 /// validate_mesh_arrays only to produce its message for the first bad face.
-inline bool face_indices_in_range(std::int64_t vertex_count, FacesRef F) {
+inline bool face_indices_in_range(std::int64_t vertex_count, FacesRef F, int threads) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
   std::vector<std::uint8_t> bad(static_cast<std::size_t>(blocks), 0);
-  parallel_blocks(F.rows(), kBlock, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-    bool any = false;
-    for (auto f = begin; f < end; ++f) {
-      for (int c = 0; c < 3; ++c) any |= F(f, c) < 0 || F(f, c) >= vertex_count;
-    }
-    bad[static_cast<std::size_t>(b)] = any;
-  });
+  parallel_blocks(F.rows(), kBlock, threads,
+                  [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+                    bool any = false;
+                    for (auto f = begin; f < end; ++f) {
+                      for (int c = 0; c < 3; ++c) any |= F(f, c) < 0 || F(f, c) >= vertex_count;
+                    }
+                    bad[static_cast<std::size_t>(b)] = any;
+                  });
   return std::find(bad.begin(), bad.end(), 1) == bad.end();
 }
 

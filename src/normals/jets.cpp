@@ -7,16 +7,21 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/parallel.h"
 #include "curvature/detail.h"
+#include "curvature/normal_rays_detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
-#include "curvature/normal_rays_detail.h"
-#include "core/parallel.h"
+#include "mesh/normals_detail.h"
+#include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
+#include "normals/jets_detail.h"
 
 namespace focal {
 namespace {
@@ -361,13 +366,30 @@ LocalJet fit_vertex(PositionsRef V, const Neighbourhoods& one, int i, Eigen::Vec
   return jet;
 }
 
-void validate(PositionsRef V, FacesRef F, const JetOptions& o) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "jet_normals");
+void validate_options(const JetOptions& o) {
   if (o.rings < 1) throw InvalidInput("jet_normals: rings must be >= 1");
   if (o.degree < 1 || o.degree > kMaxDegree)
     throw InvalidInput("jet_normals: degree must be in [1, 4], got " + std::to_string(o.degree));
   if (o.iterations < 1) throw InvalidInput("jet_normals: iterations must be >= 1");
   if (o.threads < 0) throw InvalidInput("jet_normals: threads must be >= 0");
+}
+
+void validate(PositionsRef V, FacesRef F, const JetOptions& o) {
+  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "jet_normals", o.threads);
+  validate_options(o);
+}
+
+/// The options with threads resolved for `mesh`.
+JetOptions for_mesh(const PreparedMesh& mesh, const JetOptions& options) {
+  JetOptions o = options;
+  o.threads = detail::threads_for(mesh, options.threads);
+  return o;
+}
+
+/// Max's normals of a prepared mesh, on its incidence: the jets' starting frames.
+RowMatrixX3d max_normals(const PreparedMesh& mesh, int threads) {
+  return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh),
+                                     NormalWeighting::max, threads);
 }
 
 void validate_start(PositionsRef V, NormalsRef start) {
@@ -451,16 +473,24 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
 
 }  // namespace
 
+JetNormals jet_normals(const PreparedMesh& mesh, const JetOptions& options) {
+  validate_options(options);
+  const JetOptions o = for_mesh(mesh, options);
+  return collect_normals(mesh.V(), *detail::one_ring(mesh), max_normals(mesh, o.threads), o);
+}
+
 JetNormals jet_normals(PositionsRef V, FacesRef F, const JetOptions& options) {
-  validate(V, F, options);
-  return collect_normals(V, vertex_adjacency(static_cast<int>(V.rows()), F),
-                         vertex_normals(V, F, NormalWeighting::max), options);
+  validate_options(options);
+  return jet_normals(
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "jet_normals"),
+      options);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring,
                        const JetOptions& options) {
   validate(V, F, options);
-  return collect_normals(V, one_ring, vertex_normals(V, F, NormalWeighting::max), options);
+  return collect_normals(V, one_ring, vertex_normals(V, F, NormalWeighting::max, options.threads),
+                         options);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring, NormalsRef start,
@@ -470,15 +500,22 @@ JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_rin
   return collect_normals(V, one_ring, start, options);
 }
 
-CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& options) {
+JetNormals detail::jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring,
+                                    NormalsRef start, const JetOptions& options) {
+  validate_options(options);
+  return collect_normals(V, one_ring, start, options);
+}
+
+CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
-  const auto n = V.rows();
-  CurvatureResult r = detail::unwritten_result(n);
-  const double zero = CurvatureOptions{}.zero_tolerance / mean_edge_length(V, F);
-  validate(V, F, options);
-  const Neighbourhoods one = vertex_adjacency(static_cast<int>(V.rows()), F);
-  const RowMatrixX3d start = vertex_normals(V, F, NormalWeighting::max);
-  for_each_jet(V, one, start, options, [&](int i, const LocalJet& jet) {
+  validate_options(options);
+  const JetOptions o = for_mesh(mesh, options);
+  const PositionsRef& V = mesh.V();
+  CurvatureResult r = detail::unwritten_result(V.rows());
+  const double zero = CurvatureOptions{}.zero_tolerance / mesh.mean_edge_length();
+  const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
+  const RowMatrixX3d start = max_normals(mesh, o.threads);
+  for_each_jet(V, *one, start, o, [&](int i, const LocalJet& jet) {
     if (jet.degree < 2) {
       r.rays_used[i] = r.rays_excluded[i] = 0;
       return detail::store_undefined(r, i);
@@ -486,6 +523,14 @@ CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& opti
     store_jet_curvature(jet, i, zero, r);
   });
   return r;
+}
+
+CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& options) {
+  if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
+  validate_options(options);
+  return jet_curvature(
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "jet_normals"),
+      options);
 }
 
 }  // namespace focal

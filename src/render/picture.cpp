@@ -57,7 +57,7 @@ struct PanelContent {
 
 void check_options(PositionsRef V, FacesRef F, NormalsRef N,
                    const Eigen::Ref<const Eigen::VectorXd>& field, const FieldPictureOptions& o) {
-  validate_mesh_arrays(V, F, N, "render_field_picture");
+  validate_mesh_arrays(V, F, N, "render_field_picture", o.threads);
   const auto rows = std::to_string(V.rows());
   if (N.rows() != V.rows())
     throw InvalidInput("render_field_picture: N must have " + rows + " rows");
@@ -83,7 +83,8 @@ void check_options(PositionsRef V, FacesRef F, NormalsRef N,
         throw InvalidInput("render_field_picture: a focal mesh must have the base mesh's " + rows +
                            " vertices");
       }
-      validate_mesh_arrays(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3), "render_field_picture");
+      validate_mesh_arrays(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3), "render_field_picture",
+                           o.threads);
     }
   }
 }

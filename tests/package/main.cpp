@@ -46,6 +46,24 @@ int main() {
     if (!ok) ++failures;
   }
 
+  // A mesh prepared once for several calls (README, C++ API): the same bits as on the arrays.
+  const focal::PreparedMesh prepared(mesh);
+  const auto check = [&failures](bool ok, const char* what) {
+    if (!ok) {
+      std::printf("%s\n", what);
+      ++failures;
+    }
+  };
+  check(!focal::check_mesh(prepared).has_problems(), "check_mesh found problems");
+  check(focal::estimate_curvature(prepared).k1 == c.k1, "prepared: other k1");
+  const focal::Estimate e = focal::estimate(prepared, {.estimator = focal::Estimator::paper});
+  check(!e.N.has_value() && e.curvature.k1 == c.k1, "estimate(paper): other k1 or normals");
+  const focal::RecommendedResult r =
+      focal::estimate_curvature_recommended(mesh.V, mesh.F, mesh.normals(), {.threads = 1});
+  check(r.curvature.k1.size() == 12 && r.N.rows() == 12, "recommended: wrong shapes");
+  const focal::FocalMeshes f = focal::focal_meshes(prepared.with_normals(r.N), r.curvature);
+  check(f.gamma1.mesh.V.rows() == 12, "focal meshes: wrong shapes");
+
   // The library's errors cross the package boundary as focal::InvalidInput.
   focal::RowMatrixX3i bad = mesh.F;
   bad(0, 0) = 12;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 
 namespace focal {
 
@@ -35,15 +36,23 @@ struct Mesh {
   Eigen::VectorXi face_source;
 
   [[nodiscard]] bool has_normals() const { return N.rows() == V.rows() && V.rows() > 0; }
+  /// N as the functions taking optional normals want it: std::nullopt when N has 0 rows.
+  [[nodiscard]] std::optional<NormalsRef> normals() const {
+    if (N.rows() == 0) return std::nullopt;
+    return NormalsRef(N);
+  }
 };
 
 /// Throws InvalidInput unless F indexes V (every index in [0, #V)) and, when N is non-empty,
-/// N has #V rows. `what` names the caller in the message.
-void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what);
+/// N has #V rows. `what` names the caller in the message. Checked in parallel on `threads`
+/// threads (0: FOCAL_NUM_THREADS if set, else all hardware threads).
+void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what,
+                          int threads = 0);
 
 /// Mean length of the triangle edges (each undirected edge once per incident face). Edges with a
-/// NaN or infinite length are left out; 0 when no edge is left.
-[[nodiscard]] double mean_edge_length(PositionsRef V, FacesRef F);
+/// NaN or infinite length are left out; 0 when no edge is left. Summed in parallel on `threads`
+/// threads (as validate_mesh_arrays), with the same result for any count.
+[[nodiscard]] double mean_edge_length(PositionsRef V, FacesRef F, int threads = 0);
 
 /// Length of the diagonal of the axis-aligned bounding box of the rows of V whose coordinates are
 /// all finite; 0 when there are none.

@@ -10,6 +10,7 @@
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/two_slit_fit.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -31,7 +32,9 @@ enum class RayWeighting {
   gaussian,  ///< weight exp(-d^2 / (2 s^2)), d the distance to the vertex, s = gaussian_width
 };
 
-/// Options of estimate_curvature. Defaults reproduce the paper with the closed-form solver.
+/// Options of the paper's estimator, estimate_curvature (and of triangle_curvature and the
+/// baselines, which read the fields they name). Defaults reproduce the paper with the closed-form
+/// solver.
 struct CurvatureOptions {
   Method method = Method::vertex;
   Solver solver = Solver::closed_form;
@@ -46,13 +49,20 @@ struct CurvatureOptions {
   double zero_tolerance = 1e-3;
   /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
   double umbilic_tolerance = 1e-2;
-  int threads = 0;  ///< 0: FOCAL_NUM_THREADS or all hardware threads
+  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
+  /// PrepareOptions::threads.
+  int threads = 0;
 };
 
-/// Estimates the curvature fields of a triangle mesh from its vertex normals.
-/// \param V #V x 3 positions. \param F #F x 3 triangles. \param N #V x 3 unit outward normals
-///        (rows that are not finite or not of unit length within 1e-6 are normalised; zero or
-///        non-finite rows make their vertex `undefined`).
+/// Estimates the curvature fields of a triangle mesh from its vertex normals: the paper's method.
+/// \param mesh with #V x 3 outward normals (rows are normalised; zero or non-finite rows make
+///        their vertex `undefined`).
+/// \throw InvalidInput when the mesh has no normals or an option is out of range.
+[[nodiscard]] CurvatureResult estimate_curvature(const PreparedMesh& mesh,
+                                                 const CurvatureOptions& options = {});
+
+/// estimate_curvature of the arrays. \param V #V x 3 positions. \param F #F x 3 triangles.
+/// \param N #V x 3 outward normals, as above.
 /// \throw InvalidInput when shapes differ, F indexes outside V, or an option is out of range.
 [[nodiscard]] CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                  const CurvatureOptions& options = {});

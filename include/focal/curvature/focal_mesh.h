@@ -5,6 +5,7 @@
 
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -14,10 +15,19 @@ struct FocalMeshOptions {
   double max_distance = 0.0;
   /// Leave out faces with a vertex at infinity (or undefined) instead of keeping them clamped.
   bool drop_faces_at_infinity = false;
+  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
+  /// PrepareOptions::threads.
+  int threads = 0;
 };
 
-/// Builds both focal meshes from the base mesh, its normals and its curvature fields.
-/// \throw InvalidInput when the shapes of the arguments differ.
+/// Builds both focal meshes from the base mesh, its normals (made unit) and its curvature fields.
+/// \throw InvalidInput when the mesh has no normals, the fields do not have #V rows or
+/// max_distance < 0.
+[[nodiscard]] FocalMeshes focal_meshes(const PreparedMesh& mesh, const CurvatureResult& curvature,
+                                       const FocalMeshOptions& options = {});
+
+/// focal_meshes of the arrays. \throw InvalidInput also when F indexes outside V or N does not
+/// have #V rows.
 [[nodiscard]] FocalMeshes focal_meshes(PositionsRef V, FacesRef F, NormalsRef N,
                                        const CurvatureResult& curvature,
                                        const FocalMeshOptions& options = {});

@@ -1,11 +1,11 @@
 #pragma once
 /// \file recommended.h
 /// The recommended estimator: what `focal curvature` runs when no estimator option is given,
-/// and what `focal eval` reports as "focal default". Two entry points: the file gives normals
-/// (which may be noisy), or it does not. Measured against the paper's method and the baselines
-/// in docs/ESTIMATOR.md, "The recommended estimator".
+/// and what `focal eval` reports as "focal default". One entry point, on a mesh whose normals
+/// come from a file (and may be noisy) or that has none. Measured against the paper's method and
+/// the baselines in docs/ESTIMATOR.md, "The recommended estimator".
 ///
-/// Both run the paper's estimators (the closed-form two-slit fit, and on clean positions the
+/// It runs the paper's estimators (the closed-form two-slit fit, and on clean positions the
 /// per-triangle characteristic equation) on better normals and, where the positions are noisy,
 /// over a wider neighbourhood:
 ///  1. Jets (normal_estimation.h): a cubic height fit over the 2-ring of every vertex gives
@@ -13,18 +13,19 @@
 ///     noise = median residual / mean edge length (about 1e-4 on clean smooth meshes, 0.056 for
 ///     the paper's 10% vertex noise).
 ///  2. Neighbourhood (recommended_plan_for_noise): the 1-ring (the paper) on clean positions;
-///     Gaussian-weighted 2 or 3 rings when the noise is above kNoiseForTwoRings or
-///     kNoiseForThreeRings.
+///     Gaussian-weighted 2 or 3 rings when the noise is above RecommendedOptions::
+///     noise_for_two_rings or noise_for_three_rings.
 ///  3. Normals. From the positions: per vertex the jets' normals, or Max's (exact on spheres)
 ///     where those are clearly smoother: the RMS misfit (residual) of their 1-ring two-slit fit
 ///     below half the jets'; on noisy positions instead those of wider quadratic jets (rings + 1
 ///     rings), which average the noise. The file's normals are judged as a whole by their median
-///     angle to the jet normals: within twice the position noise (the jets' own error is about
-///     the noise) they are used, and only outliers are replaced by the positions' choice (more
-///     than 10 times the noise from the jet normal and half as rough); beyond it they are ignored
-///     and the positions' normals are used, turned to the file's side. Measured ratio of that
-///     median angle to the noise: 0.09 to 0.95 on clean meshes, 0.8 to 1.05 under 10% vertex
-///     noise with exact normals (used), 5.3 to 4600 under 5% normal noise (ignored).
+///     angle to the jet normals: within twice the position noise (file_agreement; the jets' own
+///     error is about the noise) they are used, and only outliers are replaced by the positions'
+///     choice (more than 10 times the noise from the jet normal, outlier_disagreement, and half
+///     as rough); beyond it they are ignored and the positions' normals are used, turned to the
+///     file's side. Measured ratio of that median angle to the noise: 0.09 to 0.95 on clean
+///     meshes, 0.8 to 1.05 under 10% vertex noise with exact normals (used), 5.3 to 4600 under
+///     5% normal noise (ignored).
 ///  4. The two-slit fit of those normals over that neighbourhood. On clean positions (1 ring)
 ///     each vertex then takes the per-triangle characteristic equation averaged to the vertex
 ///     (Method::triangle; 1.3 to 1.8 times lower H error on irregular meshes), except where the
@@ -36,8 +37,10 @@
 /// in estimate_curvature.
 
 #include <cmath>
+#include <optional>
 
 #include "focal/curvature/curvature.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -45,6 +48,29 @@ namespace focal {
 inline constexpr double kNoiseForTwoRings = 0.015;
 /// ... and above which it uses 3 rings.
 inline constexpr double kNoiseForThreeRings = 0.035;
+
+/// Options of the recommended estimator. The defaults are the measured choices of
+/// docs/ESTIMATOR.md; each field is a knob of one of the steps above.
+struct RecommendedOptions {
+  /// Step 2: position noise (median cubic-jet residual over the mean edge length) above which the
+  /// two-slit fit uses 2 Gaussian-weighted rings...
+  double noise_for_two_rings = kNoiseForTwoRings;  // 0.015
+  /// ... and above which it uses 3.
+  double noise_for_three_rings = kNoiseForThreeRings;  // 0.035
+  /// Step 3: the file's normals are used when their median angle to the jet normals (radians) is
+  /// at most this many times the position noise (the jets' own error is about the noise).
+  double file_agreement = 2.0;
+  /// Step 3: among used file normals, one more than this many times the noise from its jet normal
+  /// (and rougher than the positions' normal by half) is an outlier, replaced.
+  double outlier_disagreement = 10.0;
+  /// Classes, as CurvatureOptions: |k| x mean edge length <= zero_tolerance is zero ...
+  double zero_tolerance = 1e-3;
+  /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
+  double umbilic_tolerance = 1e-2;
+  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
+  /// PrepareOptions::threads.
+  int threads = 0;
+};
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
 struct RecommendedPlan {
@@ -55,12 +81,18 @@ struct RecommendedPlan {
   int jet_degree = 3;     ///< their degree
 };
 
-/// The plan for a given noise level (see the steps above).
-[[nodiscard]] RecommendedPlan recommended_plan_for_noise(double noise);
+/// The plan for a given noise level (see the steps above); reads the noise thresholds.
+[[nodiscard]] RecommendedPlan recommended_plan_for_noise(double noise,
+                                                         const RecommendedOptions& options = {});
 
 /// The plan for a mesh: measures its noise (cubic jets over the 2-ring) and plans for it.
-/// \throw InvalidInput when F indexes outside V or threads < 0.
-[[nodiscard]] RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, int threads = 0);
+/// \throw InvalidInput when an option is out of range.
+[[nodiscard]] RecommendedPlan recommended_plan(const PreparedMesh& mesh,
+                                               const RecommendedOptions& options = {});
+
+/// recommended_plan of the arrays. \throw InvalidInput also when F indexes outside V.
+[[nodiscard]] RecommendedPlan recommended_plan(PositionsRef V, FacesRef F,
+                                               const RecommendedOptions& options = {});
 
 /// The recommended estimate with what it decided and the normals it fitted.
 struct RecommendedResult {
@@ -70,24 +102,23 @@ struct RecommendedResult {
   /// Median angle (radians) between the file's normals and the jet normals; NaN without normals.
   double file_disagreement = NAN;
   /// Whether the file's normals were used: they agree with the positions (file_disagreement at
-  /// most twice the noise). Otherwise they are ignored as a whole, except for their side.
+  /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
+  /// their side.
   bool file_normals_used = false;
 };
 
-/// Both cases in one: N with #V rows are the file's normals, N with 0 rows means none.
-/// \throw InvalidInput when F indexes outside V, N has neither 0 nor #V rows, or threads < 0.
-[[nodiscard]] RecommendedResult estimate_curvature_recommended_full(PositionsRef V, FacesRef F,
-                                                                    NormalsRef N, int threads = 0);
+/// The recommended estimate of a mesh, with its normals as the file's when it has them (they may
+/// be noisy, need not be unit; zero or non-finite rows take the positions' normal) or from the
+/// positions alone when it has none.
+/// \throw InvalidInput when an option is out of range.
+[[nodiscard]] RecommendedResult estimate_curvature_recommended(
+    const PreparedMesh& mesh, const RecommendedOptions& options = {});
 
-/// With normals from the file (which may be noisy). \param N #V x 3 (need not be unit; zero or
-/// non-finite rows take the jet normal).
-/// \throw InvalidInput when F indexes outside V, N does not have #V rows, or threads < 0.
-[[nodiscard]] CurvatureResult estimate_curvature_recommended(PositionsRef V, FacesRef F,
-                                                             NormalsRef N, int threads = 0);
-
-/// Without normals: they are estimated from the positions.
-/// \throw InvalidInput when F indexes outside V or threads < 0.
-[[nodiscard]] CurvatureResult estimate_curvature_recommended(PositionsRef V, FacesRef F,
-                                                             int threads = 0);
+/// The recommended estimate of the arrays. \param N #V x 3 normals from the file, or std::nullopt
+/// (not a matrix of 0 rows) when there are none.
+/// \throw InvalidInput also when F indexes outside V or N does not have #V rows.
+[[nodiscard]] RecommendedResult estimate_curvature_recommended(
+    PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
+    const RecommendedOptions& options = {});
 
 }  // namespace focal

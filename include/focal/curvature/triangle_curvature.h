@@ -45,15 +45,22 @@ struct TriangleFields {
   bool shape_operator = true;  ///< shape_operator
 };
 
-/// Solves the characteristic equation on every face. Faces with zero area in the ray frame
-/// (C = 0), a vertex normal outside the face normal's hemisphere or non-finite input are
-/// `undefined` with NaN values.
+/// Solves the characteristic equation on every face of a mesh with normals, filling `fields`
+/// (the same values in the fields it fills). Faces with zero area in the ray frame (C = 0), a
+/// vertex normal outside the face normal's hemisphere or non-finite input are `undefined` with
+/// NaN values. Each face's row is written once, by the thread that computes it. Reads
+/// options.zero_tolerance, umbilic_tolerance and threads (0: the mesh's).
+/// \throw InvalidInput when the mesh has no normals.
+[[nodiscard]] TriangleCurvatureResult triangle_curvature(const PreparedMesh& mesh,
+                                                         const CurvatureOptions& options = {},
+                                                         const TriangleFields& fields = {});
+
+/// triangle_curvature of the arrays, every field.
 /// \throw InvalidInput when shapes differ or F indexes outside V.
 [[nodiscard]] TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                          const CurvatureOptions& options = {});
 
-/// triangle_curvature filling only `fields` (same values in the fields it fills). Each face's
-/// row is written once, by the thread that computes it.
+/// triangle_curvature of the arrays filling only `fields`.
 [[nodiscard]] TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                          const CurvatureOptions& options,
                                                          const TriangleFields& fields);

@@ -33,6 +33,12 @@ enum class MeshFormat { obj, ply, off, stl };
 /// \throw IoError for any other extension.
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
+struct ReadOptions {
+  /// Threads of the parallel passes (binary PLY): 0 for FOCAL_NUM_THREADS if set, else all
+  /// hardware threads. The mesh read does not depend on it.
+  int threads = 0;
+};
+
 /// Reads a mesh; the format is taken from the extension.
 /// Vertex normals are read when the file has them (OBJ `vn` referenced by faces, PLY nx/ny/nz,
 /// OFF `NOFF`); otherwise Mesh::N is empty. They are kept as written (not renormalised), except
@@ -43,7 +49,7 @@ enum class MeshFormat { obj, ply, off, stl };
 /// materials, lines (`l`, `p`) and free-form geometry are ignored.
 /// \throw IoError naming the file and the line, byte offset or element index of the problem,
 /// also for a missing file, a directory or an unreadable path.
-[[nodiscard]] Mesh read_mesh(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 
 /// Scalar type a per-vertex property is stored as in PLY.
 enum class PropertyType { float32, float64, uint8, int32 };
@@ -58,6 +64,9 @@ struct VertexProperty {
 struct PlyWriteOptions {
   bool binary = true;                 ///< binary little endian (default) or ascii
   std::vector<std::string> comments;  ///< `comment` lines in the header
+  /// Threads of the checks and of the binary encoding: 0 for FOCAL_NUM_THREADS if set, else all
+  /// hardware threads. The bytes written do not depend on it.
+  int threads = 0;
 };
 
 /// Writes V, F, the normals when present and any extra per-vertex properties as PLY:

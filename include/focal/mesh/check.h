@@ -8,9 +8,11 @@
 /// others are computed normally. Conventions (edges, degenerate faces, components, orientation)
 /// are those of neighbourhood.h and normals.h, whose counts are reused.
 
+#include <optional>
 #include <string>
 
 #include "focal/core/mesh.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -30,7 +32,7 @@ struct MeshFindings {
   int inconsistent_component_count = 0;  ///< components whose neighbouring faces disagree on
                                          ///< orientation along some edge
   int inward_component_count = 0;        ///< closed, consistent components with negative volume
-  // Given normals (N with #V rows).
+  // Given normals.
   int non_finite_normal_count = 0;      ///< rows with a NaN or infinite component
   int zero_normal_count = 0;            ///< rows of length 0
   int non_unit_normal_count = 0;        ///< finite, non-zero rows whose length is not 1 within 1e-6
@@ -51,10 +53,16 @@ struct MeshFindings {
   [[nodiscard]] std::string summary() const;
 };
 
-/// Counts the problems of a mesh. Linear time, parallel where the reused functions are, and
-/// deterministic. \param V #V x 3 positions (NaN and infinities allowed). \param F #F x 3
-/// triangles. \param N #V x 3 normals as given, or 0 rows when there are none.
-/// \throw InvalidInput when F indexes outside V or N has neither 0 nor #V rows.
-[[nodiscard]] MeshFindings check_mesh(PositionsRef V, FacesRef F, NormalsRef N);
+/// Counts the problems of a mesh and of its normals when it has them. Linear time, parallel where
+/// the reused functions are, and deterministic. Computed once per PreparedMesh (the estimate
+/// pipeline, estimate.h, reads them again) on its kept vertex-face incidence.
+[[nodiscard]] MeshFindings check_mesh(const PreparedMesh& mesh);
+
+/// check_mesh of the arrays. \param V #V x 3 positions (NaN and infinities allowed). \param F
+/// #F x 3 triangles. \param N #V x 3 normals as given, or std::nullopt when there are none.
+/// \param threads 0: FOCAL_NUM_THREADS if set, else all hardware threads.
+/// \throw InvalidInput when F indexes outside V or N does not have #V rows.
+[[nodiscard]] MeshFindings check_mesh(PositionsRef V, FacesRef F,
+                                      std::optional<NormalsRef> N = std::nullopt, int threads = 0);
 
 }  // namespace focal

@@ -8,6 +8,7 @@
 /// (also a face with a repeated index, such as (a, a, b) for the edge {a, b}).
 ///
 /// All functions gather per vertex in a fixed order: results do not depend on the thread count.
+/// `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware threads.
 
 #include <vector>
 
@@ -30,19 +31,19 @@ struct Neighbourhoods {
 /// never the vertex itself (degenerate faces with repeated indices add no self-loops).
 /// \throw InvalidInput when vertex_count < 0, F indexes outside [0, vertex_count), or the lists
 /// would not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F);
+[[nodiscard]] Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F, int threads = 0);
 
 /// k-ring: all vertices within k edges (k >= 1), excluding the vertex itself, each once, sorted
 /// by ring distance then by index. k = 1 returns a copy of `one_ring`.
 /// \throw InvalidInput when k < 1, `one_ring` is not a valid CSR (offsets not starting at 0,
 /// decreasing, not ending at indices.size(), or an index outside [0, #V)), or the result would
 /// not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k);
+[[nodiscard]] Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads = 0);
 
 /// #V flags: true for vertices on a boundary edge (an edge with exactly one incident face).
 /// Vertices only on non-manifold edges (3+ faces) are not boundary vertices.
 /// \throw InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
-[[nodiscard]] std::vector<bool> boundary_vertices(int vertex_count, FacesRef F);
+[[nodiscard]] std::vector<bool> boundary_vertices(int vertex_count, FacesRef F, int threads = 0);
 
 /// Per-vertex ring distance to the nearest boundary vertex (0 on the boundary), capped at
 /// `max_rings` + 1 for vertices farther away or in components without boundary.
@@ -74,6 +75,6 @@ struct MeshStatistics {
 
 /// Counts of the mesh's connectivity and quality; linear time, parallel per vertex.
 /// \throw InvalidInput when F indexes outside V.
-[[nodiscard]] MeshStatistics mesh_statistics(PositionsRef V, FacesRef F);
+[[nodiscard]] MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads = 0);
 
 }  // namespace focal

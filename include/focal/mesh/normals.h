@@ -7,10 +7,14 @@
 /// having both as corners. A face with a repeated vertex index has no orientation along its edges.
 /// A face is degenerate when it repeats an index or has numerically zero area:
 /// |(b - a) x (c - a)| <= 1e-14 L^2 with L its longest edge (scale invariant).
+///
+/// `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
+/// PrepareOptions::threads. Results do not depend on it.
 
 #include <vector>
 
 #include "focal/core/mesh.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -32,6 +36,11 @@ enum class NormalWeighting {
 /// opposite faces), get a NaN row (never a silent zero).
 /// \throw InvalidInput when F indexes outside V.
 [[nodiscard]] RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F,
+                                          NormalWeighting weighting = NormalWeighting::angle,
+                                          int threads = 0);
+
+/// vertex_normals of a prepared mesh, on its kept vertex-face incidence.
+[[nodiscard]] RowMatrixX3d vertex_normals(const PreparedMesh& mesh,
                                           NormalWeighting weighting = NormalWeighting::angle);
 
 /// Orientation of one connected component (faces sharing a vertex are connected, so two closed
@@ -56,7 +65,10 @@ struct OrientationReport {
 
 /// Connected components of the faces and the orientation of each.
 /// \throw InvalidInput when F indexes outside V.
-[[nodiscard]] OrientationReport orientation_report(PositionsRef V, FacesRef F);
+[[nodiscard]] OrientationReport orientation_report(PositionsRef V, FacesRef F, int threads = 0);
+
+/// orientation_report of a prepared mesh, on its kept vertex-face incidence.
+[[nodiscard]] OrientationReport orientation_report(const PreparedMesh& mesh);
 
 /// Returns F with the faces of every inward (closed, consistent, negative-volume) component
 /// reversed, so that vertex normals computed from it point outward. Other faces are unchanged.
@@ -78,14 +90,15 @@ struct ConsistentFaces {
 /// mesh changes little. Faces with a repeated index have no orientation and are left alone. Does
 /// not decide inside from outside: follow with orientation_report and orient_outward for that.
 /// Linear time (the search is serial; ~2 M faces take tens of ms).
-/// 	hrow InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
-[[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F);
+/// \throw InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
+[[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F, int threads = 0);
 
 /// Fraction of vertices (in at least one face, with finite N) whose given normal points against
 /// the area-weighted face normal (negative dot product): near 1 means the normals are inward.
 /// Vertices whose area-weighted normal vanishes (see vertex_normals) are not counted. NaN when no
 /// vertex qualifies.
 /// \throw InvalidInput when F indexes outside V or N does not have #V rows.
-[[nodiscard]] double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N);
+[[nodiscard]] double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N,
+                                            int threads = 0);
 
 }  // namespace focal

@@ -27,6 +27,7 @@
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/prepared.h"
 
 namespace focal {
 
@@ -34,7 +35,9 @@ struct JetOptions {
   int rings = 2;       ///< neighbourhood of the fit in rings (>= 1)
   int degree = 2;      ///< degree of the height polynomial, 1 to 4
   int iterations = 2;  ///< fits per vertex (>= 1); each refits in the previous fit's frame
-  int threads = 0;     ///< 0: FOCAL_NUM_THREADS or all hardware threads
+  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
+  /// PrepareOptions::threads.
+  int threads = 0;
 };
 
 /// Normals from jets, and how well the jets fit.
@@ -47,9 +50,11 @@ struct JetNormals {
   Eigen::VectorXi degree;  ///< #V degree actually fitted (0 where undefined)
 };
 
-/// Jet normals of every vertex.
-/// \throw InvalidInput when F indexes outside V, or rings < 1, degree outside [1, 4],
-/// iterations < 1 or threads < 0.
+/// Jet normals of every vertex, from the mesh's kept incidence (and 1-ring, when kept).
+/// \throw InvalidInput when rings < 1, degree outside [1, 4], iterations < 1 or threads < 0.
+[[nodiscard]] JetNormals jet_normals(const PreparedMesh& mesh, const JetOptions& options = {});
+
+/// Jet normals of the arrays. \throw also InvalidInput when F indexes outside V.
 [[nodiscard]] JetNormals jet_normals(PositionsRef V, FacesRef F, const JetOptions& options = {});
 
 /// The same with the mesh's 1-ring (vertex_adjacency(#V, F)) at hand, which it then does not
@@ -72,6 +77,10 @@ struct JetNormals {
 /// jet normal). Needs degree >= 2: vertices fitted with a lower degree are `undefined`.
 /// residual = the jet's height residual. rays_used = points in the fit, rays_excluded = 0.
 /// \throw as jet_normals, and InvalidInput when options.degree < 2.
+[[nodiscard]] CurvatureResult jet_curvature(const PreparedMesh& mesh,
+                                            const JetOptions& options = {});
+
+/// jet_curvature of the arrays.
 [[nodiscard]] CurvatureResult jet_curvature(PositionsRef V, FacesRef F,
                                             const JetOptions& options = {});
 

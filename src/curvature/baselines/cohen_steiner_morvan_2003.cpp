@@ -5,14 +5,17 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
-#include "focal/curvature/baselines.h"
-#include "focal/core/error.h"
-#include "focal/mesh/neighbourhood.h"
 #include "core/parallel.h"
+#include "curvature/detail.h"
+#include "focal/core/error.h"
+#include "focal/curvature/baselines.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines {
@@ -98,14 +101,16 @@ CurvatureResult cohen_steiner_morvan_2003(PositionsRef V, FacesRef F,
                                           const CurvatureOptions& options) {
   if (options.rings < 1)
     throw InvalidInput("CSM03: rings must be >= 1, got " + std::to_string(options.rings));
-  validate_mesh_arrays(V, F, RowMatrixX3d(), "CSM03");
+  const PreparedMesh mesh =
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "CSM03");
   const EdgeTensors edges = edge_tensors(V, F);
-  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F);
-  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(V.rows()), F);
+  const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
+  const detail::VertexFaces& inc = *incidence;
   const Neighbourhoods centres =
-      options.rings > 1 ? k_ring(one_ring, options.rings - 1) : Neighbourhoods{};
-  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
-  CurvatureResult r = detail::undefined_result(V.rows());
+      options.rings > 1 ? k_ring(*detail::one_ring(mesh), options.rings - 1, options.threads)
+                        : Neighbourhoods{};
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mesh.mean_edge_length());
+  CurvatureResult r = detail::undefined_result(V.rows(), options.threads);
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     thread_local std::vector<int> faces;
     neighbourhood_faces(inc, centres, options.rings, static_cast<int>(i), faces);

@@ -2,13 +2,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <vector>
 
+#include "core/parallel.h"
 #include "curvature/detail.h"
 #include "focal/curvature/baselines.h"
 #include "focal/mesh/neighbourhood.h"
-#include "core/parallel.h"
+#include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines {
@@ -97,11 +100,14 @@ detail::Principal2 fit_directions(PositionsRef V, int i, const TangentFrame& fra
 }  // namespace
 
 CurvatureResult meyer_2003(PositionsRef V, FacesRef F, const CurvatureOptions& options) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(), "MDSB03");
-  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F);
-  const std::vector<bool> boundary = boundary_vertices(static_cast<int>(V.rows()), F);
-  const detail::ClassTolerances tol = detail::class_tolerances(options, mean_edge_length(V, F));
-  CurvatureResult r = detail::undefined_result(V.rows());
+  const PreparedMesh mesh =
+      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "MDSB03");
+  const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
+  const detail::VertexFaces& inc = *incidence;
+  const std::vector<bool> boundary =
+      boundary_vertices(static_cast<int>(V.rows()), F, options.threads);
+  const detail::ClassTolerances tol = detail::class_tolerances(options, mesh.mean_edge_length());
+  CurvatureResult r = detail::undefined_result(V.rows(), options.threads);
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     thread_local std::vector<EdgeWeight> edges;
     edges.clear();

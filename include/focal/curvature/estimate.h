@@ -1,0 +1,118 @@
+#pragma once
+/// \file estimate.h
+/// The whole estimate of `focal curvature` (and of `focal-mesh` and `render`) as a library call,
+/// so that the command line and the bindings run the same thing: the normals chosen by their
+/// source, the chosen estimator run on them, the fields and the normals used returned. What the
+/// command line adds is flag parsing, stage timings and the messages (from NormalsReport and the
+/// recommended estimator's decisions in Estimate).
+///
+/// Two steps, which estimate() runs one after the other (the command line times them apart):
+///  1. prepare_normals: the normals the estimator gets.
+///     - The mesh's own normals (NormalsSource::automatic when it has them, or `file`): rows that
+///       are zero or not finite are filled with Max's normals from the faces, rows not of unit
+///       length within 1e-6 are normalised (a copy is made only when some row needs it).
+///     - For the paper's estimator without them (`automatic`), or when asked (`area`, `angle`,
+///       `max`): normals from the faces (vertex_normals), after the faces of closed components
+///       that are consistently oriented inward have been reversed (orientation_report,
+///       orient_outward), so that the normals point outward.
+///     - For the recommended estimator without them: none (it estimates its own from the
+///       positions), the faces made outward as above since its normals take their side from them.
+///     It reads check_mesh(mesh)'s findings (computed if the mesh has none yet) to skip the scans
+///     a clean mesh does not need.
+///  2. estimate: the estimator on the prepared normals and faces.
+///
+/// Deterministic for any thread count, like the functions it calls.
+
+#include <cmath>
+#include <optional>
+
+#include "focal/core/fields.h"
+#include "focal/core/mesh.h"
+#include "focal/curvature/curvature.h"
+#include "focal/curvature/recommended.h"
+#include "focal/mesh/prepared.h"
+
+namespace focal {
+
+enum class Estimator {
+  recommended,  ///< estimate_curvature_recommended (recommended.h): what `focal curvature` runs
+  paper,        ///< estimate_curvature (curvature.h), the paper's method, per vertex or triangle
+};
+
+/// Where the estimator's normals come from.
+enum class NormalsSource {
+  automatic,  ///< the mesh's normals when it has them; else Max's from the faces (paper) or none
+              ///< (recommended, which estimates its own)
+  file,       ///< the mesh's normals (from the file); an error when it has none
+  area,       ///< from the faces, NormalWeighting::area (paper's estimator only)
+  angle,      ///< from the faces, NormalWeighting::angle (paper's estimator only)
+  max,        ///< from the faces, NormalWeighting::max (paper's estimator only)
+};
+
+struct EstimateOptions {
+  Estimator estimator = Estimator::recommended;
+  NormalsSource normals = NormalsSource::automatic;
+  /// Estimator::paper: its options (the paper with the closed-form solver by default).
+  CurvatureOptions paper{};
+  /// Estimator::recommended: its options.
+  RecommendedOptions recommended{};
+};
+
+/// What prepare_normals did, for a caller to report.
+struct NormalsReport {
+  /// Closed components, consistently oriented inward, whose faces were reversed (only when the
+  /// normals do not come from the mesh).
+  int reoriented_component_count = 0;
+  int filled_normal_count = 0;    ///< mesh normals that were zero or not finite: Max's instead
+  int rescaled_normal_count = 0;  ///< mesh normals not of unit length within 1e-6: normalised
+  /// Most of the mesh's normals point against the area-weighted normals of their faces (inward
+  /// normals?). The curvature signs follow the normals.
+  bool normals_against_faces = false;
+};
+
+/// The normals and faces the estimator gets (step 1).
+struct PreparedNormals {
+  /// #V x 3 normals when they are not the mesh's own as given: the mesh's with rows filled or
+  /// normalised, or normals from the faces. std::nullopt: the mesh's normals as given (or, for
+  /// the recommended estimator, none when the mesh has none).
+  std::optional<RowMatrixX3d> N;
+  /// #F x 3: F with the faces of inward components reversed; std::nullopt: F as given.
+  std::optional<RowMatrixX3i> F;
+  NormalsReport report;
+};
+
+/// Step 1. \throw InvalidInput when NormalsSource::file is asked for and the mesh has no
+/// normals, or when the recommended estimator is asked for with normals from the faces (it
+/// chooses its own).
+[[nodiscard]] PreparedNormals prepare_normals(const PreparedMesh& mesh,
+                                              const EstimateOptions& options = {});
+
+/// The fields and what produced them.
+struct Estimate {
+  CurvatureResult curvature;
+  /// #V x 3 normals the estimator used, when they are not the mesh's own as given (they are
+  /// unit rows, NaN where none): those of step 1, or the recommended estimator's choice.
+  /// std::nullopt: the mesh's normals as given (the paper's estimator on mesh normals that
+  /// needed no fixing).
+  std::optional<RowMatrixX3d> N;
+  /// #F x 3 faces the estimator used when they are not F: step 1 reversed some.
+  std::optional<RowMatrixX3i> F;
+  NormalsReport normals_report;  ///< step 1's
+  /// Estimator::recommended: its plan, the file normals' median angle to the jet normals (NaN
+  /// without mesh normals) and whether it used them (RecommendedResult).
+  RecommendedPlan plan;
+  double file_disagreement = NAN;
+  bool file_normals_used = false;
+};
+
+/// Step 2: the estimator on `normals` (from prepare_normals for the same mesh and options),
+/// which are moved into the result. Frees the mesh's kept vertex-face incidence when the
+/// per-vertex fit no longer needs it (the fit is the peak of a run; it is rebuilt if needed).
+/// \throw InvalidInput as the estimator.
+[[nodiscard]] Estimate estimate(const PreparedMesh& mesh, PreparedNormals normals,
+                                const EstimateOptions& options = {});
+
+/// Both steps.
+[[nodiscard]] Estimate estimate(const PreparedMesh& mesh, const EstimateOptions& options = {});
+
+}  // namespace focal

@@ -1,0 +1,17 @@
+#pragma once
+// Internal: the jets of jets.cpp with their inputs at hand, for the recommended estimator.
+
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/normals/jets.h"
+
+namespace focal::detail {
+
+/// jet_normals of the mesh whose positions are V and 1-ring `one_ring`, the first fit of each
+/// vertex in the frame of `start`, whose rows must be unit or non-finite (not checked: Max's
+/// normals are, by construction). options.threads is used as given.
+/// \throw InvalidInput when an option is out of range or one_ring does not have #V vertices.
+JetNormals jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
+                            const JetOptions& options);
+
+}  // namespace focal::detail
