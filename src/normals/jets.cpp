@@ -10,16 +10,21 @@
 #include <string>
 #include <vector>
 
-#include "curvature/detail.h"
+#include "core/fields_detail.h"
+#include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/point_class.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
-#include "curvature/normal_rays_detail.h"
-#include "core/parallel.h"
+#include "kernels/eigen.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 #include "mesh/topology.h"
 
 namespace focal {
 namespace {
+
+using kernels::eigen_of;
 
 constexpr int kMaxDegree = 4;
 
@@ -54,7 +59,8 @@ constexpr ProductTable kProductMoment = [] {
 
 /// One vertex's fitted graph z = sum c_k m_k(x / s, y / s) * s in `frame` (origin at the vertex).
 struct LocalJet {
-  TangentFrame frame{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
+  /// The tangent frame of every estimator (kernels::frame_of).
+  kernels::Frame<double> frame{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
   double scale = 0.0;  ///< s: the neighbourhood radius the coordinates were divided by
   int degree = 0;      ///< 0: no valid fit
   int points = 0;
@@ -109,14 +115,14 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
 
 /// The vertex itself (zero) and its ring in the frame, scaled by the largest offset; non-finite
 /// neighbours are skipped. Returns the scale (0 when no usable neighbour).
-double gather_points(PositionsRef V, int i, const TangentFrame& f, JetScratch& s) {
+double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f, JetScratch& s) {
   s.points.assign(1, Point{0.0, 0.0, 0.0});
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
   // the nine products here.
   const double px = V(i, 0), py = V(i, 1), pz = V(i, 2);
-  const double xx = f.x.x(), xy = f.x.y(), xz = f.x.z();
-  const double yx = f.y.x(), yy = f.y.y(), yz = f.y.z();
-  const double nx = f.n.x(), ny = f.n.y(), nz = f.n.z();
+  const double xx = f.x.x, xy = f.x.y, xz = f.x.z;
+  const double yx = f.y.x, yy = f.y.y, yz = f.y.z;
+  const double nx = f.n.x, ny = f.n.y, nz = f.n.z;
   double scale_sq = 0.0;
   for (const int j : s.ring) {
     if (j == i) continue;
@@ -343,7 +349,8 @@ bool solve_heights(int degree, const std::vector<Point>& points, std::vector<dou
 }
 
 Eigen::Vector3d jet_normal(const LocalJet& jet) {
-  return (jet.frame.n - jet.c[1] * jet.frame.x - jet.c[2] * jet.frame.y).normalized();
+  const kernels::Frame<double>& f = jet.frame;
+  return (eigen_of(f.n) - jet.c[1] * eigen_of(f.x) - jet.c[2] * eigen_of(f.y)).normalized();
 }
 
 /// Fits `iterations` jets at vertex i starting from the unit normal n0.
@@ -353,7 +360,7 @@ LocalJet fit_vertex(PositionsRef V, const Neighbourhoods& one, int i, Eigen::Vec
   LocalJet jet;
   for (int it = 0; it < o.iterations; ++it) {
     jet = LocalJet{};
-    jet.frame = detail::frame_of(n);
+    jet.frame = kernels::frame_of(kernels::vec3_of(n));
     jet.scale = gather_points(V, i, jet.frame, s);
     if (!(jet.scale > 0.0) || !solve_heights(o.degree, s.points, s.terms, jet)) return LocalJet{};
     n = jet_normal(jet);
@@ -433,7 +440,8 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> eig(second, first);
   const Eigen::Vector3d n = jet_normal(jet);
   const Eigen::Vector2d v = eig.eigenvectors().col(1);  // of the larger eigenvalue
-  Eigen::Vector3d d1 = jet.frame.x * v.x() + jet.frame.y * v.y() + jet.frame.n * g.dot(v);
+  const kernels::Frame<double>& f = jet.frame;
+  Eigen::Vector3d d1 = eigen_of(f.x) * v.x() + eigen_of(f.y) * v.y() + eigen_of(f.n) * g.dot(v);
   d1 = (d1 - n * n.dot(d1)).normalized();
   r.k1[i] = eig.eigenvalues()[1];
   r.k2[i] = eig.eigenvalues()[0];
@@ -444,9 +452,7 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
   r.residual[i] = jet.residual;
   r.rays_used[i] = jet.points;
   r.rays_excluded[i] = 0;
-  const CurvatureOptions defaults;
-  r.point_class[i] = static_cast<std::uint8_t>(
-      classify(r.k1[i], r.k2[i], zero_tolerance, defaults.umbilic_tolerance));
+  r.point_class[i] = kernels::classify(r.k1[i], r.k2[i], zero_tolerance, default_umbilic_tolerance);
 }
 
 }  // namespace
@@ -474,7 +480,7 @@ CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& opti
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   const auto n = V.rows();
   CurvatureResult r = detail::unwritten_result(n);
-  const double zero = CurvatureOptions{}.zero_tolerance / mean_edge_length(V, F);
+  const double zero = default_zero_tolerance / mean_edge_length(V, F);
   validate(V, F, options);
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(V.rows()), F);
   const RowMatrixX3d start = vertex_normals(V, F, NormalWeighting::max);
