@@ -73,6 +73,11 @@ struct Point {
   double x, y, z;
 };
 
+/// Two doubles as one SSE2 register: the moments (and x.q, y.q in gather_points) are sums of
+/// independent entries, added pairwise with the same per-entry operations (and bits) as one at a
+/// time.
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+
 /// A thread's scratch, reused across its vertices: no allocation per vertex once warm.
 struct JetScratch {
   /// One bit per vertex, allocated on first use (#V / 8 bytes: it stays in cache): set while
@@ -118,18 +123,18 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
 double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f, JetScratch& s) {
   s.points.assign(1, Point{0.0, 0.0, 0.0});
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
-  // the nine products here.
+  // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
+  // GCC paired them by itself or not, depending on how the frame was built.
   const double px = V(i, 0), py = V(i, 1), pz = V(i, 2);
-  const double xx = f.x.x, xy = f.x.y, xz = f.x.z;
-  const double yx = f.y.x, yy = f.y.y, yz = f.y.z;
+  const Pair frame_x = {f.x.x, f.y.x}, frame_y = {f.x.y, f.y.y}, frame_z = {f.x.z, f.y.z};
   const double nx = f.n.x, ny = f.n.y, nz = f.n.z;
   double scale_sq = 0.0;
   for (const int j : s.ring) {
     if (j == i) continue;
     const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
     if (!std::isfinite(qx) || !std::isfinite(qy) || !std::isfinite(qz)) continue;
-    s.points.push_back(
-        {xx * qx + xy * qy + xz * qz, yx * qx + yy * qy + yz * qz, nx * qx + ny * qy + nz * qz});
+    const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
+    s.points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
     scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
   }
   const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
@@ -152,10 +157,6 @@ struct Moments {
   double xy[kProducts] = {};     ///< sum x^a y^b, a + b <= 2D
   double z[kCoefficients] = {};  ///< sum z x^a y^b, a + b <= D
 };
-
-/// Two doubles as one SSE2 register: the moments are sums of independent entries, added pairwise
-/// with the same per-entry operations (and bits) as one at a time.
-using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
 constexpr int pairs_for(int count) { return (count + 1) / 2; }
 
