@@ -97,6 +97,9 @@ template <class T>
 FOCAL_HD inline bool ray_of(const Frame<T>& f, const VertexRecord<T>& p, const VertexRecord<T>& q,
                             Ray<T>& r) {
   const Vec3<T> m{q.normal_hi[0], q.normal_hi[1], q.normal_hi[2]};
+  // The hemisphere test (normal_ray's too) before the pairs are loaded: a thread whose ray does
+  // not exist reads nothing more, and the kernel keeps 56 registers (59 without, sm_90).
+  if (!(dot(f.n, m) > T(0))) return false;
   const Vec3<T> d = pair_difference(q.normal_hi, q.normal_lo, p.normal_hi, p.normal_lo);
   const Vec3<T> o = pair_difference(q.position_hi, q.position_lo, p.position_hi, p.position_lo);
   r.distance_squared = dot(o, o);
