@@ -4,6 +4,10 @@
 // 8 lanes with AVX-512, 4 with AVX2, 2 with baseline x86-64 (SSE2). Wider types than the target
 // has are not used: GCC then turns comparisons and selects into scalar code.
 //
+// The formulas the kernels share with the scalar and CUDA paths (frame, normal ray, principal
+// axes, classes) are kernels/local_shape.h's, on these types through kernels/vec3.h; the helpers
+// here are the lane primitives they and the kernels' own code use.
+//
 // Each kernel is a template on its lane type, compiled once per instruction set (functions with a
 // `target` attribute around one always-inline body) and picked at run time by simd_isa(). Only
 // lane-wise IEEE operations are used (+ - * / sqrt, comparisons, selects; no FMA: the kernel
@@ -112,24 +116,11 @@ FOCAL_LANE_INLINE L lane_abs(L x) {
   return reinterpret_cast<L>(reinterpret_cast<MaskOf<L>>(x) & INT64_MAX);
 }
 
-/// std::copysign(1.0, x) per lane (-0.0 and NaN with the sign bit give -1).
-template <class L>
-FOCAL_LANE_INLINE L sign_of(L x) {
-  const auto one = reinterpret_cast<MaskOf<L>>(broadcast<L>(1.0));
-  return reinterpret_cast<L>((reinterpret_cast<MaskOf<L>>(x) & INT64_MIN) | one);
-}
-
 /// std::copysign(magnitude, sign) per lane.
 template <class L>
 FOCAL_LANE_INLINE L lane_copysign(L magnitude, L sign) {
   return reinterpret_cast<L>((reinterpret_cast<MaskOf<L>>(magnitude) & INT64_MAX) |
                              (reinterpret_cast<MaskOf<L>>(sign) & INT64_MIN));
-}
-
-/// std::max(a, b) per lane, NaN handling included ((a < b) ? b : a).
-template <class L>
-FOCAL_LANE_INLINE L lane_max(L a, L b) {
-  return a < b ? b : a;
 }
 
 /// std::sqrt per lane: the loop becomes one vector square root (-fno-math-errno, see
@@ -139,12 +130,6 @@ FOCAL_LANE_INLINE L lane_sqrt(L x) {
   L r;
   for (int l = 0; l < lane_count<L>; ++l) r[l] = __builtin_sqrt(x[l]);
   return r;
-}
-
-/// -1 where x is finite (x - x is 0 exactly then, NaN otherwise).
-template <class L>
-FOCAL_LANE_INLINE MaskOf<L> finite(L x) {
-  return x - x == 0.0;
 }
 
 /// Unaligned whole-vector load and store.

@@ -10,15 +10,7 @@
 
 namespace focal::detail {
 
-// The kernel writes focal::PointClass codes without including Eigen into device code.
 static_assert(triangle_kernel::field::count == 28);
-static_assert(triplet::class_code::elliptic == static_cast<std::uint8_t>(PointClass::elliptic) &&
-              triplet::class_code::hyperbolic ==
-                  static_cast<std::uint8_t>(PointClass::hyperbolic) &&
-              triplet::class_code::parabolic == static_cast<std::uint8_t>(PointClass::parabolic) &&
-              triplet::class_code::umbilic == static_cast<std::uint8_t>(PointClass::umbilic) &&
-              triplet::class_code::flat == static_cast<std::uint8_t>(PointClass::flat) &&
-              triplet::class_code::undefined == static_cast<std::uint8_t>(PointClass::undefined));
 
 TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
                              const CurvatureOptions& options, const char* what) {

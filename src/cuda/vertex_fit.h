@@ -98,7 +98,7 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
   p.vertices.resize(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
     VertexRecord<T>& r = p.vertices[static_cast<std::size_t>(i)];
-    const double length = N.row(i).norm();  // as curvature_detail.h's unit_rows
+    const double length = N.row(i).norm();  // as curvature/detail.h's unit_rows
     const bool normal_ok = std::isfinite(length) && length > 0.0;
     for (int c = 0; c < 3; ++c) {
       split(V(i, c) / unit, r.position_hi[c], r.position_lo[c]);

@@ -12,13 +12,14 @@
 #include "core/simd_lanes.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
-#include "curvature/lanes.h"
 #include "curvature/normal_rays_detail.h"
 #include "curvature/triangle_curvature_detail.h"
 #include "curvature/two_slit_detail.h"
 #include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 #include "mesh/prepared_detail.h"
 
 namespace focal {
@@ -112,11 +113,12 @@ void fit_vertex(const FitContext& c, int i, RayScratch& s, CurvatureResult& r) {
 // `undefined` by select, as store_undefined gives them in the scalar path.
 
 using detail::broadcast;
-using detail::finite;
 using detail::lane_count;
 using detail::lanes_of;
 using detail::MaskOf;
 using detail::VertexFitInput;
+using kernels::Quotient;
+using kernels::Vec3;
 
 /// One group of consecutive vertices: frame (x, y, n), position and neighbour lists per lane.
 template <class L>
@@ -125,7 +127,8 @@ struct alignas(sizeof(L)) VertexGroup {
   std::int64_t first = 0;
   int active = 0;  ///< lanes holding a vertex; the rest repeat the last one and are not stored
   int slots = 0;   ///< the largest neighbour count of the group
-  L px, py, pz, xx, xy, xz, yx, yy, yz, nx, ny, nz;
+  L px, py, pz;
+  kernels::Frame<L> frame;
   MaskOf<L> ok;  ///< -1 where the lane's vertex has a valid normal
   L count;       ///< neighbours per lane
   const int* ring[kWidth];
@@ -185,14 +188,13 @@ template <class L>
   // An invalid normal is replaced by +z so that its lane computes finite values; the lane is
   // stored as undefined.
   const L zero{};
-  g.nx = g.ok ? column<L>(N, g.self, 0) : zero;
-  g.ny = g.ok ? column<L>(N, g.self, 1) : zero;
-  g.nz = g.ok ? column<L>(N, g.self, 2) : broadcast<L>(1.0);
-  detail::frame_lanes(g.nx, g.ny, g.nz, g.xx, g.xy, g.xz, g.yx, g.yy, g.yz);
+  g.frame = kernels::frame_of(Vec3<L>{g.ok ? column<L>(N, g.self, 0) : zero,
+                                      g.ok ? column<L>(N, g.self, 1) : zero,
+                                      g.ok ? column<L>(N, g.self, 2) : broadcast<L>(1.0)});
 }
 
-/// The rays of slot k of every lane (detail::ray_of's formulas), added to the sums. Lanes with
-/// fewer than k + 1 neighbours read their own vertex and do not count it.
+/// The rays of slot k of every lane (kernels::normal_ray), added to the sums. Lanes with fewer
+/// than k + 1 neighbours read their own vertex and do not count it.
 template <class L>
 [[gnu::always_inline]] inline void make_slot(const FitContext& c, const VertexGroup<L>& g, int k,
                                              RaySlot<L>& out, SlotSums<L>& sums) {
@@ -201,30 +203,22 @@ template <class L>
   for (int l = 0; l < g.kWidth; ++l) j[l] = k < g.size[l] ? g.ring[l][k] : g.self[l];
   const PositionsRef& V = in.V;
   const RowMatrixX3d& N = in.unit_normals;
-  const L dx = column<L>(V, j, 0) - g.px, dy = column<L>(V, j, 1) - g.py,
-          dz = column<L>(V, j, 2) - g.pz;
-  const L nx = column<L>(N, j, 0), ny = column<L>(N, j, 1), nz = column<L>(N, j, 2);
+  const Vec3<L> d{column<L>(V, j, 0) - g.px, column<L>(V, j, 1) - g.py, column<L>(V, j, 2) - g.pz};
+  const Vec3<L> m{column<L>(N, j, 0), column<L>(N, j, 1), column<L>(N, j, 2)};
   L weight = broadcast<L>(1.0);
   if (c.options.weighting == RayWeighting::gaussian) {
-    const L d2 = dx * dx + dy * dy + dz * dz;
+    const L d2 = d.x * d.x + d.y * d.y + d.z * d.z;
     weight = lanes_of<L>([&](int l) { return std::exp(-d2[l] * c.inverse_two_width_squared); });
   }
-  const L m_n = g.nx * nx + g.ny * ny + g.nz * nz;
-  const L q_n = g.nx * dx + g.ny * dy + g.nz * dz;
   // One reciprocal, not two divisions: the divider is the narrowest port here.
-  const L inv_m_n = 1.0 / m_n;
-  const L sigma = (g.xx * nx + g.xy * ny + g.xz * nz) * inv_m_n;
-  const L tau = (g.yx * nx + g.yy * ny + g.yz * nz) * inv_m_n;
-  const L u = (g.xx * dx + g.xy * dy + g.xz * dz) - q_n * sigma;
-  const L v = (g.yx * dx + g.yy * dy + g.yz * dz) - q_n * tau;
-  // m_n > 0 also rejects NaN; a non-finite position or normal gives no ray.
+  kernels::NormalRay<L> ray;
   const auto made = g.ok & (static_cast<double>(k) < g.count) & flags<L>(in.normal_ok, j) &
-                    (m_n > 0.0) & finite(sigma + tau + u + v);
+                    kernels::normal_ray<Quotient::reciprocal>(g.frame, d, m, m, ray);
   const L zero{};
-  out.u = made ? u : zero;
-  out.v = made ? v : zero;
-  out.sigma = made ? sigma : zero;
-  out.tau = made ? tau : zero;
+  out.u = made ? ray.u : zero;
+  out.v = made ? ray.v : zero;
+  out.sigma = made ? ray.sigma : zero;
+  out.tau = made ? ray.tau : zero;
   out.weight = made ? weight : broadcast<L>(-0.0);
   const L w = out.weight;
   sums.uu += w * out.u * out.u;
@@ -293,8 +287,11 @@ template <class L>
   const L w2 = (c02 * sums.r0 + c12 * sums.r1 + c22 * sums.r2) * inv_det;
   const auto used = -sums.used;
   const auto valid = g.ok & (-sums.positive >= 2) & (scale > 0.0) &
-                     (det > 1e-12 * scale * scale * scale) & finite(w0) & finite(w1) & finite(w2);
-  const detail::PrincipalLanes<L> p = detail::principal_lanes(w0, w1, w2);
+                     (det > 1e-12 * scale * scale * scale) & kernels::is_finite(w0) &
+                     kernels::is_finite(w1) & kernels::is_finite(w2);
+  // Both divisions by one reciprocal, for the divider's sake as in make_slot.
+  const kernels::Principal<L> p =
+      kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w0, w1, w2);
   L energy{};
   for (int k = 0; k < g.slots; ++k) {
     const RaySlot<L>& ray = slots[k];
@@ -311,14 +308,13 @@ template <class L>
   x.k1 = or_nan(p.k1), x.k2 = or_nan(p.k2);
   x.H = or_nan(0.5 * (p.k1 + p.k2)), x.K = or_nan(p.k1 * p.k2);
   x.residual = or_nan(detail::lane_sqrt(energy / weight_sum));
-  // frame.from_plane(d1) and from_plane(d2) with d2 = d1 turned by +90 degrees.
-  x.d1x = or_nan(p.d1x * g.xx + p.d1y * g.yx), x.d1y = or_nan(p.d1x * g.xy + p.d1y * g.yy);
-  x.d1z = or_nan(p.d1x * g.xz + p.d1y * g.yz);
-  x.d2x = or_nan(-p.d1y * g.xx + p.d1x * g.yx), x.d2y = or_nan(-p.d1y * g.xy + p.d1x * g.yy);
-  x.d2z = or_nan(-p.d1y * g.xz + p.d1x * g.yz);
+  // d2 = d1 turned by +90 degrees.
+  const Vec3<L> d1 = g.frame.from_plane(p.d1x, p.d1y), d2 = g.frame.from_plane(-p.d1y, p.d1x);
+  x.d1x = or_nan(d1.x), x.d1y = or_nan(d1.y), x.d1z = or_nan(d1.z);
+  x.d2x = or_nan(d2.x), x.d2y = or_nan(d2.y), x.d2z = or_nan(d2.z);
   const MaskOf<L> none{};
-  x.point_class = valid ? detail::classify_lanes(x.k1, x.k2, c.tolerances)
-                        : none + static_cast<std::int64_t>(PointClass::undefined);
+  x.point_class = valid ? kernels::classify(x.k1, x.k2, c.tolerances.zero, c.tolerances.umbilic)
+                        : kernels::class_code<L>(PointClass::undefined);
   x.used = g.ok ? used : none;
   x.excluded = g.ok ? __builtin_convertvector(g.count, MaskOf<L>) - used : none;
   store_group(g, x, r);
@@ -369,13 +365,7 @@ CurvatureResult detail::vertex_curvature_from_rays(const PreparedMesh& mesh,
 }
 
 PointClass classify(double k1, double k2, double zero_tolerance, double umbilic_tolerance) {
-  if (!std::isfinite(k1) || !std::isfinite(k2)) return PointClass::undefined;
-  const bool zero1 = std::abs(k1) <= zero_tolerance, zero2 = std::abs(k2) <= zero_tolerance;
-  if (zero1 && zero2) return PointClass::flat;
-  if (zero1 || zero2) return PointClass::parabolic;
-  if (k1 - k2 <= umbilic_tolerance * std::max(std::abs(k1), std::abs(k2)))
-    return PointClass::umbilic;
-  return k1 * k2 > 0.0 ? PointClass::elliptic : PointClass::hyperbolic;
+  return static_cast<PointClass>(kernels::classify(k1, k2, zero_tolerance, umbilic_tolerance));
 }
 
 CurvatureResult estimate_curvature(const PreparedMesh& mesh, const CurvatureOptions& options) {

@@ -7,11 +7,13 @@
 #include <limits>
 #include <vector>
 
+#include "core/fields_detail.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
+#include "kernels/local_shape.h"
 #include "mesh/prepared_detail.h"  // unit_rows
 
 namespace focal::detail {
@@ -23,62 +25,15 @@ struct Principal2 {
   Eigen::Vector2d d1, d2;
 };
 
+/// kernels::principal_axes as this path has always rounded it: the operator scaled by a
+/// reciprocal, the direction normalised by an exact division (kernels::Quotient). d2 is (0, 1)
+/// where the operator is isotropic, not the rotation's (-0, 1): the sign of that zero shows in
+/// the stored directions.
 inline Principal2 principal_from_symmetric(double a, double b, double c) {
-  const double mean = 0.5 * (a + c);
-  const double d = 0.5 * (a - c);
-  // In units of s = max(|d|, |b|) squares neither overflow nor underflow, as with std::hypot;
-  // with the algebraic eigenvector below this avoids hypot, atan2 and sincos, which were a
-  // quarter of the per-vertex fit's time.
-  const double s = std::max(std::abs(d), std::abs(b));
-  if (s == 0.0) return {mean, mean, {1.0, 0.0}, {0.0, 1.0}};  // isotropic: any frame, take x
-  const double inv = 1.0 / s;
-  const double ds = d * inv, bs = b * inv;
-  const double r = std::sqrt(ds * ds + bs * bs);  // half the eigenvalue gap, over s
-  // The eigenvector of k1 with angle in (-pi/2, pi/2]: (r + d, b), or where that cancels
-  // (d < 0) the parallel (b, r - d) turned to x >= 0. Both have length sqrt(2 r (r + |d|)).
-  Eigen::Vector2d d1 = ds >= 0.0 ? Eigen::Vector2d(r + ds, bs)
-                                 : Eigen::Vector2d(std::abs(bs), std::copysign(r - ds, bs));
-  d1 /= std::sqrt(2.0 * r * (r + std::abs(ds)));
-  return {mean + s * r, mean - s * r, d1, Eigen::Vector2d(-d1.y(), d1.x())};
-}
-
-/// A result of n vertices with every field allocated but not written: the caller writes each
-/// row once, with store_vertex or store_undefined, from the thread that owns it (first touch
-/// then happens in parallel, and nothing is written twice).
-inline CurvatureResult unwritten_result(Eigen::Index n) {
-  CurvatureResult r;
-  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) v->resize(n);
-  r.d1.resize(n, 3);
-  r.d2.resize(n, 3);
-  r.point_class.resize(n);
-  r.rays_used.resize(n);
-  r.rays_excluded.resize(n);
-  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) {
-    advise_huge_pages(v->data(), sizeof(double) * static_cast<std::size_t>(n));
-  }
-  for (RowMatrixX3d* d : {&r.d1, &r.d2}) {
-    advise_huge_pages(d->data(), 3 * sizeof(double) * static_cast<std::size_t>(n));
-  }
-  return r;
-}
-
-/// Marks vertex i `undefined`: NaN in every numeric field. Leaves the ray counts alone.
-inline void store_undefined(CurvatureResult& r, Eigen::Index i) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  r.k1[i] = r.k2[i] = r.H[i] = r.K[i] = r.residual[i] = nan;
-  r.d1.row(i).setConstant(nan);
-  r.d2.row(i).setConstant(nan);
-  r.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
-}
-
-/// A result of n vertices, every one `undefined` with NaN fields until it is filled.
-inline CurvatureResult undefined_result(Eigen::Index n, int threads = 0) {
-  CurvatureResult r = unwritten_result(n);
-  parallel_for(n, threads, [&](std::int64_t i) {
-    store_undefined(r, i);
-    r.rays_used[i] = r.rays_excluded[i] = 0;
-  });
-  return r;
+  const kernels::Principal<double> p =
+      kernels::principal_axes<kernels::Quotient::reciprocal, kernels::Quotient::exact>(a, b, c);
+  const Eigen::Vector2d d1(p.d1x, p.d1y);
+  return {p.k1, p.k2, d1, p.isotropic ? Eigen::Vector2d(0.0, 1.0) : Eigen::Vector2d(-p.d1y, p.d1x)};
 }
 
 /// Thresholds of the classification in absolute curvature units for a mesh of edge length h.

@@ -13,11 +13,12 @@
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
 #include "curvature/detail.h"
-#include "curvature/lanes.h"
 #include "curvature/normal_rays_detail.h"
 #include "curvature/triangle_curvature_detail.h"
 #include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 #include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
 
@@ -59,18 +60,20 @@ TriangleCurvatureResult unwritten_faces(Eigen::Index m, const TriangleFields& wa
 // ---- The per-face solve, one face per lane.
 //
 // Faces in groups of the lane width (simd_lanes.h): the three vertex rays in the frame of the
-// face's mean normal (face_rays of version 3: inline frame_of and ray_of), the characteristic
+// face's mean normal (kernels::frame_of and normal_ray), the characteristic
 // equation with the sagitta shift, the curvatures and, where asked, directions, slits and the
 // shape operator, all as selects per lane; faces without a solution get NaN and `undefined`. No
 // lane reads another, so every instruction set and thread count gives the same bits.
 
 using detail::broadcast;
-using detail::finite;
 using detail::lane_abs;
 using detail::lane_count;
 using detail::lane_sqrt;
 using detail::lanes_of;
 using detail::MaskOf;
+using kernels::is_finite;
+using kernels::Quotient;
+using kernels::Vec3;
 
 /// What the face kernel reads.
 struct FaceInput {
@@ -159,31 +162,26 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
   // The frame of the mean normal; the centroid as origin.
   const L sx = mx[0] + mx[1] + mx[2], sy = my[0] + my[1] + my[2], sz = mz[0] + mz[1] + mz[2];
   const L length = lane_sqrt(sx * sx + sy * sy + sz * sz);
-  valid &= (length > 0.0) & finite(length);
+  valid &= (length > 0.0) & is_finite(length);
   const L one = broadcast<L>(1.0), zero{};
   // Reciprocals times, not divisions: the divider is the kernel's narrowest port (17 divisions
   // per group became 7; each result moves by at most an ulp).
   const L inv_length = 1.0 / length;
-  const L nx = valid ? sx * inv_length : zero, ny = valid ? sy * inv_length : zero,
-          nz = valid ? sz * inv_length : one;
-  L xx, xy, xz, yx, yy, yz;
-  detail::frame_lanes(nx, ny, nz, xx, xy, xz, yx, yy, yz);
+  const kernels::Frame<L> frame =
+      kernels::frame_of(Vec3<L>{valid ? sx * inv_length : zero, valid ? sy * inv_length : zero,
+                                valid ? sz * inv_length : one});
   const double third = 1.0 / 3.0;
-  const L cx = (px[0] + px[1] + px[2]) * third, cy = (py[0] + py[1] + py[2]) * third,
-          cz = (pz[0] + pz[1] + pz[2]) * third;
+  const Vec3<L> centroid{(px[0] + px[1] + px[2]) * third, (py[0] + py[1] + py[2]) * third,
+                         (pz[0] + pz[1] + pz[2]) * third};
   L u[3], v[3], sigma[3], tau[3], ox[3], oy[3];
-  for (int c = 0; c < 3; ++c) {  // ray_of, and the vertex's tangential offset
-    const L qx = px[c] - cx, qy = py[c] - cy, qz = pz[c] - cz;
-    const L m_n = nx * mx[c] + ny * my[c] + nz * mz[c];
-    const L q_n = nx * qx + ny * qy + nz * qz;
-    const L inv_m_n = 1.0 / m_n;
-    sigma[c] = (xx * mx[c] + xy * my[c] + xz * mz[c]) * inv_m_n;
-    tau[c] = (yx * mx[c] + yy * my[c] + yz * mz[c]) * inv_m_n;
-    ox[c] = xx * qx + xy * qy + xz * qz;
-    oy[c] = yx * qx + yy * qy + yz * qz;
-    u[c] = ox[c] - q_n * sigma[c];
-    v[c] = oy[c] - q_n * tau[c];
-    valid &= (m_n > 0.0) & finite(sigma[c] + tau[c] + u[c] + v[c]);
+  for (int c = 0; c < 3; ++c) {  // the vertex's ray (slopes by a reciprocal) and tangential offset
+    const Vec3<L> q = Vec3<L>{px[c], py[c], pz[c]} - centroid;
+    kernels::NormalRay<L> ray;
+    valid &= kernels::normal_ray<Quotient::reciprocal>(frame, q, Vec3<L>{mx[c], my[c], mz[c]},
+                                                       Vec3<L>{mx[c], my[c], mz[c]}, ray);
+    sigma[c] = ray.sigma, tau[c] = ray.tau, u[c] = ray.u, v[c] = ray.v;
+    ox[c] = kernels::dot(frame.x, q);
+    oy[c] = kernels::dot(frame.y, q);
   }
   Lanes2x2<L> X{u[1] - u[0], u[2] - u[0], v[1] - v[0], v[2] - v[0]};
   const Lanes2x2<L> G{sigma[1] - sigma[0], sigma[2] - sigma[0], tau[1] - tau[0], tau[2] - tau[0]};
@@ -208,7 +206,7 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
   const L inv_C = 1.0 / C;
   const L K = A * inv_C, H = 0.5 * (B * inv_C);
   // H^2 < K only through rounding or a non-symmetric M (noise): the double root H.
-  const L root = lane_sqrt(detail::lane_max(H * H - K, zero));
+  const L root = lane_sqrt(kernels::max_of(H * H - K, zero));
   const L k1 = H + root, k2 = H - root;
   const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
   const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
@@ -237,12 +235,13 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
       }
     }
     if (want.directions || want.slits) {
-      const detail::PrincipalLanes<L> p =
-          detail::principal_lanes(M.m00, 0.5 * (M.m01 + M.m10), M.m11);
+      const kernels::Principal<L> p =
+          kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(
+              M.m00, 0.5 * (M.m01 + M.m10), M.m11);
       // frame.from_plane of d1 and of d2 = d1 turned by +90 degrees.
       const auto to_3d = [&](L a, L b, RowMatrixX3d& m) FOCAL_LANE_LAMBDA {
-        store_rows(m, first, active, or_nan(a * xx + b * yx), or_nan(a * xy + b * yy),
-                   or_nan(a * xz + b * yz));
+        const Vec3<L> w = frame.from_plane(a, b);
+        store_rows(m, first, active, or_nan(w.x), or_nan(w.y), or_nan(w.z));
       };
       if (want.directions) to_3d(p.d1x, p.d1y, r.d1), to_3d(-p.d1y, p.d1x, r.d2);
       if (want.slits) {
@@ -256,10 +255,12 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
       }
     }
   }
-  if (want.face_normal)
-    store_rows(r.face_normal, first, active, or_nan(nx), or_nan(ny), or_nan(nz));
-  const auto point_class = valid ? detail::classify_lanes(k1, k2, in.tol)
-                                 : MaskOf<L>{} + static_cast<std::int64_t>(PointClass::undefined);
+  if (want.face_normal) {
+    store_rows(r.face_normal, first, active, or_nan(frame.n.x), or_nan(frame.n.y),
+               or_nan(frame.n.z));
+  }
+  const auto point_class = valid ? kernels::classify(k1, k2, in.tol.zero, in.tol.umbilic)
+                                 : kernels::class_code<L>(PointClass::undefined);
   for (int l = 0; l < active; ++l) {
     r.point_class[first + l] = static_cast<std::uint8_t>(point_class[l]);
   }

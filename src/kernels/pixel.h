@@ -6,11 +6,13 @@
 
 #include <cstdint>
 
+#include "kernels/local_shape.h"
 #include "kernels/triplet.h"
+#include "kernels/vec3.h"
 
 namespace focal::image_kernel {
 
-using triplet::Vec3;
+using kernels::Vec3;
 
 /// A G-buffer in place (see focal::GBuffer): row-major, pixel (x, y) at y * width + x.
 struct ImageView {
@@ -27,11 +29,11 @@ FOCAL_HD inline bool covered(const ImageView& v, int x, int y) {
 }
 
 FOCAL_HD inline Vec3<float> position_at(const ImageView& v, int x, int y) {
-  return triplet::load3(v.position + 3 * pixel_index(v, x, y));
+  return kernels::load3(v.position + 3 * pixel_index(v, x, y));
 }
 
 FOCAL_HD inline Vec3<float> normal_at(const ImageView& v, int x, int y) {
-  return triplet::load3(v.normal + 3 * pixel_index(v, x, y));
+  return kernels::load3(v.normal + 3 * pixel_index(v, x, y));
 }
 
 /// Inserts `value` into the sorted len[0, n).
@@ -50,8 +52,8 @@ FOCAL_HD inline float median_edge(const ImageView& v, int x0, int x1, int y0, in
   for (int py = y0; py <= y1; ++py) {
     for (int px = x0; px <= x1; ++px) {
       if (!covered(v, px, py) || !covered(v, px + dx, py + dy)) continue;
-      const float l = triplet::length(position_at(v, px + dx, py + dy) - position_at(v, px, py));
-      if (triplet::is_finite(l)) insert_sorted(len, n, l);
+      const float l = kernels::length(position_at(v, px + dx, py + dy) - position_at(v, px, py));
+      if (kernels::is_finite(l)) insert_sorted(len, n, l);
     }
   }
   if (n == 0) return 0.0f;
@@ -85,7 +87,7 @@ FOCAL_HD inline triplet::TripletSolution<float> pixel_triplet(const ImageView& v
                             position_at(v, x, y + 1)};
   const Vec3<float> n[3] = {normal_at(v, x, y), normal_at(v, x + 1, y), normal_at(v, x, y + 1)};
   // NaN limits (ratio inf times footprint 0) compare false: no discontinuity test then.
-  if (triplet::length(p[1] - p[0]) > limit.x || triplet::length(p[2] - p[0]) > limit.y) {
+  if (kernels::length(p[1] - p[0]) > limit.x || kernels::length(p[2] - p[0]) > limit.y) {
     return triplet::invalid_triplet<float>();
   }
   return triplet::solve_triplet(p, n);
@@ -99,8 +101,8 @@ struct PixelResult {
 };
 
 FOCAL_HD inline PixelResult invalid_pixel() {
-  const float nan = triplet::quiet_nan<float>();
-  return {false, nan, nan, nan, nan, nan, nan, triplet::nan3<float>(), triplet::nan3<float>()};
+  const float nan = kernels::quiet_nan<float>();
+  return {false, nan, nan, nan, nan, nan, nan, kernels::nan3<float>(), kernels::nan3<float>()};
 }
 
 FOCAL_HD inline PixelResult from_triplet(const triplet::TripletSolution<float>& s) {
@@ -118,8 +120,8 @@ struct ImageFields {
 FOCAL_HD inline void store_pixel(const ImageFields& out, int i, const PixelResult& r) {
   out.k1[i] = r.k1, out.k2[i] = r.k2, out.H[i] = r.H, out.K[i] = r.K;
   out.focal_depth1[i] = r.lambda1, out.focal_depth2[i] = r.lambda2;
-  triplet::store3(out.d1 + 3 * i, r.d1);
-  triplet::store3(out.d2 + 3 * i, r.d2);
+  kernels::store3(out.d1 + 3 * i, r.d1);
+  kernels::store3(out.d2 + 3 * i, r.d2);
   out.valid[i] = r.valid ? 1 : 0;
 }
 
@@ -154,22 +156,22 @@ FOCAL_HD inline PixelOperator pixel_operator(const ImageView& v, int x, int y, f
 
 /// The minimal rotation taking unit a to unit b (a.b > -1) applied to w (Rodrigues).
 FOCAL_HD inline Vec3<float> rotate_between(Vec3<float> a, Vec3<float> b, Vec3<float> w) {
-  const Vec3<float> axis = triplet::cross(a, b);
-  const float c = triplet::dot(a, b);
-  return w + triplet::cross(axis, w) +
-         (1.0f / (1.0f + c)) * triplet::cross(axis, triplet::cross(axis, w));
+  const Vec3<float> axis = kernels::cross(a, b);
+  const float c = kernels::dot(a, b);
+  return w + kernels::cross(axis, w) +
+         (1.0f / (1.0f + c)) * kernels::cross(axis, kernels::cross(axis, w));
 }
 
 /// A pixel's symmetric operator expressed in the frame `to`: its frame rotated onto to's tangent
 /// plane (a rotation, not a projection, so that k I stays k I exactly, as on a sphere).
-FOCAL_HD inline void operator_in_frame(const PixelOperator& o, const triplet::Frame<float>& to,
+FOCAL_HD inline void operator_in_frame(const PixelOperator& o, const kernels::Frame<float>& to,
                                        float& a, float& b, float& c) {
-  const triplet::Frame<float> from = triplet::frame_of(Vec3<float>{o.n[0], o.n[1], o.n[2]});
+  const kernels::Frame<float> from = kernels::frame_of(Vec3<float>{o.n[0], o.n[1], o.n[2]});
   const Vec3<float> x = rotate_between(from.n, to.n, from.x);
   const Vec3<float> y = rotate_between(from.n, to.n, from.y);
   // q: orthogonal change of basis from the rotated axes (x, y) to (to.x, to.y); S' = q S q^T.
-  const float q00 = triplet::dot(to.x, x), q01 = triplet::dot(to.x, y);
-  const float q10 = triplet::dot(to.y, x), q11 = triplet::dot(to.y, y);
+  const float q00 = kernels::dot(to.x, x), q01 = kernels::dot(to.x, y);
+  const float q10 = kernels::dot(to.y, x), q11 = kernels::dot(to.y, y);
   const float t00 = q00 * o.s00 + q01 * o.s01, t01 = q00 * o.s01 + q01 * o.s11;
   const float t10 = q10 * o.s00 + q11 * o.s01, t11 = q10 * o.s01 + q11 * o.s11;
   a = t00 * q00 + t01 * q01;
@@ -178,9 +180,9 @@ FOCAL_HD inline void operator_in_frame(const PixelOperator& o, const triplet::Fr
 }
 
 /// The principal curvatures of the symmetric [a b; b c] in frame f, as a pixel result.
-FOCAL_HD inline PixelResult from_operator(const triplet::Frame<float>& f, float a, float b,
+FOCAL_HD inline PixelResult from_operator(const kernels::Frame<float>& f, float a, float b,
                                           float c) {
-  const triplet::Principal<float> p = triplet::principal_from_symmetric(a, b, c);
+  const kernels::Principal<float> p = triplet::principal_of(a, b, c);
   return {true,
           p.k1,
           p.k2,
@@ -201,8 +203,8 @@ FOCAL_HD inline PixelResult window_result(const ImageView& v, const PixelOperato
                                           int y, int w) {
   const PixelOperator& centre = ops[pixel_index(v, x, y)];
   if (!(centre.weight > 0.0f)) return invalid_pixel();
-  const triplet::Frame<float> frame =
-      triplet::frame_of(Vec3<float>{centre.n[0], centre.n[1], centre.n[2]});
+  const kernels::Frame<float> frame =
+      kernels::frame_of(Vec3<float>{centre.n[0], centre.n[1], centre.n[2]});
   const Vec3<float> p = position_at(v, x, y);
   float sa = 0.0f, sb = 0.0f, sc = 0.0f, total = 0.0f;
   for (int j = -w; j <= w; ++j) {
@@ -211,9 +213,9 @@ FOCAL_HD inline PixelResult window_result(const ImageView& v, const PixelOperato
       if (px < 0 || py < 0 || px >= v.width || py >= v.height) continue;
       const PixelOperator& o = ops[pixel_index(v, px, py)];
       if (!(o.weight > 0.0f)) continue;
-      if (!(triplet::dot(frame.n, Vec3<float>{o.n[0], o.n[1], o.n[2]}) > 0.0f)) continue;
+      if (!(kernels::dot(frame.n, Vec3<float>{o.n[0], o.n[1], o.n[2]}) > 0.0f)) continue;
       const float steps = static_cast<float>((i < 0 ? -i : i) + (j < 0 ? -j : j));
-      const float distance = triplet::length(position_at(v, px, py) - p);
+      const float distance = kernels::length(position_at(v, px, py) - p);
       if (distance > steps * centre.limit.x && distance > steps * centre.limit.y) continue;
       float a, b, c;
       operator_in_frame(o, frame, a, b, c);

@@ -5,11 +5,13 @@
 
 #include <cstdint>
 
+#include "kernels/local_shape.h"
 #include "kernels/triplet.h"
+#include "kernels/vec3.h"
 
 namespace focal::triangle_kernel {
 
-using triplet::Vec3;
+using kernels::Vec3;
 
 /// Per-face float outputs, field-major: value (field, face) at field * faces + face.
 namespace field {
@@ -35,14 +37,14 @@ struct TriangleKernelParams {
 FOCAL_HD inline triplet::TripletSolution<float> face_triplet(const TriangleKernelParams& k, int f) {
   Vec3<double> p[3], centroid{0.0, 0.0, 0.0};
   for (int c = 0; c < 3; ++c) {
-    p[c] = triplet::load3(k.V + 3 * k.F[3 * f + c]);
+    p[c] = kernels::load3(k.V + 3 * k.F[3 * f + c]);
     centroid = centroid + p[c];
   }
   centroid = (1.0 / 3.0) * centroid;
   Vec3<float> q[3], n[3];
   for (int c = 0; c < 3; ++c) {
-    q[c] = triplet::vec_cast<float>(p[c] - centroid);
-    n[c] = triplet::vec_cast<float>(triplet::load3(k.N + 3 * k.F[3 * f + c]));
+    q[c] = kernels::vec_cast<float>(p[c] - centroid);
+    n[c] = kernels::vec_cast<float>(kernels::load3(k.N + 3 * k.F[3 * f + c]));
   }
   return triplet::solve_triplet(q, n);
 }
@@ -70,8 +72,8 @@ FOCAL_HD inline void triangle_face(const TriangleKernelParams& k, int f) {
   store_field3(k, field::face_normal, f, s.frame.n);
   const float m[4] = {s.shape.a, s.shape.b, s.shape.c, s.shape.d};
   for (int i = 0; i < 4; ++i) value_at(k, field::shape_operator + i, f) = m[i];
-  k.point_class[f] = s.valid ? triplet::classify(s.k1, s.k2, k.zero_tolerance, k.umbilic_tolerance)
-                             : triplet::class_code::undefined;
+  k.point_class[f] = s.valid ? kernels::classify(s.k1, s.k2, k.zero_tolerance, k.umbilic_tolerance)
+                             : kernels::class_code<float>(PointClass::undefined);
 }
 
 }  // namespace focal::triangle_kernel

@@ -4,9 +4,9 @@
 // image-space kernel and the CUDA per-triangle kernel (and, in double, the check against
 // triangle_curvature in tests/image_space_test.cpp).
 //
-// It follows src/triangle_curvature.cpp step by step (frame of the unit mean normal, rays from
-// the centroid, sagitta correction, K = A / C, 2H = B / C, k = H +- sqrt(discriminant), directions
-// from the symmetrised M = G X^-1, slits from eq. 18), with two changes for float32:
+// It follows src/curvature/triangle_curvature.cpp step by step (frame of the unit mean normal, rays
+// from the centroid, sagitta correction, K = A / C, 2H = B / C, k = H +- sqrt(discriminant),
+// directions from the symmetrised M = G X^-1, slits from eq. 18), with two changes for float32:
 //  - positions are taken relative to the triplet's centroid and divided by the triplet's size s
 //    before any product is formed, so that no intermediate over- or underflows whatever the
 //    units and the results carry float's relative precision, not that of the coordinates;
@@ -14,42 +14,31 @@
 //    two nearly equal squares at umbilics.
 // Degeneracy tests are ratios (scale-free); their thresholds are per precision (Tolerance).
 
-#include <math.h>  // sqrtf, sqrt, fabsf, ... : the C names are the ones CUDA provides on the device
-
-#include <cstdint>
-
 #include "kernels/host_device.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 
 namespace focal::triplet {
 
-// ---------------------------------------------------------------------------------------------
-// Scalars: overloads that resolve to the same C functions on the host and on the device.
-
-FOCAL_HD inline float sqrt_of(float v) { return sqrtf(v); }
-FOCAL_HD inline double sqrt_of(double v) { return sqrt(v); }
-FOCAL_HD inline float abs_of(float v) { return fabsf(v); }
-FOCAL_HD inline double abs_of(double v) { return fabs(v); }
-FOCAL_HD inline float copysign_of(float m, float s) { return copysignf(m, s); }
-FOCAL_HD inline double copysign_of(double m, double s) { return copysign(m, s); }
-template <class T>
-FOCAL_HD T quiet_nan();
-template <>
-FOCAL_HD inline float quiet_nan<float>() {
-  return nanf("");
-}
-template <>
-FOCAL_HD inline double quiet_nan<double>() {
-  return nan("");
-}
-/// False for NaN and +-inf (v - v is NaN for both), without the device/host split of isfinite.
-template <class T>
-FOCAL_HD bool is_finite(T v) {
-  return v - v == T(0);
-}
-template <class T>
-FOCAL_HD T max_of(T a, T b) {
-  return a > b ? a : b;
-}
+// The arithmetic (kernels/vec3.h) and the local shape (kernels/local_shape.h) of every kernel.
+using kernels::abs_of;
+using kernels::cross;
+using kernels::dot;
+using kernels::Frame;
+using kernels::frame_of;
+using kernels::is_finite;
+using kernels::length;
+using kernels::load3;
+using kernels::max_abs;
+using kernels::max_of;
+using kernels::nan3;
+using kernels::norm;
+using kernels::Principal;
+using kernels::quiet_nan;
+using kernels::sqrt_of;
+using kernels::store3;
+using kernels::Vec3;
+using kernels::vec_cast;
 
 /// Thresholds per precision. `degenerate`: a triangle of rays whose area in the ray frame is
 /// below this fraction of its squared size (|det X| vs |X|_F^2, about sin of its smallest angle)
@@ -69,90 +58,6 @@ struct Tolerance<double> {
   FOCAL_HD static double degenerate() { return 1e-14; }
   FOCAL_HD static double slit() { return 1e-9; }
 };
-
-// ---------------------------------------------------------------------------------------------
-// Vectors.
-
-template <class T>
-struct Vec3 {
-  T x, y, z;
-};
-template <class T>
-FOCAL_HD Vec3<T> operator+(Vec3<T> a, Vec3<T> b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-template <class T>
-FOCAL_HD Vec3<T> operator-(Vec3<T> a, Vec3<T> b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-template <class T>
-FOCAL_HD Vec3<T> operator*(T s, Vec3<T> a) {
-  return {s * a.x, s * a.y, s * a.z};
-}
-template <class T>
-FOCAL_HD T dot(Vec3<T> a, Vec3<T> b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-template <class T>
-FOCAL_HD Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-template <class T>
-FOCAL_HD T norm(Vec3<T> a) {
-  return sqrt_of(dot(a, a));
-}
-template <class T>
-FOCAL_HD bool is_finite(Vec3<T> a) {
-  return is_finite(a.x) && is_finite(a.y) && is_finite(a.z);
-}
-/// The largest absolute component.
-template <class T>
-FOCAL_HD T max_abs(Vec3<T> a) {
-  return max_of(max_of(abs_of(a.x), abs_of(a.y)), abs_of(a.z));
-}
-/// |a| without over- or underflow of the squares (as hypot does): float squares overflow from
-/// 1.8e19 and underflow below 1.1e-19, well inside the range of coordinates. NaN when a
-/// component is not finite.
-template <class T>
-FOCAL_HD T length(Vec3<T> a) {
-  if (!is_finite(a)) return quiet_nan<T>();
-  const T m = max_abs(a);
-  return m > T(0) ? m * norm((T(1) / m) * a) : T(0);
-}
-template <class T, class U>
-FOCAL_HD Vec3<T> vec_cast(Vec3<U> a) {
-  return {T(a.x), T(a.y), T(a.z)};
-}
-template <class T>
-FOCAL_HD Vec3<T> load3(const T* p) {
-  return {p[0], p[1], p[2]};
-}
-template <class T>
-FOCAL_HD void store3(T* p, Vec3<T> a) {
-  p[0] = a.x, p[1] = a.y, p[2] = a.z;
-}
-template <class T>
-FOCAL_HD Vec3<T> nan3() {
-  return {quiet_nan<T>(), quiet_nan<T>(), quiet_nan<T>()};
-}
-
-/// A right-handed orthonormal frame (x, y, n).
-template <class T>
-struct Frame {
-  Vec3<T> x, y, n;
-  FOCAL_HD Vec3<T> from_plane(T a, T b) const { return a * x + b * y; }
-};
-
-/// The frame of a unit normal: Duff et al. (JCGT 2017), the same construction as
-/// focal::tangent_frame, so that 2D quantities (the shape operator, the sign of d1) agree with
-/// the CPU path's.
-template <class T>
-FOCAL_HD Frame<T> frame_of(Vec3<T> n) {
-  const T sign = copysign_of(T(1), n.z);
-  const T a = T(-1) / (sign + n.z);
-  const T b = n.x * n.y * a;
-  return {{T(1) + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
-}
 
 // ---------------------------------------------------------------------------------------------
 // 2x2 algebra.
@@ -178,25 +83,11 @@ FOCAL_HD Mat2<T> times_inverse(const Mat2<T>& g, const Mat2<T>& x) {
           (g.c * x.d - g.d * x.c) * inv, (g.d * x.a - g.c * x.b) * inv};
 }
 
-/// Eigen-decomposition of the symmetric [a b; b c]: k1 >= k2, unit d1 = (d1x, d1y) of k1 with
-/// angle in (-pi/2, pi/2], d2 = d1 turned by +90 degrees. The formula of
-/// detail::principal_from_symmetric (src/curvature_detail.h), in T.
+/// The principal axes of the symmetric [a b; b c] (kernels::principal_axes) as the triplet has
+/// always rounded them: both divisions exact.
 template <class T>
-struct Principal {
-  T k1, k2, d1x, d1y;
-};
-template <class T>
-FOCAL_HD Principal<T> principal_from_symmetric(T a, T b, T c) {
-  const T mean = T(0.5) * (a + c);
-  const T d = T(0.5) * (a - c);
-  const T s = max_of(abs_of(d), abs_of(b));
-  if (s == T(0)) return {mean, mean, T(1), T(0)};
-  const T ds = d / s, bs = b / s;
-  const T r = sqrt_of(ds * ds + bs * bs);
-  T x = ds >= T(0) ? r + ds : abs_of(bs);
-  T y = ds >= T(0) ? bs : copysign_of(r - ds, bs);
-  const T len = sqrt_of(T(2) * r * (r + abs_of(ds)));
-  return {mean + s * r, mean - s * r, x / len, y / len};
+FOCAL_HD Principal<T> principal_of(T a, T b, T c) {
+  return kernels::principal_axes<kernels::Quotient::exact, kernels::Quotient::exact>(a, b, c);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -238,21 +129,19 @@ struct ScaledRays {
   T offset[3][2];  ///< tangential position of each point relative to the centroid
 };
 
-/// False where a ray cannot be parametrised: a normal outside frame.n's open hemisphere.
+/// False where a ray cannot be parametrised (kernels::normal_ray, slopes divided exactly): a
+/// normal outside frame.n's open hemisphere, or a ray that is not finite (its X would have no
+/// area, has_area false, and the triplet be invalid all the same).
 template <class T>
 FOCAL_HD bool scaled_rays(const Frame<T>& f, const Vec3<T> q[3], const Vec3<T> n[3],
                           ScaledRays<T>& out) {
   T u[3], v[3], sigma[3], tau[3];
   for (int i = 0; i < 3; ++i) {
-    const T mz = dot(f.n, n[i]);
-    if (!(mz > T(0))) return false;
-    sigma[i] = dot(f.x, n[i]) / mz;
-    tau[i] = dot(f.y, n[i]) / mz;
-    const T qz = dot(f.n, q[i]);
+    kernels::NormalRay<T> ray;
+    if (!kernels::normal_ray<kernels::Quotient::exact>(f, q[i], n[i], n[i], ray)) return false;
+    sigma[i] = ray.sigma, tau[i] = ray.tau, u[i] = ray.u, v[i] = ray.v;
     out.offset[i][0] = dot(f.x, q[i]);
     out.offset[i][1] = dot(f.y, q[i]);
-    u[i] = out.offset[i][0] - qz * sigma[i];
-    v[i] = out.offset[i][1] - qz * tau[i];
   }
   out.X = {u[1] - u[0], u[2] - u[0], v[1] - v[0], v[2] - v[0]};
   out.G = {sigma[1] - sigma[0], sigma[2] - sigma[0], tau[1] - tau[0], tau[2] - tau[0]};
@@ -311,7 +200,8 @@ FOCAL_HD TripletSolution<T> solve_scaled(const Frame<T>& f, const ScaledRays<T>&
   const Mat2<T> M = times_inverse(G, X);
   const T half_gap = T(0.5) * (M.a - M.d);
   // Below zero only through rounding or an unsymmetric M (noise): the double root H, as the CPU.
-  const T root = sqrt_of(max_of(half_gap * half_gap + M.b * M.c, T(0)));
+  // max_of(0, x), not (x, 0): NaN (an M that overflowed) gives 0 here, as it always has.
+  const T root = sqrt_of(max_of(T(0), half_gap * half_gap + M.b * M.c));
   const T H = B / (T(2) * C);
   TripletSolution<T> s;
   s.valid = true;
@@ -322,7 +212,7 @@ FOCAL_HD TripletSolution<T> solve_scaled(const Frame<T>& f, const ScaledRays<T>&
   s.relative_area = abs_of(C);
   s.frame = f;
   s.shape = {M.a / size, M.b / size, M.c / size, M.d / size};
-  const Principal<T> p = principal_from_symmetric(M.a, T(0.5) * (M.b + M.c), M.d);
+  const Principal<T> p = principal_of(M.a, T(0.5) * (M.b + M.c), M.d);
   s.d1 = f.from_plane(p.d1x, p.d1y);
   s.d2 = f.from_plane(-p.d1y, p.d1x);
   // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
@@ -369,24 +259,6 @@ FOCAL_HD TripletSolution<T> solve_triplet(const Vec3<T> p[3], const Vec3<T> n[3]
   correct_sagitta(rays);
   if (!has_area(rays.X)) return invalid_triplet<T>();
   return solve_scaled(f, rays, size);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Classification (focal::classify in plain data; codes are focal::PointClass's).
-
-namespace class_code {
-constexpr std::uint8_t elliptic = 0, hyperbolic = 1, parabolic = 2, umbilic = 3, flat = 4,
-                       undefined = 5;
-}  // namespace class_code
-
-template <class T>
-FOCAL_HD std::uint8_t classify(T k1, T k2, T zero_tolerance, T umbilic_tolerance) {
-  if (!is_finite(k1) || !is_finite(k2)) return class_code::undefined;
-  const bool zero1 = abs_of(k1) <= zero_tolerance, zero2 = abs_of(k2) <= zero_tolerance;
-  if (zero1 && zero2) return class_code::flat;
-  if (zero1 || zero2) return class_code::parabolic;
-  if (k1 - k2 <= umbilic_tolerance * max_of(abs_of(k1), abs_of(k2))) return class_code::umbilic;
-  return k1 * k2 > T(0) ? class_code::elliptic : class_code::hyperbolic;
 }
 
 }  // namespace focal::triplet

@@ -3,9 +3,10 @@
 // math that nvcc compiles into the CUDA kernel and g++ into the CPU test that checks it against
 // estimate_curvature. No Eigen, no allocation: one thread runs fit_vertex for one vertex.
 //
-// The formulas are those of src/curvature.cpp and src/*_detail.h (frame of Duff et al., rays of
-// paper eq. 3, 3x3 normal equations in W = [a b; b c], eigen-decomposition, classification), in
-// an arithmetic type T (float on the device, double to check the formula). Three changes keep
+// The frame of Duff et al., the rays of paper eq. 3, the eigen-decomposition and the
+// classification are kernels/local_shape.h's, those of every estimator; the 3x3 normal equations
+// in W = [a b; b c] are those of curvature/two_slit_detail.h. All in an arithmetic type T (float
+// on the device, double to check the formula). Three changes keep
 // float32 accurate to a few units of its rounding relative to the curvature, whatever the mesh
 // size, units or placement (docs/GPU.md):
 //  - Positions and normals arrive as float pairs hi + lo (lo = the rounding error of hi). A
@@ -21,7 +22,10 @@
 #include <cmath>
 #include <cstdint>
 
+#include "focal/core/point_class.h"
 #include "kernels/host_device.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 
 namespace focal::cuda {
 
@@ -67,25 +71,9 @@ struct VertexFitParams {
   VertexFitOutput<T> out;
 };
 
-/// PointClass codes (focal/curvature.h), repeated so that this header needs no Eigen.
-enum : std::uint8_t {
-  kElliptic = 0,
-  kHyperbolic = 1,
-  kParabolic = 2,
-  kUmbilic = 3,
-  kFlat = 4,
-  kUndefined = 5,
-};
-
-template <class T>
-struct Vec3 {
-  T x, y, z;
-};
-
-template <class T>
-FOCAL_HD inline T dot(const Vec3<T>& a, const Vec3<T>& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
+using kernels::dot;
+using kernels::Frame;
+using kernels::Vec3;
 
 /// hi + lo of `a` minus hi + lo of `b`: the hi difference first, which is exact to rounding
 /// relative to itself, then the small correction.
@@ -96,46 +84,26 @@ FOCAL_HD inline Vec3<T> pair_difference(const T* a_hi, const T* a_lo, const T* b
           (a_hi[2] - b_hi[2]) + (a_lo[2] - b_lo[2])};
 }
 
-/// Tangent frame (x, y, n) of Duff et al. 2017, as normal_rays_detail.h's frame_of.
-template <class T>
-struct Frame {
-  Vec3<T> x, y, n;
-};
-
-template <class T>
-FOCAL_HD inline Frame<T> frame_of(const Vec3<T>& n) {
-  const T sign = std::copysign(T(1), n.z);
-  const T a = T(-1) / (sign + n.z);
-  const T b = n.x * n.y * a;
-  return {{T(1) + sign * n.x * n.x * a, sign * b, -sign * n.x},
-          {b, sign + n.y * n.y * a, -n.y},
-          n};
-}
-
 /// A neighbour's ray (paper eq. 3) and its squared distance, in scaled units.
 template <class T>
 struct Ray {
   T sigma, tau, u, v, distance_squared;
 };
 
-/// The ray of neighbour `q` seen from vertex `p` in `f`; false where the CPU has none (normal
-/// outside the open hemisphere of n, or anything not finite).
+/// The ray of neighbour `q` seen from vertex `p` in `f` (kernels::normal_ray, slopes by one
+/// reciprocal as the CPU's lane kernel); false where the CPU has none (normal outside the open
+/// hemisphere of n, or anything not finite; invalid normals are NaN).
 template <class T>
 FOCAL_HD inline bool ray_of(const Frame<T>& f, const VertexRecord<T>& p, const VertexRecord<T>& q,
                             Ray<T>& r) {
   const Vec3<T> m{q.normal_hi[0], q.normal_hi[1], q.normal_hi[2]};
-  const T mz = dot(f.n, m);
-  if (!(mz > T(0))) return false;  // also rejects NaN (invalid normals are NaN)
+  // The hemisphere test (normal_ray's too) before the pairs are loaded: a thread whose ray does
+  // not exist reads nothing more, and the kernel keeps 56 registers (59 without, sm_90).
+  if (!(dot(f.n, m) > T(0))) return false;
   const Vec3<T> d = pair_difference(q.normal_hi, q.normal_lo, p.normal_hi, p.normal_lo);
   const Vec3<T> o = pair_difference(q.position_hi, q.position_lo, p.position_hi, p.position_lo);
-  const T inv_mz = T(1) / mz;
-  r.sigma = dot(f.x, d) * inv_mz;
-  r.tau = dot(f.y, d) * inv_mz;
-  const T oz = dot(f.n, o);
-  r.u = dot(f.x, o) - oz * r.sigma;
-  r.v = dot(f.y, o) - oz * r.tau;
   r.distance_squared = dot(o, o);
-  return std::isfinite(r.sigma + r.tau + r.u + r.v);
+  return kernels::normal_ray<kernels::Quotient::reciprocal>(f, o, m, d, r);
 }
 
 template <class T>
@@ -189,47 +157,12 @@ FOCAL_HD inline bool solve(const NormalSums<T>& s, T min_relative_determinant, T
   return std::isfinite(w[0] + w[1] + w[2]);
 }
 
-/// Eigenvalues k1 >= k2 of [a b; b c], unit d1 of k1, d2 = d1 turned by +90 degrees; the
-/// algebraic form of curvature_detail.h's principal_from_symmetric (no atan2, no hypot).
-template <class T>
-struct Principal {
-  T k1, k2, d1x, d1y;
-};
-
-template <class T>
-FOCAL_HD inline Principal<T> principal_of(T a, T b, T c) {
-  const T mean = T(0.5) * (a + c);
-  const T d = T(0.5) * (a - c);
-  const T s = std::fmax(std::fabs(d), std::fabs(b));
-  if (s == T(0)) return {mean, mean, T(1), T(0)};
-  const T inv = T(1) / s;
-  const T ds = d * inv, bs = b * inv;
-  const T r = std::sqrt(ds * ds + bs * bs);
-  T x = ds >= T(0) ? r + ds : std::fabs(bs);
-  T y = ds >= T(0) ? bs : std::copysign(r - ds, bs);
-  const T n = T(1) / std::sqrt(T(2) * r * (r + std::fabs(ds)));
-  x *= n;
-  y *= n;
-  return {mean + s * r, mean - s * r, x, y};
-}
-
-/// curvature.cpp's classify, in T.
-template <class T>
-FOCAL_HD inline std::uint8_t classify_point(T k1, T k2, T zero_tolerance, T umbilic_tolerance) {
-  if (!std::isfinite(k1) || !std::isfinite(k2)) return kUndefined;
-  const bool zero1 = std::fabs(k1) <= zero_tolerance, zero2 = std::fabs(k2) <= zero_tolerance;
-  if (zero1 && zero2) return kFlat;
-  if (zero1 || zero2) return kParabolic;
-  if (k1 - k2 <= umbilic_tolerance * std::fmax(std::fabs(k1), std::fabs(k2))) return kUmbilic;
-  return k1 * k2 > T(0) ? kElliptic : kHyperbolic;
-}
-
 template <class T>
 FOCAL_HD inline void store_undefined(const VertexFitOutput<T>& o, int i) {
   const T nan = static_cast<T>(NAN);  // numeric_limits is not callable in device code
   o.k1[i] = o.k2[i] = o.H[i] = o.K[i] = o.residual[i] = nan;
   for (int c = 0; c < 3; ++c) o.d1[3 * i + c] = o.d2[3 * i + c] = nan;
-  o.point_class[i] = kUndefined;
+  o.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
 }
 
 /// Weighted sum of squared misfits |W x - g|^2 and of the weights: a second pass over the
@@ -259,7 +192,7 @@ FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
   const Vec3<T> n{me.normal_hi[0], me.normal_hi[1], me.normal_hi[2]};
   o.rays_used[i] = o.rays_excluded[i] = 0;
   if (!std::isfinite(n.x + n.y + n.z)) return store_undefined(o, i);
-  const Frame<T> f = frame_of(n);
+  const Frame<T> f = kernels::frame_of(n);
   NormalSums<T> sums;
   int used = 0, excluded = 0;
   for (int k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
@@ -277,24 +210,19 @@ FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
   if (!solve(sums, p.min_relative_determinant, w)) return store_undefined(o, i);
   T energy, weight_sum;
   misfit(p, i, f, w, energy, weight_sum);
-  const Principal<T> e = principal_of(w[0], w[1], w[2]);
+  // Both divisions by a reciprocal, as the CPU's lane kernel.
+  const kernels::Principal<T> e =
+      kernels::principal_axes<kernels::Quotient::reciprocal, kernels::Quotient::reciprocal>(
+          w[0], w[1], w[2]);
   const T k1 = e.k1 * p.curvature_unit, k2 = e.k2 * p.curvature_unit;
   o.k1[i] = k1;
   o.k2[i] = k2;
   o.H[i] = T(0.5) * (k1 + k2);
   o.K[i] = k1 * k2;
-  const Vec3<T> d1{e.d1x * f.x.x + e.d1y * f.y.x, e.d1x * f.x.y + e.d1y * f.y.y,
-                   e.d1x * f.x.z + e.d1y * f.y.z};
-  const Vec3<T> d2{-e.d1y * f.x.x + e.d1x * f.y.x, -e.d1y * f.x.y + e.d1x * f.y.y,
-                   -e.d1y * f.x.z + e.d1x * f.y.z};
-  o.d1[3 * i] = d1.x;
-  o.d1[3 * i + 1] = d1.y;
-  o.d1[3 * i + 2] = d1.z;
-  o.d2[3 * i] = d2.x;
-  o.d2[3 * i + 1] = d2.y;
-  o.d2[3 * i + 2] = d2.z;
+  kernels::store3(o.d1 + 3 * i, f.from_plane(e.d1x, e.d1y));
+  kernels::store3(o.d2 + 3 * i, f.from_plane(-e.d1y, e.d1x));
   o.residual[i] = std::sqrt(energy / weight_sum);
-  o.point_class[i] = classify_point(k1, k2, p.zero_tolerance, p.umbilic_tolerance);
+  o.point_class[i] = kernels::classify(k1, k2, p.zero_tolerance, p.umbilic_tolerance);
 }
 
 }  // namespace focal::cuda

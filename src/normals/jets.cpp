@@ -12,12 +12,15 @@
 #include <string>
 #include <vector>
 
+#include "core/fields_detail.h"
 #include "core/parallel.h"
-#include "curvature/detail.h"
-#include "curvature/normal_rays_detail.h"
 #include "focal/core/error.h"
+#include "focal/core/point_class.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
+#include "kernels/eigen.h"
+#include "kernels/local_shape.h"
+#include "kernels/vec3.h"
 #include "mesh/normals_detail.h"
 #include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
@@ -25,6 +28,8 @@
 
 namespace focal {
 namespace {
+
+using kernels::eigen_of;
 
 constexpr int kMaxDegree = 4;
 
@@ -59,7 +64,8 @@ constexpr ProductTable kProductMoment = [] {
 
 /// One vertex's fitted graph z = sum c_k m_k(x / s, y / s) * s in `frame` (origin at the vertex).
 struct LocalJet {
-  TangentFrame frame{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
+  /// The tangent frame of every estimator (kernels::frame_of).
+  kernels::Frame<double> frame{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
   double scale = 0.0;  ///< s: the neighbourhood radius the coordinates were divided by
   int degree = 0;      ///< 0: no valid fit
   int points = 0;
@@ -71,6 +77,11 @@ struct LocalJet {
 struct Point {
   double x, y, z;
 };
+
+/// Two doubles as one SSE2 register: the moments (and x.q, y.q in gather_points) are sums of
+/// independent entries, added pairwise with the same per-entry operations (and bits) as one at a
+/// time.
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
 /// A thread's scratch, reused across its vertices: no allocation per vertex once warm.
 struct JetScratch {
@@ -114,21 +125,21 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
 
 /// The vertex itself (zero) and its ring in the frame, scaled by the largest offset; non-finite
 /// neighbours are skipped. Returns the scale (0 when no usable neighbour).
-double gather_points(PositionsRef V, int i, const TangentFrame& f, JetScratch& s) {
+double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f, JetScratch& s) {
   s.points.assign(1, Point{0.0, 0.0, 0.0});
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
-  // the nine products here.
+  // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
+  // GCC paired them by itself or not, depending on how the frame was built.
   const double px = V(i, 0), py = V(i, 1), pz = V(i, 2);
-  const double xx = f.x.x(), xy = f.x.y(), xz = f.x.z();
-  const double yx = f.y.x(), yy = f.y.y(), yz = f.y.z();
-  const double nx = f.n.x(), ny = f.n.y(), nz = f.n.z();
+  const Pair frame_x = {f.x.x, f.y.x}, frame_y = {f.x.y, f.y.y}, frame_z = {f.x.z, f.y.z};
+  const double nx = f.n.x, ny = f.n.y, nz = f.n.z;
   double scale_sq = 0.0;
   for (const int j : s.ring) {
     if (j == i) continue;
     const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
     if (!std::isfinite(qx) || !std::isfinite(qy) || !std::isfinite(qz)) continue;
-    s.points.push_back(
-        {xx * qx + xy * qy + xz * qz, yx * qx + yy * qy + yz * qz, nx * qx + ny * qy + nz * qz});
+    const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
+    s.points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
     scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
   }
   const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
@@ -151,10 +162,6 @@ struct Moments {
   double xy[kProducts] = {};     ///< sum x^a y^b, a + b <= 2D
   double z[kCoefficients] = {};  ///< sum z x^a y^b, a + b <= D
 };
-
-/// Two doubles as one SSE2 register: the moments are sums of independent entries, added pairwise
-/// with the same per-entry operations (and bits) as one at a time.
-using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
 constexpr int pairs_for(int count) { return (count + 1) / 2; }
 
@@ -348,7 +355,8 @@ bool solve_heights(int degree, const std::vector<Point>& points, std::vector<dou
 }
 
 Eigen::Vector3d jet_normal(const LocalJet& jet) {
-  return (jet.frame.n - jet.c[1] * jet.frame.x - jet.c[2] * jet.frame.y).normalized();
+  const kernels::Frame<double>& f = jet.frame;
+  return (eigen_of(f.n) - jet.c[1] * eigen_of(f.x) - jet.c[2] * eigen_of(f.y)).normalized();
 }
 
 /// Fits `iterations` jets at vertex i starting from the unit normal n0.
@@ -358,7 +366,7 @@ LocalJet fit_vertex(PositionsRef V, const Neighbourhoods& one, int i, Eigen::Vec
   LocalJet jet;
   for (int it = 0; it < o.iterations; ++it) {
     jet = LocalJet{};
-    jet.frame = detail::frame_of(n);
+    jet.frame = kernels::frame_of(kernels::vec3_of(n));
     jet.scale = gather_points(V, i, jet.frame, s);
     if (!(jet.scale > 0.0) || !solve_heights(o.degree, s.points, s.terms, jet)) return LocalJet{};
     n = jet_normal(jet);
@@ -455,7 +463,8 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> eig(second, first);
   const Eigen::Vector3d n = jet_normal(jet);
   const Eigen::Vector2d v = eig.eigenvectors().col(1);  // of the larger eigenvalue
-  Eigen::Vector3d d1 = jet.frame.x * v.x() + jet.frame.y * v.y() + jet.frame.n * g.dot(v);
+  const kernels::Frame<double>& f = jet.frame;
+  Eigen::Vector3d d1 = eigen_of(f.x) * v.x() + eigen_of(f.y) * v.y() + eigen_of(f.n) * g.dot(v);
   d1 = (d1 - n * n.dot(d1)).normalized();
   r.k1[i] = eig.eigenvalues()[1];
   r.k2[i] = eig.eigenvalues()[0];
@@ -466,9 +475,7 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
   r.residual[i] = jet.residual;
   r.rays_used[i] = jet.points;
   r.rays_excluded[i] = 0;
-  const CurvatureOptions defaults;
-  r.point_class[i] = static_cast<std::uint8_t>(
-      classify(r.k1[i], r.k2[i], zero_tolerance, defaults.umbilic_tolerance));
+  r.point_class[i] = kernels::classify(r.k1[i], r.k2[i], zero_tolerance, default_umbilic_tolerance);
 }
 
 }  // namespace
@@ -512,7 +519,7 @@ CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& option
   const JetOptions o = for_mesh(mesh, options);
   const PositionsRef& V = mesh.V();
   CurvatureResult r = detail::unwritten_result(V.rows());
-  const double zero = CurvatureOptions{}.zero_tolerance / mesh.mean_edge_length();
+  const double zero = default_zero_tolerance / mesh.mean_edge_length();
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RowMatrixX3d start = max_normals(mesh, o.threads);
   for_each_jet(V, *one, start, o, [&](int i, const LocalJet& jet) {

@@ -10,25 +10,11 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <string_view>
 
 #include "focal/core/mesh.h"
+#include "focal/core/point_class.h"
 
 namespace focal {
-
-/// Classification of a vertex (or face) from its principal curvatures. The codes are stable:
-/// they are written to PLY files as a uchar property.
-enum class PointClass : std::uint8_t {
-  elliptic = 0,    ///< K > 0 and not umbilic
-  hyperbolic = 1,  ///< K < 0
-  parabolic = 2,   ///< exactly one principal curvature near zero
-  umbilic = 3,     ///< k1 ~ k2, not near zero (sphere-like)
-  flat = 4,        ///< both principal curvatures near zero
-  undefined = 5,   ///< no estimate: too few usable rays, singular fit or invalid input at the vertex
-};
-
-/// Lower-case name of a class (`elliptic`, ..., `undefined`).
-[[nodiscard]] std::string_view class_name(PointClass c);
 
 /// Per-vertex fields, #V rows each, row i for input vertex i. Vertices of class `undefined`
 /// have NaN in every numeric field (never zeros).

@@ -46,9 +46,9 @@ struct CurvatureOptions {
   /// A principal curvature counts as zero for the classification when |k| x (mean edge length)
   /// <= zero_tolerance: scale-free, so results do not depend on the units of the mesh. At the
   /// default a curvature radius over 1000 edge lengths is "flat" in that direction.
-  double zero_tolerance = 1e-3;
+  double zero_tolerance = default_zero_tolerance;  // 1e-3 (core/point_class.h)
   /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
-  double umbilic_tolerance = 1e-2;
+  double umbilic_tolerance = default_umbilic_tolerance;  // 1e-2
   /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
   /// PrepareOptions::threads.
   int threads = 0;
