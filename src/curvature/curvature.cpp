@@ -19,6 +19,7 @@
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
 #include "kernels/local_shape.h"
+#include "kernels/two_slit.h"
 #include "kernels/vec3.h"
 #include "mesh/prepared_detail.h"
 
@@ -144,11 +145,12 @@ struct alignas(sizeof(L)) RaySlot {
   L u, v, sigma, tau, weight;
 };
 
-/// Per-lane sums of the normal equations' terms over the slots: lhs (uu, uv, vv), rhs (us,
-/// vs + ut, vt), counts of rays made and of rays of positive weight (as -1 per ray).
+/// Per-lane sums of the normal equations (kernels/two_slit.h) over the slots, of the weights,
+/// and counts of rays made and of rays of positive weight (as -1 per ray).
 template <class L>
 struct alignas(sizeof(L)) SlotSums {
-  L uu{}, uv{}, vv{}, r0{}, r1{}, r2{}, weight{};
+  kernels::SlitSums<L> equations;
+  L weight{};
   MaskOf<L> used{}, positive{};
 };
 
@@ -221,12 +223,7 @@ template <class L>
   out.tau = made ? ray.tau : zero;
   out.weight = made ? weight : broadcast<L>(-0.0);
   const L w = out.weight;
-  sums.uu += w * out.u * out.u;
-  sums.uv += w * out.u * out.v;
-  sums.vv += w * out.v * out.v;
-  sums.r0 += w * (out.u * out.sigma);
-  sums.r1 += w * (out.v * out.sigma + out.u * out.tau);
-  sums.r2 += w * (out.v * out.tau);
+  kernels::add_ray(sums.equations, w, out.u, out.v, out.sigma, out.tau);
   sums.weight += w;
   sums.used += made;
   sums.positive += made & (w > 0.0);
@@ -265,7 +262,7 @@ template <class L>
   }
 }
 
-/// The closed-form fit of one group (closed_form_fit's equations, solved by cofactors).
+/// The closed-form fit of one group (kernels/two_slit.h), one vertex per lane.
 template <class L>
 [[gnu::always_inline]] inline void fit_group(const FitContext& c, std::int64_t first, int active,
                                              std::vector<RaySlot<L>>& slots, CurvatureResult& r) {
@@ -274,30 +271,16 @@ template <class L>
   if (slots.size() < static_cast<std::size_t>(g.slots)) slots.resize(g.slots);
   SlotSums<L> sums;
   for (int k = 0; k < g.slots; ++k) make_slot(c, g, k, slots[k], sums);
-  // lhs = [a b 0; b a+c b; 0 b c] with a = uu, b = uv, c = vv: its cofactors, determinant and
-  // the scale-free conditioning test of solve_well_conditioned.
-  const L a = sums.uu, b = sums.uv, cc = sums.vv, s = a + cc;
-  const L c00 = s * cc - b * b, c01 = -(b * cc), c02 = b * b;
-  const L c11 = a * cc, c12 = -(a * b), c22 = a * s - b * b;
-  const L det = a * c00 + b * c01;
-  const L scale = (a + s + cc) * (1.0 / 3.0);
-  const L inv_det = 1.0 / det;
-  const L w0 = (c00 * sums.r0 + c01 * sums.r1 + c02 * sums.r2) * inv_det;
-  const L w1 = (c01 * sums.r0 + c11 * sums.r1 + c12 * sums.r2) * inv_det;
-  const L w2 = (c02 * sums.r0 + c12 * sums.r1 + c22 * sums.r2) * inv_det;
+  const kernels::SlitSolution<L> w = kernels::solve_slits(sums.equations, detail::kMinRelativeDeterminant);
   const auto used = -sums.used;
-  const auto valid = g.ok & (-sums.positive >= 2) & (scale > 0.0) &
-                     (det > 1e-12 * scale * scale * scale) & kernels::is_finite(w0) &
-                     kernels::is_finite(w1) & kernels::is_finite(w2);
+  const auto valid = g.ok & (-sums.positive >= 2) & w.valid;
   // Both divisions by one reciprocal, for the divider's sake as in make_slot.
   const kernels::Principal<L> p =
-      kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w0, w1, w2);
+      kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w.a, w.b, w.c);
   L energy{};
   for (int k = 0; k < g.slots; ++k) {
     const RaySlot<L>& ray = slots[k];
-    const L ru = w0 * ray.u + w1 * ray.v - ray.sigma;
-    const L rv = w1 * ray.u + w2 * ray.v - ray.tau;
-    energy += ray.weight * (ru * ru + rv * rv);
+    energy += ray.weight * kernels::slit_misfit(w, ray.u, ray.v, ray.sigma, ray.tau);
   }
   const L weight_sum = c.options.weighting == RayWeighting::gaussian
                            ? sums.weight

@@ -135,7 +135,7 @@ SlitFit fit_two_slits_levenberg_marquardt(std::span<const NormalRay> rays,
                                           std::span<const double> weights,
                                           const LevenbergMarquardtOptions& options) {
   // Same well-posedness test as the closed form, so both solvers flag the same vertices.
-  Eigen::Vector3d unused;
+  kernels::SlitSolution<double> unused;
   if (!detail::solve_well_conditioned(detail::accumulate(rays, weights), unused)) {
     return detail::invalid_fit();
   }

@@ -4,9 +4,9 @@
 // estimate_curvature. No Eigen, no allocation: one thread runs fit_vertex for one vertex.
 //
 // The frame of Duff et al., the rays of paper eq. 3, the eigen-decomposition and the
-// classification are kernels/local_shape.h's, those of every estimator; the 3x3 normal equations
-// in W = [a b; b c] are those of curvature/two_slit_detail.h. All in an arithmetic type T (float
-// on the device, double to check the formula). Three changes keep
+// classification are kernels/local_shape.h's, the normal equations in W = [a b; b c], their
+// solve and the misfit kernels/two_slit.h's: those of every estimator. All in an arithmetic type
+// T (float on the device, double to check the formula). Three changes keep
 // float32 accurate to a few units of its rounding relative to the curvature, whatever the mesh
 // size, units or placement (docs/GPU.md):
 //  - Positions and normals arrive as float pairs hi + lo (lo = the rounding error of hi). A
@@ -16,8 +16,8 @@
 //    orthogonal to N, and x.D has float rounding relative to |D| ~ |k| h, where x.M computed from
 //    rounded M would carry an absolute 6e-8 (relative 6e-8 / (|k| h)).
 //  - Positions are scaled by a power of two near 1 / (mean edge length x rings), exactly, so that
-//    u, v are O(1) in every unit system, and the normal equations are divided by their trace/3
-//    before the solve, so that no determinant under- or overflows.
+//    u, v are O(1) in every unit system: the normal equations' sums are then O(rays) and their
+//    determinant O(rays^3), far inside float's range for any neighbourhood.
 
 #include <cmath>
 #include <cstdint>
@@ -25,6 +25,7 @@
 #include "focal/core/point_class.h"
 #include "kernels/host_device.h"
 #include "kernels/local_shape.h"
+#include "kernels/two_slit.h"
 #include "kernels/vec3.h"
 
 namespace focal::cuda {
@@ -111,52 +112,6 @@ FOCAL_HD inline T ray_weight(const VertexFitParams<T>& p, const Ray<T>& r) {
   return p.gaussian ? std::exp(-r.distance_squared * p.inverse_two_width_squared) : T(1);
 }
 
-/// Sums of the normal equations of min sum w |W x - g|^2 over w = (a, b, c). Their matrix is
-/// [[Suu, Suv, 0], [Suv, Suu + Svv, Suv], [0, Suv, Svv]] (rows (u, v, 0) -> sigma and
-/// (0, u, v) -> tau per ray), so three sums describe it.
-template <class T>
-struct NormalSums {
-  T uu = 0, uv = 0, vv = 0;
-  T r0 = 0, r1 = 0, r2 = 0;  // right-hand side
-  int rays = 0;              // rays of positive weight
-};
-
-template <class T>
-FOCAL_HD inline void accumulate(NormalSums<T>& s, const Ray<T>& r, T w) {
-  if (!(w > T(0))) return;  // as the CPU: a zero weight is no equation
-  s.uu += w * r.u * r.u;
-  s.uv += w * r.u * r.v;
-  s.vv += w * r.v * r.v;
-  s.r0 += w * r.u * r.sigma;
-  s.r1 += w * (r.v * r.sigma + r.u * r.tau);
-  s.r2 += w * r.v * r.tau;
-  ++s.rays;
-}
-
-/// Solves the normal equations when well conditioned, as two_slit_detail.h's
-/// solve_well_conditioned: det / (trace/3)^3 above the threshold. det factors exactly as
-/// (Suu + Svv)(Suu Svv - Suv^2); in units of trace/3 the entries are O(1).
-template <class T>
-FOCAL_HD inline bool solve(const NormalSums<T>& s, T min_relative_determinant, T w[3]) {
-  if (s.rays < 2) return false;
-  const T scale = T(2) * (s.uu + s.vv) / T(3);
-  if (!(scale > T(0))) return false;
-  const T inv = T(1) / scale;
-  const T a = s.uu * inv, b = s.uv * inv, c = s.vv * inv;
-  const T r0 = s.r0 * inv, r1 = s.r1 * inv, r2 = s.r2 * inv;
-  const T trace_ac = a + c;
-  const T det = trace_ac * (a * c - b * b);
-  if (!(det > min_relative_determinant)) return false;
-  // Adjugate of the symmetric [[a, b, 0], [b, a + c, b], [0, b, c]].
-  const T inv_det = T(1) / det;
-  const T c00 = trace_ac * c - b * b, c01 = -b * c, c02 = b * b;
-  const T c11 = a * c, c12 = -a * b, c22 = a * trace_ac - b * b;
-  w[0] = (c00 * r0 + c01 * r1 + c02 * r2) * inv_det;
-  w[1] = (c01 * r0 + c11 * r1 + c12 * r2) * inv_det;
-  w[2] = (c02 * r0 + c12 * r1 + c22 * r2) * inv_det;
-  return std::isfinite(w[0] + w[1] + w[2]);
-}
-
 template <class T>
 FOCAL_HD inline void store_undefined(const VertexFitOutput<T>& o, int i) {
   const T nan = static_cast<T>(NAN);  // numeric_limits is not callable in device code
@@ -169,17 +124,15 @@ FOCAL_HD inline void store_undefined(const VertexFitOutput<T>& o, int i) {
 /// neighbours, since expanding E through the normal equations cancels catastrophically (it is 0
 /// on a sphere). The rays are recomputed: cheaper on a GPU than keeping a ring in local memory.
 template <class T>
-FOCAL_HD inline void misfit(const VertexFitParams<T>& p, int i, const Frame<T>& f, const T w[3],
-                            T& energy, T& weight_sum) {
+FOCAL_HD inline void misfit(const VertexFitParams<T>& p, int i, const Frame<T>& f,
+                            const kernels::SlitSolution<T>& w, T& energy, T& weight_sum) {
   energy = weight_sum = T(0);
   const VertexRecord<T>& me = p.vertices[i];
   for (int k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
     Ray<T> r;
     if (!ray_of(f, me, p.vertices[p.indices[k]], r)) continue;
     const T wt = ray_weight(p, r);
-    const T eu = w[0] * r.u + w[1] * r.v - r.sigma;
-    const T ev = w[1] * r.u + w[2] * r.v - r.tau;
-    energy += wt * (eu * eu + ev * ev);
+    energy += wt * kernels::slit_misfit(w, r.u, r.v, r.sigma, r.tau);
     weight_sum += wt;
   }
 }
@@ -193,8 +146,8 @@ FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
   o.rays_used[i] = o.rays_excluded[i] = 0;
   if (!std::isfinite(n.x + n.y + n.z)) return store_undefined(o, i);
   const Frame<T> f = kernels::frame_of(n);
-  NormalSums<T> sums;
-  int used = 0, excluded = 0;
+  kernels::SlitSums<T> sums;
+  int used = 0, excluded = 0, weighted = 0;
   for (int k = p.offsets[i]; k < p.offsets[i + 1]; ++k) {
     Ray<T> r;
     if (!ray_of(f, me, p.vertices[p.indices[k]], r)) {
@@ -202,18 +155,21 @@ FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
       continue;
     }
     ++used;
-    accumulate(sums, r, ray_weight(p, r));
+    const T w = ray_weight(p, r);
+    if (!(w > T(0))) continue;  // as the CPU: a zero weight is no equation
+    kernels::add_ray(sums, w, r.u, r.v, r.sigma, r.tau);
+    ++weighted;
   }
   o.rays_used[i] = used;
   o.rays_excluded[i] = excluded;
-  T w[3];
-  if (!solve(sums, p.min_relative_determinant, w)) return store_undefined(o, i);
+  const kernels::SlitSolution<T> w = kernels::solve_slits(sums, p.min_relative_determinant);
+  if (weighted < 2 || !w.valid) return store_undefined(o, i);
   T energy, weight_sum;
   misfit(p, i, f, w, energy, weight_sum);
   // Both divisions by a reciprocal, as the CPU's lane kernel.
   const kernels::Principal<T> e =
       kernels::principal_axes<kernels::Quotient::reciprocal, kernels::Quotient::reciprocal>(
-          w[0], w[1], w[2]);
+          w.a, w.b, w.c);
   const T k1 = e.k1 * p.curvature_unit, k2 = e.k2 * p.curvature_unit;
   o.k1[i] = k1;
   o.k2[i] = k2;
