@@ -88,8 +88,8 @@ vertex noise moves positions by uniform vectors of up to 10% of the mean edge le
 exact normals ("file normals"); normal noise perturbs the normals by up to 5% and keeps the
 positions. "Max normals" ignores the file's normals and estimates them from the faces (Max 1999),
 so under normal noise it sees noise-free data. "focal default" is
-`estimate_curvature_recommended` (include/focal/recommended.h), with the file's normals or
-without normals. MDSB03 and CSM03 (the paper's baselines, `focal/baselines.h`) use positions only.
+`estimate_curvature_recommended` (include/focal/curvature/recommended.h), with the file's normals or
+without normals. MDSB03 and CSM03 (the paper's baselines, `focal/curvature/baselines.h`) use positions only.
 
 The peers measure the same vertices with the same metrics: `focal eval --export DIR` writes every
 case as the estimators see it (`<case>.ply` with the file normals) and its truth with the interior

@@ -1,12 +1,12 @@
 // The CUDA per-vertex fit (estimate_curvature_cuda) against the CPU estimator.
 //
-// (a) always: the kernel's FOCAL_HD math (src/cuda/vertex_fit_kernel.h) run on the CPU in float,
+// (a) always: the kernel's FOCAL_HD math (src/kernels/vertex_fit.h) run on the CPU in float,
 //     as the device runs it, and in double, against estimate_curvature (double);
 // (b) with a GPU: estimate_curvature_cuda against estimate_curvature (skipped without one);
 // (c) the error paths: DeviceError without backend or device, InvalidInput for bad input.
 //
 // Tolerances (docs/GPU.md). Float's unit roundoff is u = 6e-8. The device path computes the rays
-// to a few u relative to |k| h (hi/lo pairs, see vertex_fit_kernel.h); the 3x3 solve amplifies by
+// to a few u relative to |k| h (hi/lo pairs, see kernels/vertex_fit.h); the 3x3 solve amplifies by
 // the condition of the normal equations (< 100 on these meshes) and the eigen-decomposition's
 // absolute error is a few u x kappa, kappa = max(|k1|, |k2|) at the vertex. So:
 //  - |dk| <= 1e-5 kappa at every vertex (170 u; measured max 3.4e-6 on the regular sphere,

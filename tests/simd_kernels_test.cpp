@@ -1,4 +1,4 @@
-// The lane kernels of the closed-form fit and of the per-triangle solve (src/simd_lanes.h): the
+// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h): the
 // same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
 // (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).

@@ -1,5 +1,5 @@
 // The image-space estimator's kernels (paper section 5.1): one thread per pixel running the
-// per-pixel functions of src/image_space/pixel_kernel.h, the code of the CPU reference. The
+// per-pixel functions of src/kernels/pixel.h, the code of the CPU reference. The
 // public estimate_image_curvature_cuda (src/image_space/image_space.cpp) validates the input on
 // the host and calls image_curvature_on_device.
 #include <cuda_runtime.h>

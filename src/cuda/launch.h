@@ -3,7 +3,7 @@
 // files need neither: nvcc builds them as C++17 (src/CMakeLists.txt) while focal's public
 // headers use C++20, and Eigen in nvcc code is slow to compile and warns. The public functions
 // (estimate_image_curvature_cuda, triangle_curvature_cuda) validate their input on the host in
-// C++ and call these; src/cuda/ defines them, src/cpu_only/ throws DeviceError.
+// C++ and call these; the .cu files beside them define them, the *_cpu_only.cpp stand-ins throw DeviceError.
 
 #include <cstdint>
 #include <vector>
@@ -18,7 +18,7 @@ namespace focal::detail {
 void image_curvature_on_device(const image_kernel::ImageView& image, float discontinuity_ratio,
                                int window, const image_kernel::ImageFields& out, int device);
 
-/// A mesh packed for triangle_kernel.h: contiguous V, N (double) and F, classification
+/// A mesh packed for kernels/triangle.h: contiguous V, N (double) and F, classification
 /// thresholds in float.
 struct TriangleInput {
   std::vector<double> V, N;

@@ -1,4 +1,4 @@
-// Host side of the float per-triangle estimator (see triangle_fields.h).
+// Host side of the float per-triangle estimator (see cuda/triangle_fit.h).
 #include "cuda/triangle_fit.h"
 
 #include <string>

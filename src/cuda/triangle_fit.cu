@@ -1,7 +1,7 @@
 // The per-triangle characteristic equation's kernel: one thread per face running
-// triangle_kernel::triangle_face (src/image_space/triangle_kernel.h), the code that
+// triangle_kernel::triangle_face (src/kernels/triangle.h), the code that
 // detail::triangle_curvature_float runs on the CPU. The public triangle_curvature_cuda
-// (src/image_space/triangle_fields.cpp) validates and packs the mesh on the host and calls
+// (src/cuda/triangle_fit.cpp) validates and packs the mesh on the host and calls
 // triangle_faces_on_device.
 #include <cuda_runtime.h>
 

@@ -1,7 +1,7 @@
 #pragma once
 // Host side of the float per-triangle estimator, shared by triangle_curvature_cuda (defined in
-// triangle_fields.cpp, its kernel in src/cuda/triangle_fit.cu) and its CPU emulation: inputs
-// checked and packed for triangle_kernel.h, outputs unpacked into a TriangleCurvatureResult.
+// cuda/triangle_fit.cpp, its kernel in src/cuda/triangle_fit.cu) and its CPU emulation: inputs
+// checked and packed for kernels/triangle.h, outputs unpacked into a TriangleCurvatureResult.
 
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 // estimate_curvature_cuda: the per-vertex closed-form two-slit fit on a CUDA device, one thread
-// per vertex. The math is vertex_fit_kernel.h (shared with the CPU test); this file moves data
+// per vertex. The math is kernels/vertex_fit.h (shared with the CPU test); this file moves data
 // and launches.
 //
 // One thread per vertex rather than a warp per vertex: a 1-ring has about 6 neighbours and the

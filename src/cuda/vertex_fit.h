@@ -86,7 +86,7 @@ inline double length_unit(double mean_edge_length, int rings) {
   return std::ldexp(1.0, e);
 }
 
-/// Validates and builds the device's inputs (see vertex_fit_kernel.h for the hi/lo pairs).
+/// Validates and builds the device's inputs (see kernels/vertex_fit.h for the hi/lo pairs).
 template <class T>
 PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N,
                                         const CurvatureOptions& options) {

@@ -1,4 +1,4 @@
-// The image-space estimator: the CPU reference (the per-pixel functions of pixel_kernel.h in a
+// The image-space estimator: the CPU reference (the per-pixel functions of kernels/pixel.h in a
 // parallel loop over pixels) and the CUDA entry point's host side (validation, allocation; the
 // kernels are in src/cuda/image_space.cu).
 #include "focal/image_space/image_space.h"

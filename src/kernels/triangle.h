@@ -1,6 +1,6 @@
 #pragma once
 // The per-face body of the CUDA per-triangle estimator (src/cuda/triangle_fit.cu) in plain data,
-// so that the CPU runs exactly the same code (triangle_fields.cpp: triangle_curvature_float) and
+// so that the CPU runs exactly the same code (cuda/triangle_fit.cpp: triangle_curvature_float) and
 // tests compare it with triangle_curvature in double.
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Jet normals and jet curvature (normal_estimation.h): exactness where the polynomial model is
+// Jet normals and jet curvature (normals/jets.h): exactness where the polynomial model is
 // exact, measured convergence orders on irregular meshes, noise estimate, determinism, errors.
 #include "focal/normals/jets.h"
 
