@@ -3,8 +3,13 @@
 PRESET ?= release
 BUILD_DIR := build/$(PRESET)
 JOBS ?= $(shell nproc)
+# The Python environment of the bindings' build and tests (python/): nanobind, NumPy and pytest
+# from PyPI in a venv, so that the extension is built in the same CMake build as the library (one
+# library build) and the `python` ctest runs pytest on it. Users install with `pip install ./python`.
+VENV := build/venv
+PYTHON := $(VENV)/bin/python
 
-.PHONY: all deps deps-demo configure build test demo bench install clean format
+.PHONY: all deps deps-demo venv configure build test demo bench install clean format
 
 all: build
 
@@ -14,8 +19,15 @@ deps:
 deps-demo:
 	@bash scripts/install-deps.sh demo
 
-configure: deps
-	@cmake --preset $(PRESET) >/dev/null
+venv: $(VENV)/.ready
+
+$(VENV)/.ready: | deps
+	@python3 -m venv $(VENV)
+	@$(PYTHON) -m pip install -q --disable-pip-version-check nanobind numpy pytest
+	@touch $@
+
+configure: deps venv
+	@cmake --preset $(PRESET) -DFOCAL_BUILD_PYTHON=ON -DPython_EXECUTABLE=$(CURDIR)/$(PYTHON) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)

@@ -6,10 +6,13 @@
 #   scripts/install-deps.sh fuzz     also clang with libFuzzer and its OpenMP (scripts/fuzz.sh)
 set -euo pipefail
 
+# python3-venv and python3-dev: the venv of the Python bindings' build and tests (`make test`
+# creates build/venv and installs nanobind, NumPy and pytest into it from PyPI) and the headers
+# the extension compiles against.
 # libegl-dev, libopengl-dev and Mesa (libegl-mesa0, libgl1-mesa-dri): headless OpenGL for
 # rasterised G-buffers and `focal render`; libpng-dev writes its pictures.
 packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev
-          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libpng-dev)
+          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libpng-dev python3-venv python3-dev)
 if [[ "${1:-}" == "demo" ]]; then
   packages+=(libcgal-demo)
 elif [[ "${1:-}" == "bench" ]]; then

@@ -1,0 +1,372 @@
+"""Tests of the focal Python package: values against analytic truth, the same numbers as the
+`focal` command line, no copies of results, every error path, determinism over threads, the GIL
+released, file round trips.
+
+Run by `make test` (the `python` ctest) on the build tree's package. `import focal` is not
+guarded: if the extension cannot be imported, collection fails and so does the run.
+"""
+
+import csv
+import inspect
+import math
+import os
+import pathlib
+import re
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import focal
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return focal.generate_surface("sphere", 2000, a=2.0)
+
+
+@pytest.fixture(scope="module")
+def torus():
+    return focal.generate_surface("torus", 3000, triangulation="irregular", seed=3)
+
+
+# --- analytic truth -------------------------------------------------------------------------
+
+
+def test_sphere_exact_normals_paper_closed_form_is_exact(sphere):
+    # Normal rays of a sphere with exact normals all pass through its centre: the two-slit fit
+    # is exact, so only rounding separates k from 1/r (r = 2).
+    c = focal.curvature(sphere.V, sphere.F, sphere.N, estimator="paper")
+    assert not c.undefined.any()
+    for k in (c.k1, c.k2, c.H):
+        np.testing.assert_allclose(k, 0.5, rtol=1e-9)
+    np.testing.assert_allclose(c.K, 0.25, rtol=1e-9)
+    assert (c.point_class == focal.PointClass.umbilic).all()
+    # d1, d2 unit, tangent and (d1, d2, N) right-handed.
+    np.testing.assert_allclose(np.linalg.norm(c.d1, axis=1), 1, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", c.d1, sphere.N), 0, atol=1e-9)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", np.cross(c.d1, c.d2), sphere.N), 1,
+                               atol=1e-9)
+
+
+def test_sphere_recommended_estimator_is_exact(sphere):
+    # Max's normals are exact on a sphere and the recommended estimator keeps an exact fit.
+    c = focal.curvature(sphere.V, sphere.F)
+    np.testing.assert_allclose(c.k1, 0.5, rtol=1e-9)
+    np.testing.assert_allclose(c.k2, 0.5, rtol=1e-9)
+    assert c.plan["rings"] == 1
+
+
+def test_inward_normals_flip_the_sign(sphere):
+    c = focal.curvature(sphere.V, sphere.F, -sphere.N, estimator="paper")
+    np.testing.assert_allclose(c.k1, -0.5, rtol=1e-9)
+    np.testing.assert_allclose(c.H, -0.5, rtol=1e-9)
+
+
+def test_torus_against_truth(torus):
+    # Irregular torus, 3000 vertices: mean edge length h ~ 0.1; the 1-ring fit's error is O(h)
+    # relative to the largest curvature 1/b = 2.5 (measured below 0.05 x 2.5 on this mesh).
+    c = focal.curvature(torus.V, torus.F, torus.N, estimator="paper")
+    ok = ~c.undefined
+    assert ok.mean() > 0.99
+    assert np.median(np.abs(c.H[ok] - (torus.k1 + torus.k2)[ok] / 2)) < 0.05 * 2.5
+    assert np.median(np.abs(c.k1[ok] - torus.k1[ok])) < 0.05 * 2.5
+
+
+def test_vertex_normals_max_exact_on_sphere(sphere):
+    N = focal.vertex_normals(sphere.V, sphere.F)
+    assert N.shape == sphere.V.shape and N.dtype == np.float64
+    np.testing.assert_allclose(N, sphere.N, atol=1e-12)
+    # Area weights are exact only to first order in the edge length h (h / r ~ 0.07 here).
+    Na = focal.vertex_normals(sphere.V, sphere.F, "area", threads=1)
+    assert 1e-6 < np.abs(Na - sphere.N).max() < 0.05
+
+
+def test_focal_meshes_of_sphere_meet_at_the_centre(sphere):
+    fm = focal.focal_meshes(sphere.V, sphere.F, sphere.N, estimator="paper")
+    for g in (fm.gamma1, fm.gamma2):
+        np.testing.assert_allclose(g.V, 0, atol=1e-9)
+        assert (g.flag == focal.FocalPointFlag.finite).all()
+        assert len(g.F) == len(sphere.F) and same_bits(g.kept_faces, np.arange(len(sphere.F),
+                                                                              dtype=np.int32))
+
+
+def test_focal_meshes_drop_faces_at_infinity():
+    cyl = focal.generate_surface("cylinder", 1000)
+    fm = focal.focal_meshes(cyl.V, cyl.F, cyl.N, estimator="paper", drop_faces_at_infinity=True,
+                            max_distance=50.0)
+    assert (fm.gamma2.flag == focal.FocalPointFlag.infinite).mean() > 0.5
+    assert len(fm.gamma2.F) < len(cyl.F)
+    assert np.linalg.norm(fm.gamma2.V - cyl.V, axis=1).max() <= 50.0 + 1e-9
+
+
+def test_check_mesh(sphere):
+    clean = focal.check_mesh(sphere.V, sphere.F, sphere.N)
+    assert not clean.has_problems and clean.summary == ""
+    assert clean.component_count == 1 and clean.boundary_edge_count == 0
+    F = np.vstack([sphere.F, sphere.F[:1]])
+    found = focal.check_mesh(sphere.V, F)
+    assert found.has_problems and found.duplicate_face_count == 1
+    assert "duplicate face" in found.summary
+
+
+def test_undefined_vertex_is_nan():
+    s = focal.generate_surface("sphere", 500)
+    V = np.vstack([s.V, [[5.0, 5.0, 5.0]]])  # in no face
+    c = focal.curvature(V, s.F, estimator="paper")
+    assert c.undefined[-1] and not c.undefined[:-1].any()
+    assert math.isnan(c.k1[-1]) and np.isnan(c.d1[-1]).all()
+
+
+def test_to_dict(sphere):
+    c = focal.curvature(sphere.V, sphere.F, sphere.N, estimator="paper")
+    d = c.to_dict()
+    assert set(d) >= {"k1", "k2", "H", "K", "d1", "d2", "residual", "point_class"}
+    assert d["k1"] is c.k1
+    assert c.k1.shape == (len(sphere.V),) and c.d1.shape == (len(sphere.V), 3)
+    assert c.point_class.dtype == np.uint8
+
+
+# --- the same numbers as the command line ---------------------------------------------------
+
+
+def cli():
+    path = os.environ.get("FOCAL_CLI")
+    if not path:
+        candidate = REPO / "build" / "release" / "cli" / "focal"
+        if not candidate.exists():
+            pytest.skip("no focal command (set FOCAL_CLI; `make test` does)")
+        path = str(candidate)
+    assert os.access(path, os.X_OK), f"FOCAL_CLI={path} is not executable"
+    return path
+
+
+def read_cli_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    cols = {name: [r[i] for r in body] for i, name in enumerate(header)}
+    out = {n: np.array([float(x) for x in cols[n]]) for n in header if n != "class"}
+    names = [c.name for c in focal.PointClass]
+    out["class"] = np.array([names.index(x) for x in cols["class"]], dtype=np.uint8)
+    return out
+
+
+@pytest.mark.parametrize("estimator, flags, with_normals", [
+    ("recommended", [], True),
+    ("recommended", [], False),
+    ("paper", ["--paper"], True),
+    ("paper", ["--paper"], False),
+])
+def test_identical_to_cli(tmp_path, estimator, flags, with_normals):
+    s = focal.generate_surface("ellipsoid", 1500, triangulation="irregular", seed=2)
+    mesh_path = tmp_path / "ellipsoid.ply"
+    focal.write_mesh(mesh_path, s.V, s.F, s.N if with_normals else None)
+    out = tmp_path / "k.csv"
+    subprocess.run([cli(), "curvature", str(mesh_path), "-o", str(out), *flags], check=True,
+                   capture_output=True)
+    expected = read_cli_csv(out)
+    m = focal.read_mesh(mesh_path)
+    assert (m.N is not None) == with_normals
+    c = focal.curvature(m.V, m.F, m.N, estimator=estimator)
+    for name in ("k1", "k2", "H", "K", "residual"):
+        assert same_bits(getattr(c, name), expected[name]), name
+    for i, axis in enumerate("xyz"):
+        assert same_bits(c.d1[:, i].copy(), expected["d1" + axis])
+        assert same_bits(c.d2[:, i].copy(), expected["d2" + axis])
+    assert same_bits(c.point_class, expected["class"])
+
+
+# --- inputs: dtypes, layouts, one conversion ------------------------------------------------
+
+
+def test_input_layouts_give_the_same_bits(torus):
+    ref = focal.curvature(torus.V, torus.F, torus.N)
+    variants = [
+        (np.asfortranarray(torus.V), torus.F.astype(np.int64), torus.N),
+        (torus.V.tolist(), torus.F.tolist(), torus.N.tolist()),
+        (torus.V, np.asfortranarray(torus.F.astype(np.uint32)), np.asfortranarray(torus.N)),
+    ]
+    for V, F, N in variants:
+        c = focal.curvature(V, F, N)
+        assert same_bits(c.k1, ref.k1) and same_bits(c.d2, ref.d2)
+
+
+def test_float32_input_is_the_float32_values(sphere):
+    V32 = sphere.V.astype(np.float32)
+    a = focal.curvature(V32, sphere.F, estimator="paper")
+    b = focal.curvature(V32.astype(np.float64), sphere.F, estimator="paper")
+    assert same_bits(a.k1, b.k1)
+
+
+def test_inputs_in_the_library_layout_are_not_copied(sphere):
+    assert focal._as_rows(sphere.V, "V", np.float64) is sphere.V
+    assert focal._as_rows(sphere.F, "F", np.int32) is sphere.F
+    converted = focal._as_rows(np.asfortranarray(sphere.V, dtype=np.float32), "V", np.float64)
+    assert converted.flags.c_contiguous and converted.dtype == np.float64
+
+
+def test_results_own_the_library_buffers(sphere):
+    c = focal.curvature(sphere.V, sphere.F, sphere.N, estimator="paper")
+    for name, a in c.to_dict().items():
+        # A view on the C++ buffer: NumPy did not allocate (copy) it, and it is not a view of
+        # another NumPy array.
+        assert not a.flags.owndata, name
+        assert not isinstance(a.base, np.ndarray), name
+        assert a.flags.c_contiguous and a.flags.writeable, name
+    assert not np.shares_memory(c.k1, c.k2)
+    # The buffers stay valid after the result object is gone.
+    k1 = c.k1
+    del c
+    np.testing.assert_allclose(k1, 0.5, rtol=1e-9)
+
+
+# --- determinism and the GIL ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("estimator", ["recommended", "paper"])
+def test_threads_do_not_change_results(torus, estimator):
+    a = focal.curvature(torus.V, torus.F, torus.N, estimator=estimator, threads=1)
+    b = focal.curvature(torus.V, torus.F, torus.N, estimator=estimator, threads=2)
+    for name, x in a.to_dict().items():
+        assert same_bits(x, getattr(b, name)), name
+
+
+def test_gil_is_released():
+    # Two Python threads start the same estimate together (a barrier). If the GIL were held
+    # during the computation, the second could not even take its start time before the first
+    # returned; released, both computations overlap.
+    s = focal.generate_surface("torus", 40000)
+    barrier = threading.Barrier(2)
+    spans = [None, None]
+
+    def work(i):
+        barrier.wait()
+        t0 = time.perf_counter()
+        focal.curvature(s.V, s.F, s.N, estimator="paper", rings=2, threads=1)
+        spans[i] = (t0, time.perf_counter())
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert max(s[0] for s in spans) < min(s[1] for s in spans), spans
+
+
+# --- files ----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("ext", [".ply", ".obj", ".off"])
+def test_write_read_round_trip(tmp_path, torus, ext):
+    path = tmp_path / ("torus" + ext)
+    focal.write_mesh(path, torus.V, torus.F, torus.N)
+    m = focal.read_mesh(str(path))
+    assert same_bits(m.V, torus.V) and same_bits(m.F, torus.F) and same_bits(m.N, torus.N)
+    focal.write_mesh(path, torus.V, torus.F)
+    assert focal.read_mesh(path).N is None
+
+
+# --- errors ---------------------------------------------------------------------------------
+
+
+def test_error_hierarchy():
+    assert issubclass(focal.InvalidInputError, ValueError)
+    assert issubclass(focal.FocalIOError, OSError)
+    assert issubclass(focal.DeviceError, RuntimeError)
+    for e in (focal.InvalidInputError, focal.FocalIOError, focal.DeviceError):
+        assert issubclass(e, focal.FocalError)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda s: focal.curvature(s.V[:, :2], s.F), r"V must have shape \(n, 3\), got shape \(\d+, 2\)"),
+    (lambda s: focal.curvature(s.V.ravel(), s.F), r"V must have shape \(n, 3\)"),
+    (lambda s: focal.curvature(s.V, s.F[:, :2]), r"F must have shape \(n, 3\)"),
+    (lambda s: focal.curvature(s.V, s.F, s.N[:-1]), r"N must have shape \(\d+, 3\) like V"),
+    (lambda s: focal.curvature(s.V, s.F.astype(float)), r"F must hold integer vertex indices"),
+    (lambda s: focal.curvature(s.V.astype(str), s.F), r"V must hold numbers"),
+    (lambda s: focal.curvature([[0, 0], [1]], s.F), r"V"),
+    (lambda s: focal.curvature(s.V, s.F.astype(np.int64) + 2**31), r"F holds vertex index"),
+    (lambda s: focal.curvature(s.V, s.F.astype(np.int64) - 1), r"F holds vertex index -1"),
+    (lambda s: focal.curvature(s.V, s.F - 1), r"face 0 refers to vertex -1"),
+    (lambda s: focal.curvature(s.V[:10], s.F), r"refers to vertex 10, but there are 10 vertices"),
+    (lambda s: focal.curvature(s.V, s.F, estimator="fast"), r"estimator: unknown value 'fast'"),
+    (lambda s: focal.curvature(s.V, s.F, rings=2), r"rings: option\(s\) of estimator='paper'"),
+    (lambda s: focal.curvature(s.V, s.F, estimator="paper", file_agreement=3.0),
+     r"file_agreement: option\(s\) of estimator='recommended'"),
+    (lambda s: focal.curvature(s.V, s.F, normals="file"), r"normal"),
+    (lambda s: focal.curvature(s.V, s.F, normals="max"), r"recommended"),
+    (lambda s: focal.curvature(s.V, s.F, normals="jets"), r"normals: unknown value 'jets'"),
+    (lambda s: focal.curvature(s.V, s.F, estimator="paper", rings=0), r"ring"),
+    (lambda s: focal.curvature(s.V, s.F, estimator="paper", method="edge"), r"method"),
+    (lambda s: focal.curvature(s.V, s.F, threads=-1), r"threads must be None or >= 0"),
+    (lambda s: focal.vertex_normals(s.V, s.F, "cotan"), r"weighting: unknown value 'cotan'"),
+    (lambda s: focal.check_mesh(s.V, s.F[:, ::-1][:, :2]), r"F must have shape"),
+    (lambda s: focal.focal_meshes(s.V, s.F, max_distance=-1.0), r"max_distance"),
+    (lambda s: focal.generate_surface("klein-bottle"), r"klein-bottle"),
+    (lambda s: focal.generate_surface("sphere", 3), r"target_vertices|vertices"),
+    (lambda s: focal.write_mesh("x.ply", s.V, s.F[:, :1]), r"F must have shape"),
+])
+def test_invalid_input(sphere, call, message):
+    with pytest.raises(focal.InvalidInputError, match=message):
+        call(sphere)
+
+
+def test_unknown_keyword_is_a_type_error(sphere):
+    with pytest.raises(TypeError):
+        focal.curvature(sphere.V, sphere.F, ringz=2)
+    with pytest.raises(TypeError):
+        focal.focal_meshes(sphere.V, sphere.F, ringz=2)
+
+
+def test_io_errors(tmp_path, sphere):
+    with pytest.raises(focal.FocalIOError, match="missing.ply") as e:
+        focal.read_mesh(tmp_path / "missing.ply")
+    assert isinstance(e.value, OSError)
+    bad = tmp_path / "bad.off"
+    bad.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
+    with pytest.raises(focal.FocalIOError, match="bad.off"):
+        focal.read_mesh(bad)
+    with pytest.raises(focal.FocalIOError, match="txt"):
+        focal.read_mesh(tmp_path / "mesh.txt")
+    with pytest.raises(focal.FocalIOError):
+        focal.write_mesh(tmp_path / "mesh.stl", sphere.V, sphere.F)
+    with pytest.raises(focal.FocalIOError):
+        focal.write_mesh(tmp_path / "no-such-dir" / "mesh.ply", sphere.V, sphere.F)
+
+
+# --- the package ----------------------------------------------------------------------------
+
+
+def test_defaults_are_the_librarys():
+    lib = focal._ext.default_options()
+    sig = inspect.signature(focal.curvature).parameters
+    for name in ("rings", "gaussian_width", "lm_initial_angles", "lm_max_iterations",
+                 "lm_tolerance", "zero_tolerance", "umbilic_tolerance", "noise_for_two_rings",
+                 "noise_for_three_rings", "file_agreement", "outlier_disagreement"):
+        assert sig[name].default == lib[name], name
+    assert lib["recommended_zero_tolerance"] == lib["zero_tolerance"]
+    assert lib["recommended_umbilic_tolerance"] == lib["umbilic_tolerance"]
+    fsig = inspect.signature(focal.focal_meshes).parameters
+    assert fsig["max_distance"].default == lib["max_distance"]
+    assert fsig["drop_faces_at_infinity"].default == lib["drop_faces_at_infinity"]
+
+
+def test_version_is_the_cmake_project_version():
+    text = (REPO / "CMakeLists.txt").read_text()
+    assert focal.__version__ == re.search(r"project\(focal\s+VERSION\s+([0-9.]+)", text).group(1)
+
+
+def test_point_class_codes():
+    assert [c.name for c in focal.PointClass] == [
+        "elliptic", "hyperbolic", "parabolic", "umbilic", "flat", "undefined"]
+    assert focal.PointClass.undefined == 5
