@@ -39,7 +39,8 @@ demo: deps-demo build
 	@bash scripts/demo.sh $(BUILD_DIR)/cli/focal
 
 # Benchmarks (bench/, docs/PERFORMANCE.md): the stages with Google Benchmark, then whole runs
-# of the focal command from 10K to 10M vertices, and the peers. About 15 minutes on 2 cores.
+# of the focal command from 10K to 10M vertices, and the peers, then 1 vs 2 threads on a quiet
+# and a loaded machine (bench/threads_under_load.sh, issue 20). About 20 minutes on 2 cores.
 bench:
 	@bash scripts/install-deps.sh bench
 	@cmake --preset bench >/dev/null
@@ -47,6 +48,7 @@ bench:
 	@build/bench/bench/focal_kernels_bench --benchmark_repetitions=3 \
 	  --benchmark_report_aggregates_only=true --benchmark_out=build/bench/kernels.json
 	@bash bench/run_bench.sh build/bench | tee build/bench/whole-runs.md
+	@bash bench/threads_under_load.sh build/bench | tee build/bench/threads-under-load.md
 
 install: build
 	@cmake --install $(BUILD_DIR) --prefix $(or $(PREFIX),/usr/local)

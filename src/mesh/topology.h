@@ -10,8 +10,6 @@
 // follows a counter-clockwise; a face with a repeated index traverses it both ways, i.e. has no
 // direction along it.
 
-#include <omp.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
@@ -150,14 +148,13 @@ inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F, 
   const auto chunk_begin = [&](std::int64_t k) { return k * F.rows() / chunks; };
   // cursor[k][v]: first counts of chunk k's faces at v, then where chunk k writes its next face.
   std::vector<std::vector<int>> cursor(static_cast<std::size_t>(chunks));
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int k = 0; k < chunks; ++k) {
+  parallel_chunks(chunks, threads, [&](std::int64_t k) {
     auto& count = cursor[static_cast<std::size_t>(k)];
     count.assign(n, 0);
     for (auto f = chunk_begin(k); f < chunk_begin(k + 1); ++f) {
       for_each_distinct_corner(F, f, [&](int v) { ++count[static_cast<std::size_t>(v)]; });
     }
-  }
+  });
   VertexFaces inc;
   inc.offsets.resize(n + 1);
   int total = 0;
@@ -167,8 +164,7 @@ inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F, 
   }
   inc.offsets[n] = total;
   inc.faces.resize(static_cast<std::size_t>(total));
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int k = 0; k < chunks; ++k) {
+  parallel_chunks(chunks, threads, [&](std::int64_t k) {
     auto& next = cursor[static_cast<std::size_t>(k)];
     for (auto f = chunk_begin(k); f < chunk_begin(k + 1); ++f) {
       for_each_distinct_corner(F, f, [&](int v) {
@@ -176,7 +172,7 @@ inline VertexFaces vertex_face_incidence(std::int64_t vertex_count, FacesRef F, 
             static_cast<int>(f);
       });
     }
-  }
+  });
   return inc;
 }
 
@@ -260,13 +256,14 @@ inline bool is_consistent_interior_edge(const EdgeSide* first, const EdgeSide* l
   return last - first == 2 && first[0].direction != 0 && first[0].direction == -first[1].direction;
 }
 
-/// One scratch object per thread of detail::parallel_for(n, threads, ...) (or _blocks): both size
-/// the team with thread_count(threads), so omp_get_thread_num() indexes a slot of its own.
+/// One scratch object per thread of detail::parallel_for(n, threads, ...) (or _blocks): a loop
+/// on `threads` threads numbers them worker_slot() in [0, thread_count(threads)), so each
+/// indexes a slot of its own.
 template <class T>
 class PerThread {
  public:
   explicit PerThread(int threads) : slots_(static_cast<std::size_t>(thread_count(threads))) {}
-  T& local() { return slots_[static_cast<std::size_t>(omp_get_thread_num())]; }
+  T& local() { return slots_[static_cast<std::size_t>(worker_slot())]; }
 
  private:
   std::vector<T> slots_;
