@@ -6,8 +6,8 @@
 #include "commands.h"
 #include "estimator_flags.h"
 #include "focal/core/error.h"
-#include "focal/io/fields_io.h"
 #include "focal/curvature/focal_mesh.h"
+#include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
 #include "input_check.h"
 #include "paths.h"
@@ -58,15 +58,8 @@ void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   }
   Stage stage(log, "write");
   const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads};
-  write_focal_mesh_ply(f.prefix + ".focal1.ply", meshes.gamma1, o);
-  try {
-    write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);
-  } catch (...) {
-    // A failed run leaves no output behind, not one focal mesh without the other.
-    std::error_code ignored;
-    std::filesystem::remove(f.prefix + ".focal1.ply", ignored);
-    throw;
-  }
+  // All or nothing: a failed run leaves neither new focal mesh, and existing files as they were.
+  write_focal_meshes_ply(f.prefix + ".focal1.ply", f.prefix + ".focal2.ply", meshes, o);
   std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),
               static_cast<long long>(meshes.gamma1.mesh.F.rows()), f.prefix.c_str(),
               static_cast<long long>(meshes.gamma2.mesh.F.rows()));

@@ -113,7 +113,7 @@ TEST(Estimate, MeshNormalsAreFilledAndNormalised) {
     }
   }
   // Inward normals are reported, and used as they are.
-  const Mesh inward{m.V, m.F, -torus().N, {}};
+  const Mesh inward{m.V, m.F, -torus().N, {}, {}};
   EXPECT_TRUE(prepare_normals(PreparedMesh(inward), paper()).report.normals_against_faces);
 }
 

@@ -1,6 +1,6 @@
-// STL reading, ascii and binary. STL stores triangles without shared vertices; each facet's
-// corners become three new vertices in file order, so the vertex order is the file's and nothing
-// is merged (welding would be a separate, explicit step). Facet normals are not vertex normals
+// STL reading, ascii and binary. STL stores triangles without shared vertices; the parsers return
+// each facet's corners as new vertices in file order, and read_mesh then welds them
+// (io/weld.cpp, ReadOptions). Facet normals are not vertex normals
 // (and are often zero), so Mesh::N stays empty.
 
 #include <algorithm>
