@@ -19,6 +19,7 @@ struct CurvatureFlags {
   std::string input;
   std::string output;
   bool ascii = false;
+  bool force = false;
   EstimatorFlags estimator;
 };
 
@@ -26,6 +27,7 @@ struct FocalMeshFlags {
   std::string input;
   std::string prefix;
   bool ascii = false;
+  bool force = false;
   EstimatorFlags estimator;
   FocalMeshOptions focal;
 };
@@ -86,7 +88,11 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
-  cmd->parse_complete_callback([f] { require_extension("-o", f->output, {".csv", ".ply"}); });
+  cmd->add_flag("--force", f->force, "replace a read-only output file");
+  cmd->parse_complete_callback([f] {
+    require_extension("-o", f->output, {".csv", ".ply"});
+    check_output("-o", f->output, f->input, f->force);
+  });
   cmd->callback([f, &log] { run_curvature(*f, log); });
 }
 
@@ -106,6 +112,11 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
   f->estimator.add_to(*cmd);
   cmd->footer(
       "Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");
+  cmd->add_flag("--force", f->force, "replace read-only output files");
+  cmd->parse_complete_callback([f] {
+    check_output("-o", f->prefix + ".focal1.ply", f->input, f->force);
+    check_output("-o", f->prefix + ".focal2.ply", f->input, f->force);
+  });
   cmd->callback([f, &log] { run_focal_mesh(*f, log); });
 }
 

@@ -12,8 +12,8 @@ focal::Mesh parse_and_weld(const std::filesystem::path& path, std::string_view d
       data.empty() ? 0.0 : static_cast<double>(static_cast<unsigned char>(data[0]) % 4) * 0.25;
   focal::io_detail::weld_corners(mesh, tolerance, true);
   if (mesh.corner_vertex.size() != corners || mesh.V.rows() > corners ||
-      (corners > 0 && (mesh.corner_vertex.minCoeff() < 0 ||
-                       mesh.corner_vertex.maxCoeff() >= mesh.V.rows()))) {
+      (corners > 0 &&
+       (mesh.corner_vertex.minCoeff() < 0 || mesh.corner_vertex.maxCoeff() >= mesh.V.rows()))) {
     std::abort();
   }
   return mesh;

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <bit>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -916,6 +918,18 @@ TEST_F(MeshIo, StlWeldingClosesASphere) {
   EXPECT_EQ(m.corner_vertex.size(), 3 * static_cast<Eigen::Index>(facets.size()));
 }
 
+TEST_F(MeshIo, StlAsciiVariantsAreNotTakenForBinary) {
+  // Upper-case keywords, a UTF-8 byte order mark, a comment line before `solid`: ascii, welded.
+  std::string upper = kAsciiStl;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  for (const std::string& text :
+       {upper, "\xEF\xBB\xBF" + std::string(kAsciiStl), "# exported\n" + std::string(kAsciiStl)}) {
+    const Mesh m = focal::read_mesh(write("v.stl", text));
+    expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.05}}));
+  }
+}
+
 TEST_F(MeshIo, StlErrors) {
   std::string truncated = binary_stl("solid x", {{0, 0, 0, 1, 0, 0, 0, 1, 0}}).data;
   truncated[80] = 3;  // claims 3 facets, holds 1
@@ -966,6 +980,18 @@ TEST_F(MeshIo, FocalMeshPairIsWrittenAllOrNothing) {
   EXPECT_EQ(focal::read_mesh(file("fm.focal1.ply")).V.rows(), meshes.gamma1.mesh.V.rows());
   EXPECT_EQ(focal::read_mesh(file("fm.focal2.ply")).V.rows(), meshes.gamma2.mesh.V.rows());
   EXPECT_EQ(folder_entries(), (std::vector<std::string>{"fm.focal1.ply", "fm.focal2.ply"}));
+}
+
+TEST_F(MeshIo, WritersWriteThroughALinkAndRefuseADanglingOne) {
+  write("target.obj", "old\n");
+  fs::create_symlink("target.obj", file("link.obj"));
+  focal::write_obj(file("link.obj"), sample_mesh(false));
+  EXPECT_TRUE(fs::is_symlink(file("link.obj")));
+  EXPECT_EQ(focal::read_mesh(file("target.obj")).V.rows(), sample_mesh(false).V.rows());
+  fs::create_symlink("nowhere.obj", file("dangling.obj"));
+  expect_error<focal::IoError>([&] { focal::write_obj(file("dangling.obj"), sample_mesh(false)); },
+                               {"dangling.obj", "link to a missing"});
+  EXPECT_FALSE(fs::exists(file("nowhere.obj")));
 }
 
 TEST_F(MeshIo, WriteIntoMissingFolderFailsAndCreatesNothing) {

@@ -44,6 +44,13 @@ std::FILE* open_temporary(const std::filesystem::path& path, std::filesystem::pa
 
 AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
   if (target_.filename().empty()) fail(target_, "is not a file name");
+  // A link is written through: the file it points to is replaced, the link stays a link (renaming
+  // over the link itself would silently turn it into a plain file).
+  std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(target_, ec))) {
+    target_ = std::filesystem::canonical(target, ec);
+    if (ec) fail(target, "is a symbolic link to a missing file or folder; not written");
+  }
   file_ = open_temporary(target_, temporary_);
 }
 

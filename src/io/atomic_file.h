@@ -6,6 +6,9 @@
 /// and leaves an existing target as it was. Used by every writer: the mesh and table writers of
 /// io/ and write_png (render/png_io.cpp).
 ///
+/// A target that is a symbolic link is written through: the file the link points to is replaced
+/// (the temporary file goes beside it) and the link is kept; a link to nothing is an IoError.
+///
 /// The temporary file is `.<name>.tmp-<16 hex digits>` in the target's folder (hidden, so that a
 /// leftover after a crash does not look like output; the same folder, so that the rename is
 /// atomic), created exclusively so that no other writer's file is reused. No fsync: the rename

@@ -690,5 +690,30 @@ check "focal-mesh whose 2nd file fails: exit 2, the existing 1st file untouched"
   bash -c '[[ $1 -eq 2 && $(cat fm.focal1.ply) == old ]]' _ "$rc"
 check "focal-mesh: no temporary or backup files left behind" bash -c '! ls -A | grep -q "\.tmp-"'
 
+# Output paths (issue 13 item 6): never the input, a read-only file only with --force, a link
+# written through to its file.
+cp s.ply in6.ply
+expect_error "curvature -o the input file: exit 1" 1 "is the input file" in6-x.csv curvature in6.ply -o in6.ply
+check "... and the input is untouched" cmp -s s.ply in6.ply
+ln -s in6.ply in6-link.ply
+expect_error "curvature -o a link to the input: exit 1" 1 "is the input file" in6-x.csv curvature in6-link.ply -o in6.ply
+check "... and the input is still untouched" cmp -s s.ply in6.ply
+printf 'old\n' >ro.csv
+chmod a-w ro.csv
+run curvature s.ply -o ro.csv
+check "a read-only output is refused: exit 1, kept" bash -c '[[ $1 -eq 1 && $(cat ro.csv) == old ]] && grep -q "^Error: .*read-only.*--force" "$2"' _ "$rc" "$ERR"
+run curvature s.ply -o ro.csv --force
+check "--force replaces a read-only output" bash -c '[[ $1 -eq 0 && $(head -1 ro.csv) == k1,* ]]' _ "$rc"
+printf 'old\n' >ro.focal2.ply
+chmod a-w ro.focal2.ply
+expect_error "focal-mesh with a read-only 2nd output: exit 1, nothing written" 1 "read-only" ro.focal1.ply focal-mesh s.ply -o ro
+printf 'old\n' >target.csv
+ln -s target.csv link.csv
+run curvature s.ply -o link.csv
+check "an output that is a link is written through: the link stays, its file is replaced" \
+  bash -c '[[ $1 -eq 0 && -L link.csv && $(head -1 target.csv) == k1,* ]]' _ "$rc"
+ln -s missing-target.csv dangling.csv
+expect_error "an output that is a link to nothing: exit 2" 2 "dangling.csv" missing-target.csv curvature s.ply -o dangling.csv
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]
