@@ -6,8 +6,8 @@
 #include "commands.h"
 #include "estimator_flags.h"
 #include "focal/core/error.h"
-#include "focal/io/fields_io.h"
 #include "focal/curvature/focal_mesh.h"
+#include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
 #include "input_check.h"
 #include "paths.h"
@@ -19,6 +19,7 @@ struct CurvatureFlags {
   std::string input;
   std::string output;
   bool ascii = false;
+  bool force = false;
   EstimatorFlags estimator;
 };
 
@@ -26,6 +27,7 @@ struct FocalMeshFlags {
   std::string input;
   std::string prefix;
   bool ascii = false;
+  bool force = false;
   EstimatorFlags estimator;
   FocalMeshOptions focal;
 };
@@ -58,15 +60,8 @@ void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   }
   Stage stage(log, "write");
   const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads};
-  write_focal_mesh_ply(f.prefix + ".focal1.ply", meshes.gamma1, o);
-  try {
-    write_focal_mesh_ply(f.prefix + ".focal2.ply", meshes.gamma2, o);
-  } catch (...) {
-    // A failed run leaves no output behind, not one focal mesh without the other.
-    std::error_code ignored;
-    std::filesystem::remove(f.prefix + ".focal1.ply", ignored);
-    throw;
-  }
+  // All or nothing: a failed run leaves neither new focal mesh, and existing files as they were.
+  write_focal_meshes_ply(f.prefix + ".focal1.ply", f.prefix + ".focal2.ply", meshes, o);
   std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),
               static_cast<long long>(meshes.gamma1.mesh.F.rows()), f.prefix.c_str(),
               static_cast<long long>(meshes.gamma2.mesh.F.rows()));
@@ -93,7 +88,11 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
-  cmd->parse_complete_callback([f] { require_extension("-o", f->output, {".csv", ".ply"}); });
+  cmd->add_flag("--force", f->force, "replace a read-only output file");
+  cmd->parse_complete_callback([f] {
+    require_extension("-o", f->output, {".csv", ".ply"});
+    check_output("-o", f->output, f->input, f->force);
+  });
   cmd->callback([f, &log] { run_curvature(*f, log); });
 }
 
@@ -113,6 +112,11 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
   f->estimator.add_to(*cmd);
   cmd->footer(
       "Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");
+  cmd->add_flag("--force", f->force, "replace read-only output files");
+  cmd->parse_complete_callback([f] {
+    check_output("-o", f->prefix + ".focal1.ply", f->input, f->force);
+    check_output("-o", f->prefix + ".focal2.ply", f->input, f->force);
+  });
   cmd->callback([f, &log] { run_focal_mesh(*f, log); });
 }
 

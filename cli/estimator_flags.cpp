@@ -86,6 +86,21 @@ void report_recommended(const Input& input, const Estimate& e, const Log& log) {
 
 }  // namespace
 
+void add_read_flags(CLI::App& command, ReadOptions& read) {
+  auto* tolerance =
+      command
+          .add_option("--weld-tolerance", read.weld_tolerance,
+                      "STL: weld facet corners within this distance into one vertex (default 0: "
+                      "exactly equal positions)")
+          ->check(CLI::NonNegativeNumber);
+  command
+      .add_flag_callback(
+          "--no-weld", [&read] { read.weld = false; },
+          "STL: keep every facet corner a vertex of its own (no triangle shares an edge, so "
+          "every vertex is undefined)")
+      ->excludes(tolerance);
+}
+
 void EstimatorFlags::add_to(CLI::App& command) {
   const std::map<std::string, Method> methods = {{"vertex", Method::vertex},
                                                  {"triangle", Method::triangle}};
@@ -125,6 +140,7 @@ void EstimatorFlags::add_to(CLI::App& command) {
                    "implied by any of --method --solver --rings --weights --normals");
   command.add_option("--threads", threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
       ->check(CLI::NonNegativeNumber);
+  add_read_flags(command, read);
   command.add_flag("--strict", strict,
                    "fail (exit 2, nothing written) when the input has problems such as NaN "
                    "coordinates, degenerate or non-manifold faces or bad normals, instead of "
@@ -157,7 +173,11 @@ EstimateOptions EstimatorFlags::estimate_options() const {
 Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
   {
     Stage stage(log, "read");
-    mesh = read_mesh(path, {.threads = flags.threads});
+    ReadOptions read = flags.read;
+    read.threads = flags.threads;
+    mesh = read_mesh(path, read);
+    // Every output has one row per vertex: an empty mesh would write an empty file and exit 0.
+    if (mesh.V.rows() == 0) throw IoError(path + ": no vertices, nothing to compute");
     log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
              " triangles");
   }

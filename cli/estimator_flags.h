@@ -11,6 +11,7 @@
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/estimate.h"
+#include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/prepared.h"
 #include "log.h"
@@ -23,6 +24,7 @@ struct EstimatorFlags {
   int threads = 0;      ///< --threads: every stage of the run (0 = FOCAL_NUM_THREADS or all)
   bool strict = false;  ///< --strict: problems found in the input are errors (input_check.h)
   bool paper = false;   ///< --paper: the paper's method as configured by the options above
+  ReadOptions read;     ///< --no-weld, --weld-tolerance (STL); threads set from --threads
   /// --method, --solver, --rings, --weights, --normals: giving any selects the paper's method.
   std::vector<CLI::Option*> method_options;
 
@@ -35,6 +37,9 @@ struct EstimatorFlags {
   /// The library's options for this run.
   [[nodiscard]] EstimateOptions estimate_options() const;
 };
+
+/// --weld-tolerance and --no-weld (STL welding, ReadOptions) on `command`, stored in `read`.
+void add_read_flags(CLI::App& command, ReadOptions& read);
 
 /// A mesh read for a run, prepared once for every stage, and what check_mesh found in it.
 /// Not copyable: `prepared` views `mesh`.

@@ -10,12 +10,12 @@
 #include <sstream>
 
 #include "commands.h"
-#include "focal/curvature/baselines.h"
 #include "focal/core/error.h"
+#include "focal/curvature/baselines.h"
+#include "focal/curvature/recommended.h"
 #include "focal/evaluation/evaluation.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/normals.h"
-#include "focal/curvature/recommended.h"
 #include "paths.h"
 
 namespace focal::cli {
@@ -322,7 +322,7 @@ void write_coloured_h(const std::filesystem::path& path, const Mesh& mesh, const
     blue[i] = t <= 0 ? 255 : fade;
     green[i] = fade;
   }
-  Mesh plain{mesh.V, mesh.F, RowMatrixX3d(0, 3), {}};
+  Mesh plain{mesh.V, mesh.F, RowMatrixX3d(0, 3), {}, {}};
   const std::vector<VertexProperty> properties = {{"red", red, PropertyType::uint8},
                                                   {"green", green, PropertyType::uint8},
                                                   {"blue", blue, PropertyType::uint8},

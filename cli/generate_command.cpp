@@ -17,6 +17,7 @@ struct GenerateFlags {
   std::string surface;
   std::string output;
   std::string truth;
+  bool force = false;
   SurfaceOptions options;
   double position_noise = 0.0;
   double normal_noise = 0.0;
@@ -100,8 +101,11 @@ void add_generate_command(CLI::App& app, const Log& log) {
   cmd->footer(
       "Example:\n  focal generate torus --triangulation irregular --vertices 5000 -o torus.ply "
       "--truth torus-truth.csv");
+  cmd->add_flag("--force", f->force, "replace read-only output files");
   cmd->parse_complete_callback([f] {
     require_extension("-o", f->output, {".ply", ".obj", ".off"});
+    check_output("-o", f->output, "", f->force);
+    if (!f->truth.empty()) check_output("--truth", f->truth, "", f->force);
   });
   cmd->callback([f, &log] { generate(*f, log); });
 }

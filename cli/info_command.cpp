@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "estimator_flags.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -9,16 +10,26 @@
 namespace focal::cli {
 namespace {
 
-void print_info(const std::string& path, const Log& log) {
+struct InfoFlags {
+  std::string path;
+  ReadOptions read;
+};
+
+void print_info(const InfoFlags& f, const Log& log) {
+  const std::string& path = f.path;
   Mesh mesh;
   {
     Stage stage(log, "read");
-    mesh = read_mesh(path);
+    mesh = read_mesh(path, f.read);
   }
   const MeshStatistics s = mesh_statistics(mesh.V, mesh.F);
   const OrientationReport orientation = orientation_report(mesh.V, mesh.F);
   std::printf("file:                 %s\n", path.c_str());
   std::printf("vertices:             %d\n", s.vertex_count);
+  if (mesh.corner_vertex.size() > 0) {
+    std::printf("STL corners:          %lld (welded into the vertices above)\n",
+                static_cast<long long>(mesh.corner_vertex.size()));
+  }
   std::printf("triangles:            %d (from %d input faces)\n", s.face_count,
               mesh.face_source.size() > 0 ? mesh.face_source.maxCoeff() + 1 : 0);
   std::printf("edges:                %d (boundary %d, non-manifold %d)\n", s.edge_count,
@@ -40,10 +51,11 @@ void print_info(const std::string& path, const Log& log) {
 
 void add_info_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("info", "Counts, bounds and connectivity statistics of a mesh");
-  auto path = std::make_shared<std::string>();
-  cmd->add_option("input", *path, "mesh file (.obj .ply .off .stl)")->required();
+  auto f = std::make_shared<InfoFlags>();
+  cmd->add_option("input", f->path, "mesh file (.obj .ply .off .stl)")->required();
+  add_read_flags(*cmd, f->read);
   cmd->footer("Example:\n  focal info bunny.off");
-  cmd->callback([path, &log] { print_info(*path, log); });
+  cmd->callback([f, &log] { print_info(*f, log); });
 }
 
 }  // namespace focal::cli

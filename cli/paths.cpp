@@ -25,4 +25,20 @@ void require_extension(const std::string& option, const std::string& path,
   throw CLI::ValidationError(option, "output must end in " + names + ", got '" + path + "'");
 }
 
+void check_output(const std::string& option, const std::string& output, const std::string& input,
+                  bool force) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!input.empty() && fs::equivalent(input, output, ec) && !ec) {
+    throw CLI::ValidationError(option,
+                               "'" + output + "' is the input file; refusing to overwrite it");
+  }
+  const fs::file_status status = fs::status(output, ec);
+  const auto writable = fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write;
+  if (!force && fs::is_regular_file(status) &&
+      (status.permissions() & writable) == fs::perms::none) {
+    throw CLI::ValidationError(option, "'" + output + "' is read-only; --force replaces it");
+  }
+}
+
 }  // namespace focal::cli

@@ -14,4 +14,11 @@ namespace focal::cli {
 void require_extension(const std::string& option, const std::string& path,
                        std::initializer_list<const char*> allowed);
 
+/// Checks an output path of a run before any work (CLI::ValidationError naming `option`, exit 1):
+///  - it may not be the input file (the same file also through a link or another name);
+///  - an existing file with no write permission bit is not replaced unless `force`.
+/// A symbolic link as output is written through to the file it points to (io/atomic_file.h).
+void check_output(const std::string& option, const std::string& output, const std::string& input,
+                  bool force);
+
 }  // namespace focal::cli

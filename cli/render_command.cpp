@@ -22,6 +22,7 @@ namespace {
 struct RenderFlags {
   std::string input;
   std::string output;
+  bool force = false;
   std::string field = "H";
   std::string camera_text;  // "AZIMUTH,ELEVATION" in degrees
   std::string size_text = "1200x900";
@@ -169,7 +170,11 @@ void add_render_command(CLI::App& app, const Log& log) {
       "  focal render scan.ply -o scan-class.png --field class --rings 2\n"
       "  focal render torus.ply -o torus.png --field k1 --directions d1 --range -1,3\n"
       "  focal render bunny.off -o bunny-focal.png --focal-meshes --size 2400x900");
-  cmd->parse_complete_callback([f] { parse_picture_flags(*f); });
+  cmd->add_flag("--force", f->force, "replace a read-only output file");
+  cmd->parse_complete_callback([f] {
+    parse_picture_flags(*f);
+    check_output("-o", f->output, f->input, f->force);
+  });
   cmd->callback([f, &log] { run_render(*f, log); });
 }
 

@@ -113,7 +113,7 @@ TEST(Estimate, MeshNormalsAreFilledAndNormalised) {
     }
   }
   // Inward normals are reported, and used as they are.
-  const Mesh inward{m.V, m.F, -torus().N, {}};
+  const Mesh inward{m.V, m.F, -torus().N, {}, {}};
   EXPECT_TRUE(prepare_normals(PreparedMesh(inward), paper()).report.normals_against_faces);
 }
 
@@ -130,6 +130,30 @@ TEST(Estimate, InwardFacesAreReversedForNormalsFromThem) {
     const Mesh outward = torus();
     EXPECT_TRUE(*e.F == outward.F);
     EXPECT_TRUE(same(e.curvature.H, estimate(PreparedMesh(outward.V, outward.F), o).curvature.H));
+  }
+}
+
+TEST(Estimate, IsolatedTrianglesWithoutNormalsAreUndefinedNotFlat) {
+  // Two isolated triangles on the unit sphere and one fan of three triangles sharing vertex 6.
+  const double s = std::sqrt(0.5);
+  RowMatrixX3d V(10, 3);
+  V << 1, 0, 0, s, s, 0, s, 0, s, -1, 0, 0, -s, s, 0, -s, 0, s, 0, 0, 1, s, 0, s, 0, s, s, -s, 0, s;
+  RowMatrixX3i F(5, 3);
+  F << 0, 1, 2, 3, 5, 4, 6, 7, 8, 6, 8, 9, 6, 9, 7;
+  for (const EstimateOptions& o : {EstimateOptions{}, paper()}) {
+    const PreparedMesh mesh(V, F, std::nullopt);
+    const CurvatureResult r = estimate(mesh, o).curvature;
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_EQ(r.class_of(i), PointClass::undefined) << i;
+      EXPECT_TRUE(std::isnan(r.k1[i]) && std::isnan(r.H[i])) << i;
+    }
+  }
+  // With the exact normals of the sphere the rays of a lone triangle meet: a valid fit, k = 1.
+  const RowMatrixX3d N = V.rowwise().normalized();
+  const CurvatureResult r = estimate(PreparedMesh(V, F, N), paper()).curvature;
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NE(r.class_of(i), PointClass::undefined) << i;
+    EXPECT_NEAR(r.k1[i], 1.0, 1e-9) << i;
   }
 }
 

@@ -1,8 +1,11 @@
 #include "focal/io/mesh_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <algorithm>
 #include <bit>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -840,12 +843,22 @@ Bytes binary_stl(const std::string& header80, const std::vector<std::array<float
   return b;
 }
 
-TEST_F(MeshIo, StlAsciiGivesThreeNewVerticesPerFacet) {
+TEST_F(MeshIo, StlCornersAreWeldedInFirstAppearanceOrder) {
   const Mesh m = focal::read_mesh(write("a.stl", kAsciiStl));
-  // The shared corners (1,0,0) and (0,1,0) are NOT merged: 6 vertices in file order.
-  expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0.05}, {0, 1, 0}}));
-  expect_faces(m, {{0, 1, 2}, {3, 4, 5}}, {0, 1});
+  // The shared corners (1,0,0) and (0,1,0) become one vertex each, numbered where first seen.
+  expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.05}}));
+  expect_faces(m, {{0, 1, 2}, {1, 3, 2}}, {0, 1});
+  EXPECT_EQ(m.corner_vertex, (Eigen::VectorXi(6) << 0, 1, 2, 1, 3, 2).finished());
   EXPECT_FALSE(m.has_normals());
+  // --no-weld: every corner its own vertex, in file order.
+  const Mesh apart = focal::read_mesh(file("a.stl"), {.weld = false});
+  expect_same(apart.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0.05}, {0, 1, 0}}));
+  expect_faces(apart, {{0, 1, 2}, {3, 4, 5}}, {0, 1});
+  EXPECT_EQ(apart.corner_vertex, (Eigen::VectorXi(6) << 0, 1, 2, 3, 4, 5).finished());
+  // Indexed formats keep their vertices: no corner map.
+  EXPECT_EQ(
+      focal::read_mesh(write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).corner_vertex.size(),
+      0);
 }
 
 TEST_F(MeshIo, StlBinaryIsDetectedBySizeEvenWithASolidHeader) {
@@ -853,11 +866,68 @@ TEST_F(MeshIo, StlBinaryIsDetectedBySizeEvenWithASolidHeader) {
                                                     {1, 0, 0, 1, 1, 0.25f, 0, 1, 0}};
   for (const std::string header : {"binary stl", "solid exported by a CAD tool"}) {
     const Mesh m = focal::read_mesh(write("b.stl", binary_stl(header, facets).data));
-    expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0.25}, {0, 1, 0}}));
-    expect_faces(m, {{0, 1, 2}, {3, 4, 5}}, {0, 1});
+    expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.25}}));
+    expect_faces(m, {{0, 1, 2}, {1, 3, 2}}, {0, 1});
   }
   const Mesh empty = focal::read_mesh(write("e.stl", binary_stl("", {}).data));
   EXPECT_EQ(empty.V.rows(), 0);
+}
+
+TEST_F(MeshIo, StlWeldingExactAndWithTolerance) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // -0.0 is 0.0; NaN corners never weld (NaN equals nothing); 1e-7 apart welds only with a
+  // tolerance, and then to the first vertex within reach.
+  const std::vector<std::array<float, 9>> facets = {{0, 0, 0, 1, 0, 0, 0, 1, 0},
+                                                    {-0.0f, 0, -0.0f, 1e-7f, 1, 0, nan, 0, 0},
+                                                    {1, 1e-7f, 0, 0, 1, 1e-7f, nan, 0, 0}};
+  const fs::path p = write("w.stl", binary_stl("w", facets).data);
+  const Mesh exact = focal::read_mesh(p);
+  EXPECT_EQ(exact.corner_vertex, (Eigen::VectorXi(9) << 0, 1, 2, 0, 3, 4, 5, 6, 7).finished());
+  EXPECT_EQ(exact.V.rows(), 8);
+  const Mesh loose = focal::read_mesh(p, {.weld_tolerance = 1e-6});
+  EXPECT_EQ(loose.corner_vertex, (Eigen::VectorXi(9) << 0, 1, 2, 0, 2, 3, 1, 2, 4).finished());
+  expect_same(loose.V.topRows(3), rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+  // 1e-7 away from (1,0,0) and from (0,1,0) alike at tolerance 2: the first vertex wins.
+  const Mesh coarse = focal::read_mesh(p, {.weld_tolerance = 2.0});
+  EXPECT_EQ(coarse.corner_vertex(4), 0);
+  expect_error<focal::InvalidInput>([&] { (void)focal::read_mesh(p, {.weld_tolerance = -1}); },
+                                    {"weld_tolerance"});
+}
+
+TEST_F(MeshIo, StlWeldingClosesASphere) {
+  // A closed sphere as STL: every vertex is shared by its triangles after welding, and the
+  // welded vertex count is the indexed mesh's.
+  const int n = 60;
+  std::vector<std::array<float, 9>> facets;
+  const auto point = [&](int i, int j) {
+    const double t = M_PI * i / n, p = 2 * M_PI * (j % (2 * n)) / (2 * n);
+    const bool pole = i == 0 || i == n;
+    return std::array<float, 3>{pole ? 0.0f : static_cast<float>(std::sin(t) * std::cos(p)),
+                                pole ? 0.0f : static_cast<float>(std::sin(t) * std::sin(p)),
+                                static_cast<float>(std::cos(t))};
+  };
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < 2 * n; ++j) {
+      const auto a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1), d = point(i, j + 1);
+      if (i + 1 < n) facets.push_back({a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]});
+      if (i > 0) facets.push_back({a[0], a[1], a[2], c[0], c[1], c[2], d[0], d[1], d[2]});
+    }
+  }
+  const Mesh m = focal::read_mesh(write("sphere.stl", binary_stl("s", facets).data));
+  EXPECT_EQ(m.V.rows(), 2 + (n - 1) * 2 * n);
+  EXPECT_EQ(m.corner_vertex.size(), 3 * static_cast<Eigen::Index>(facets.size()));
+}
+
+TEST_F(MeshIo, StlAsciiVariantsAreNotTakenForBinary) {
+  // Upper-case keywords, a UTF-8 byte order mark, a comment line before `solid`: ascii, welded.
+  std::string upper = kAsciiStl;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  for (const std::string& text :
+       {upper, "\xEF\xBB\xBF" + std::string(kAsciiStl), "# exported\n" + std::string(kAsciiStl)}) {
+    const Mesh m = focal::read_mesh(write("v.stl", text));
+    expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.05}}));
+  }
 }
 
 TEST_F(MeshIo, StlErrors) {
@@ -881,6 +951,48 @@ TEST_F(MeshIo, StlErrors) {
 
 // ---------------------------------------------------------------------------------------------
 // Writers: atomicity and failures
+
+TEST_F(MeshIo, FocalMeshPairIsWrittenAllOrNothing) {
+  focal::FocalMeshes meshes;
+  for (focal::FocalMesh* g : {&meshes.gamma1, &meshes.gamma2}) {
+    g->mesh = sample_mesh(false);
+    g->flag = focal::VectorXu8::Zero(g->mesh.V.rows());
+  }
+  // The second target is a folder: the first keeps its old contents, no temporary is left.
+  write("fm.focal1.ply", "old\n");
+  fs::create_directory(file("fm.focal2.ply"));
+  expect_error<focal::IoError>(
+      [&] { focal::write_focal_meshes_ply(file("fm.focal1.ply"), file("fm.focal2.ply"), meshes); },
+      {"fm.focal2.ply", "directory"});
+  EXPECT_EQ(slurp(file("fm.focal1.ply")), "old\n");
+  EXPECT_EQ(folder_entries(), (std::vector<std::string>{"fm.focal1.ply", "fm.focal2.ply"}));
+  // Neither exists and the second cannot be validated: neither is created.
+  meshes.gamma2.flag.resize(1);
+  expect_error<focal::InvalidInput>(
+      [&] { focal::write_focal_meshes_ply(file("a.focal1.ply"), file("a.focal2.ply"), meshes); },
+      {"focal_flag"});
+  EXPECT_FALSE(fs::exists(file("a.focal1.ply")));
+  // Both writable: both replaced, no backup left behind.
+  meshes.gamma2.flag = focal::VectorXu8::Zero(meshes.gamma2.mesh.V.rows());
+  fs::remove(file("fm.focal2.ply"));
+  write("fm.focal2.ply", "old\n");
+  focal::write_focal_meshes_ply(file("fm.focal1.ply"), file("fm.focal2.ply"), meshes);
+  EXPECT_EQ(focal::read_mesh(file("fm.focal1.ply")).V.rows(), meshes.gamma1.mesh.V.rows());
+  EXPECT_EQ(focal::read_mesh(file("fm.focal2.ply")).V.rows(), meshes.gamma2.mesh.V.rows());
+  EXPECT_EQ(folder_entries(), (std::vector<std::string>{"fm.focal1.ply", "fm.focal2.ply"}));
+}
+
+TEST_F(MeshIo, WritersWriteThroughALinkAndRefuseADanglingOne) {
+  write("target.obj", "old\n");
+  fs::create_symlink("target.obj", file("link.obj"));
+  focal::write_obj(file("link.obj"), sample_mesh(false));
+  EXPECT_TRUE(fs::is_symlink(file("link.obj")));
+  EXPECT_EQ(focal::read_mesh(file("target.obj")).V.rows(), sample_mesh(false).V.rows());
+  fs::create_symlink("nowhere.obj", file("dangling.obj"));
+  expect_error<focal::IoError>([&] { focal::write_obj(file("dangling.obj"), sample_mesh(false)); },
+                               {"dangling.obj", "link to a missing"});
+  EXPECT_FALSE(fs::exists(file("nowhere.obj")));
+}
 
 TEST_F(MeshIo, WriteIntoMissingFolderFailsAndCreatesNothing) {
   const Mesh m = sample_mesh(true);
@@ -1046,8 +1158,43 @@ TEST_F(MeshIo, EmptyFilesAreErrorsInEveryFormat) {
   expect_io_error(write("empty.off", ""), {"empty file"});
   expect_io_error(write("empty.stl", ""), {"too short", "0 bytes"});
   expect_io_error(write("empty.obj", ""), {"empty file (0 bytes)"});
-  // Text without geometry is an explicit empty mesh in OBJ, which has no header to require.
-  EXPECT_EQ(focal::read_mesh(write("comment.obj", "# nothing yet\n")).V.rows(), 0);
+  // OBJ has no header: a file without vertices is not taken for an empty mesh (issue 13).
+  expect_io_error(write("comment.obj", "# nothing yet\n"), {"comment.obj", "no vertices"});
+}
+
+TEST_F(MeshIo, BytesThatCannotBeObjAreErrors) {
+  expect_io_error(write("html.obj", "<!DOCTYPE html>\n<html><body>hi</body></html>\n"),
+                  {"html.obj", "no vertices"});
+  expect_io_error(write("text.obj", "just some words\nand more\n"), {"no vertices"});
+  expect_io_error(write("nul.obj", std::string("v 0 0 0\n\0\0\0", 11)),
+                  {"byte offset 8", "control byte 0x00", "not OBJ text"});
+  expect_io_error(write("elf.obj", std::string("\x7F"
+                                               "ELF\x02\x01\x01",
+                                               7)),
+                  {"byte offset 0", "0x7F"});
+  expect_io_error(write("png.obj", std::string("\x89PNG\r\n\x1A\n", 8)), {"byte offset 6", "0x1A"});
+  expect_io_error(write("utf16.obj", std::string("\xFF\xFEv\0 \0", 6)), {"UTF-16"});
+  // A PLY or OFF renamed .obj: no `v` lines.
+  expect_io_error(write("ply.obj", "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n"),
+                  {"no vertices"});
+  expect_io_error(write("off.obj", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), {"no vertices"});
+  // Random bytes: an error, never an empty mesh.
+  std::mt19937 random(13);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::string bytes(256, '\0');
+    for (char& c : bytes) c = static_cast<char>(random() & 0xFF);
+    expect_io_error(write("random.obj", bytes), {"random.obj"});
+  }
+}
+
+TEST_F(MeshIo, InputsThatAreNotRegularFilesAreErrors) {
+  const fs::path fifo = file("f.obj");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  expect_io_error(fifo, {"f.obj", "FIFO", "not a regular file"});  // returns at once
+  if (fs::exists("/dev/zero")) {
+    fs::create_symlink("/dev/zero", file("zero.ply"));
+    expect_io_error(file("zero.ply"), {"zero.ply", "character device"});
+  }
 }
 
 /// Every proper prefix of `data` but the one without just the final byte, read as `name`: either
@@ -1108,8 +1255,8 @@ TEST_F(MeshIoCut, FilesCutAtEveryByteAreErrorsThatSayWhere) {
   const std::string obj = slurp(file("full.obj"));
   EXPECT_GT(read_every_prefix("cut.obj", obj, m, true, 0), 0);
   // Ascii STL: only cuts in the final `endsolid` line (a solid without its end) can be read.
-  Mesh two;
-  two.V = rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0.05}, {0, 1, 0}});
+  Mesh two;  // welded
+  two.V = rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.05}});
   const std::string stl = kAsciiStl;
   const int read = read_every_prefix("cut.stl", stl, two, true, std::strlen("solid"));
   EXPECT_LE(read, static_cast<int>(std::string("endsolid two").size()));
@@ -1155,7 +1302,7 @@ TEST_F(MeshIo, BytesThatAreNotUtf8) {
   expect_same(ply.V, rows({{1, 2, 3}}));
   const Mesh stl =
       focal::read_mesh(write("latin1.stl", std::string(kAsciiStl).replace(6, 3, "\xe9\xe9\xe9")));
-  EXPECT_EQ(stl.V.rows(), 6);
+  EXPECT_EQ(stl.V.rows(), 4);
   // ...and where a number or keyword belongs they are an error that names the line.
   expect_io_error(write("v.obj", "v 0 0 0\nv 1 \xff 0\n"), {"line 2", "is not a number"});
   expect_io_error(write("v.off", "OFF\n1 0 0\n0 \xc3\xa9 0\n"), {"line 3"});

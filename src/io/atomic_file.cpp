@@ -44,6 +44,13 @@ std::FILE* open_temporary(const std::filesystem::path& path, std::filesystem::pa
 
 AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
   if (target_.filename().empty()) fail(target_, "is not a file name");
+  // A link is written through: the file it points to is replaced, the link stays a link (renaming
+  // over the link itself would silently turn it into a plain file).
+  std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(target_, ec))) {
+    target_ = std::filesystem::canonical(target, ec);
+    if (ec) fail(target, "is a symbolic link to a missing file or folder; not written");
+  }
   file_ = open_temporary(target_, temporary_);
 }
 
@@ -55,6 +62,15 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
+  finish();
+  std::error_code ec;
+  std::filesystem::rename(temporary_, target_, ec);
+  if (ec) fail(target_, "cannot replace the file: " + ec.message());
+  committed_ = true;
+}
+
+void AtomicFile::finish() {
+  if (file_ == nullptr) return;
   const bool write_failed = std::fflush(file_) != 0 || std::ferror(file_) != 0;
   const int saved_errno = errno;
   const bool close_failed = std::fclose(file_) != 0;
@@ -62,10 +78,63 @@ void AtomicFile::commit() {
   if (write_failed || close_failed) {
     fail(target_, std::string("write failed: ") + std::strerror(saved_errno));
   }
+}
+
+namespace {
+thread_local AtomicFileGroup* current_group = nullptr;
+}  // namespace
+
+AtomicFileGroup::AtomicFileGroup() : previous_(current_group) { current_group = this; }
+
+AtomicFileGroup::~AtomicFileGroup() { current_group = previous_; }
+
+AtomicFileGroup* AtomicFileGroup::current() { return current_group; }
+
+void AtomicFileGroup::adopt(std::unique_ptr<AtomicFile> file) { files_.push_back(std::move(file)); }
+
+void AtomicFileGroup::commit() {
+  current_group = previous_;  // nothing more joins the group
   std::error_code ec;
-  std::filesystem::rename(temporary_, target_, ec);
-  if (ec) fail(target_, "cannot replace the file: " + ec.message());
-  committed_ = true;
+  // A folder in the way would be moved aside and replaced by a file, which a single write never
+  // does (its rename fails): refuse before anything moves.
+  for (const auto& file : files_) {
+    if (std::filesystem::is_directory(std::filesystem::symlink_status(file->target(), ec))) {
+      fail(file->target(), "cannot replace the file: it is a directory");
+    }
+  }
+  // Phase 1: the existing targets move aside (same folder, so that the renames are atomic).
+  std::vector<std::filesystem::path> backups(files_.size());
+  const auto restore = [&](std::size_t placed) {
+    for (std::size_t i = 0; i < files_.size(); ++i) {
+      std::error_code ignored;
+      if (i < placed && backups[i].empty()) std::filesystem::remove(files_[i]->target(), ignored);
+      if (!backups[i].empty()) std::filesystem::rename(backups[i], files_[i]->target(), ignored);
+    }
+  };
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    const std::filesystem::path& target = files_[i]->target();
+    if (!std::filesystem::exists(std::filesystem::symlink_status(target, ec))) continue;
+    const std::filesystem::path backup = temporary_path_for(target);
+    std::filesystem::rename(target, backup, ec);
+    if (ec) {
+      restore(0);
+      fail(target, "cannot replace the file: " + ec.message());
+    }
+    backups[i] = backup;
+  }
+  // Phase 2: the new files move in.
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    std::filesystem::rename(files_[i]->temporary(), files_[i]->target(), ec);
+    if (ec) {
+      const std::string message = ec.message();
+      restore(i);
+      fail(files_[i]->target(), "cannot replace the file: " + message);
+    }
+    files_[i]->mark_committed();
+  }
+  for (const auto& backup : backups) {
+    if (!backup.empty()) std::filesystem::remove(backup, ec);
+  }
 }
 
 void AtomicFile::write(const char* data, std::size_t bytes) {
@@ -87,11 +156,16 @@ void OutputSink::write(const char* data, std::size_t bytes) {
 
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(OutputSink&)>& body) {
-  AtomicFile file(path);
-  OutputSink sink(file);
+  auto file = std::make_unique<AtomicFile>(path);
+  OutputSink sink(*file);
   body(sink);
   sink.flush();
-  file.commit();
+  if (AtomicFileGroup* group = AtomicFileGroup::current()) {
+    file->finish();
+    group->adopt(std::move(file));
+  } else {
+    file->commit();
+  }
 }
 
 }  // namespace io_detail

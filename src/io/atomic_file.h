@@ -6,6 +6,9 @@
 /// and leaves an existing target as it was. Used by every writer: the mesh and table writers of
 /// io/ and write_png (render/png_io.cpp).
 ///
+/// A target that is a symbolic link is written through: the file the link points to is replaced
+/// (the temporary file goes beside it) and the link is kept; a link to nothing is an IoError.
+///
 /// The temporary file is `.<name>.tmp-<16 hex digits>` in the target's folder (hidden, so that a
 /// leftover after a crash does not look like output; the same folder, so that the rename is
 /// atomic), created exclusively so that no other writer's file is reused. No fsync: the rename
@@ -15,7 +18,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace focal::io_detail {
 
@@ -39,6 +44,14 @@ class AtomicFile {
   /// \throw IoError naming the target on a write error or a failed rename (the temporary file is
   /// removed by the destructor).
   void commit();
+  /// Flushes and closes the file without renaming it (the first phase of AtomicFileGroup).
+  /// \throw IoError naming the target on a write error.
+  void finish();
+
+  [[nodiscard]] const std::filesystem::path& target() const { return target_; }
+  [[nodiscard]] const std::filesystem::path& temporary() const { return temporary_; }
+  /// The temporary file has been renamed to the target (by its owner): do not remove it.
+  void mark_committed() { committed_ = true; }
 
  private:
   std::filesystem::path target_;
@@ -68,7 +81,37 @@ class OutputSink {
   std::string buffer_;
 };
 
-/// Runs `body` on an OutputSink into a new AtomicFile for `path`, flushes it and commits.
+/// Several files written all or nothing (a two-phase commit): while a group is open on a thread,
+/// write_atomically on that thread writes and closes its temporary file but leaves the rename to
+/// the group. commit() then moves the existing targets aside, renames every temporary file over
+/// its target and removes the old files; if any step fails, every target gets its old file back
+/// (or is removed when it did not exist) and the temporaries are removed. Destroyed without
+/// commit() (an exception on the way) it removes the temporaries and touches no target.
+/// Protects against failures in the process (a target that is a folder, a failed rename), not
+/// against a crash during commit(), between the moves aside and the renames.
+class AtomicFileGroup {
+ public:
+  AtomicFileGroup();
+  ~AtomicFileGroup();
+  AtomicFileGroup(const AtomicFileGroup&) = delete;
+  AtomicFileGroup& operator=(const AtomicFileGroup&) = delete;
+
+  /// Puts every file in place. \throw IoError naming the target that failed; then every target
+  /// is as it was before.
+  void commit();
+
+  /// The group open on this thread, or nullptr.
+  [[nodiscard]] static AtomicFileGroup* current();
+  /// Takes a finished (AtomicFile::finish) file for commit().
+  void adopt(std::unique_ptr<AtomicFile> file);
+
+ private:
+  std::vector<std::unique_ptr<AtomicFile>> files_;
+  AtomicFileGroup* previous_;
+};
+
+/// Runs `body` on an OutputSink into a new AtomicFile for `path`, flushes it and commits (or,
+/// inside an AtomicFileGroup, leaves the commit to the group).
 /// \throw IoError naming `path` when the file cannot be created, written or renamed; whatever
 /// `body` throws. In either case `path` is left as it was.
 void write_atomically(const std::filesystem::path& path,

@@ -30,6 +30,16 @@ std::string read_whole_file(const std::filesystem::path& path) {
   const auto status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) fail(path, "no such file");
   if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a mesh file");
+  // A FIFO would block until a writer appears and a device such as /dev/zero never ends; only a
+  // regular file (or a link to one) has the fixed size the readers check counts against.
+  if (!std::filesystem::is_regular_file(status)) {
+    const char* kind = std::filesystem::is_fifo(status)             ? "a FIFO"
+                       : std::filesystem::is_character_file(status) ? "a character device"
+                       : std::filesystem::is_block_file(status)     ? "a block device"
+                       : std::filesystem::is_socket(status)         ? "a socket"
+                                                                    : "not a regular file";
+    fail(path, std::string("is ") + kind + ", not a regular file (mesh files are read whole)");
+  }
 
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) fail(path, std::string("cannot open for reading: ") + std::strerror(errno));

@@ -102,6 +102,13 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
   out += '\n';
 }
 
+/// STL welding (ReadOptions): `mesh` as the STL parsers return it, one vertex per corner in file
+/// order; replaces V by the welded vertices (first-appearance order), remaps F and fills
+/// Mesh::corner_vertex. tolerance 0: exactly equal coordinates (-0 == 0; non-finite corners stay
+/// apart); > 0: a corner joins the first vertex within that distance. weld false: identity.
+/// \throw InvalidInput for a negative or non-finite tolerance.
+void weld_corners(Mesh& mesh, double tolerance, bool weld);
+
 // The per-format readers, dispatched by read_mesh().
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);

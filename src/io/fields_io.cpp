@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "io/atomic_file.h"
 #include "io/detail.h"
 #include "io/ply.h"
 
@@ -92,6 +93,14 @@ void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& fo
   PlyWriteOptions o = options;
   o.comments.push_back("focal mesh; focal_flag codes: 0=finite 1=infinite(clamped) 2=undefined");
   write_ply(path, focal.mesh, flag, o);
+}
+
+void write_focal_meshes_ply(const std::filesystem::path& path1, const std::filesystem::path& path2,
+                            const FocalMeshes& meshes, const PlyWriteOptions& options) {
+  io_detail::AtomicFileGroup group;
+  write_focal_mesh_ply(path1, meshes.gamma1, options);
+  write_focal_mesh_ply(path2, meshes.gamma2, options);
+  group.commit();
 }
 
 }  // namespace focal

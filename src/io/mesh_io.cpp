@@ -2,6 +2,8 @@
 
 #include "focal/io/mesh_io.h"
 
+#include <cmath>
+
 #include "focal/core/error.h"
 #include "io/detail.h"
 
@@ -26,8 +28,14 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
       return io_detail::read_ply(path, options.threads);
     case MeshFormat::off:
       return io_detail::read_off(path);
-    case MeshFormat::stl:
-      return io_detail::read_stl(path);
+    case MeshFormat::stl: {
+      if (!(options.weld_tolerance >= 0.0) || !std::isfinite(options.weld_tolerance)) {
+        throw InvalidInput("read_mesh: weld_tolerance must be finite and >= 0");
+      }
+      Mesh mesh = io_detail::read_stl(path);
+      io_detail::weld_corners(mesh, options.weld_tolerance, options.weld);
+      return mesh;
+    }
   }
   io_detail::fail(path, "unknown mesh format");
 }

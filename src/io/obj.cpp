@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "focal/core/error.h"
@@ -228,7 +229,26 @@ Mesh parse_obj(const std::filesystem::path& path, std::string_view data) {
   // unknown one, silently dropping the first vertex and shifting every index.
   constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
   if (data.starts_with(kByteOrderMark)) data.remove_prefix(kByteOrderMark.size());
-  return ObjReader(path).read(data);
+  // OBJ ignores statements it does not know, so without these checks any file (an image, a
+  // binary, a PLY renamed .obj) would read as an empty mesh. OBJ is text: control bytes other
+  // than blanks and line breaks (NUL in UTF-16 and binary data, for a start) mean it is not OBJ.
+  if (data.starts_with("\xFF\xFE") || data.starts_with("\xFE\xFF")) {
+    fail(path, "starts with a UTF-16 byte order mark; OBJ files are ASCII/UTF-8 text");
+  }
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto byte = static_cast<unsigned char>(data[i]);
+    if ((byte < 0x20 && byte != '\t' && byte != '\n' && byte != '\r' && byte != '\v' &&
+         byte != '\f') ||
+        byte == 0x7F) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", byte);
+      io_detail::fail_at_offset(path, i,
+                                std::string("control byte ") + hex + ": binary data, not OBJ text");
+    }
+  }
+  Mesh mesh = ObjReader(path).read(data);
+  if (mesh.V.rows() == 0) fail(path, "no vertices ('v' lines): not an OBJ mesh");
+  return mesh;
 }
 
 Mesh read_obj(const std::filesystem::path& path) { return parse_obj(path, read_whole_file(path)); }

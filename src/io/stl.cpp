@@ -1,6 +1,6 @@
-// STL reading, ascii and binary. STL stores triangles without shared vertices; each facet's
-// corners become three new vertices in file order, so the vertex order is the file's and nothing
-// is merged (welding would be a separate, explicit step). Facet normals are not vertex normals
+// STL reading, ascii and binary. STL stores triangles without shared vertices; the parsers return
+// each facet's corners as new vertices in file order, and read_mesh then welds them
+// (io/weld.cpp, ReadOptions). Facet normals are not vertex normals
 // (and are often zero), so Mesh::N stays empty.
 
 #include <algorithm>
@@ -31,9 +31,27 @@ std::uint32_t load_u32_le(const char* p) {
 
 float load_f32_le(const char* p) { return std::bit_cast<float>(load_u32_le(p)); }
 
+/// Skips blanks and `#` comment lines (some exporters write one before `solid`).
+std::string_view skip_leading_comments(std::string_view data) {
+  for (;;) {
+    const std::size_t first = data.find_first_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return {};
+    data.remove_prefix(first);
+    if (data.front() != '#') return data;
+    const std::size_t end = data.find('\n');
+    if (end == std::string_view::npos) return {};
+    data.remove_prefix(end + 1);
+  }
+}
+
+/// Whether `text` starts with `keyword`, ignoring ASCII case (`SOLID` is as common as `solid`).
+bool starts_with_keyword(std::string_view text, std::string_view keyword) {
+  return text.size() >= keyword.size() &&
+         io_detail::to_lower(text.substr(0, keyword.size())) == keyword;
+}
+
 bool starts_with_solid(std::string_view data) {
-  const std::size_t first = data.find_first_not_of(" \t\r\n");
-  return first != std::string_view::npos && data.substr(first, 5) == "solid";
+  return starts_with_keyword(skip_leading_comments(data), "solid");
 }
 
 /// True when the last non-blank line starts with "endsolid": an ascii file, even if its size
@@ -44,7 +62,7 @@ bool ends_with_endsolid(std::string_view data) {
   const std::size_t line_start = data.find_last_of('\n', last);
   std::string_view line = data.substr(line_start == std::string_view::npos ? 0 : line_start + 1);
   line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
-  return line.substr(0, 8) == "endsolid";
+  return starts_with_keyword(line, "endsolid");
 }
 
 Mesh read_binary(const std::filesystem::path& path, std::string_view data) {
@@ -94,7 +112,7 @@ class AsciiStlReader {
     while (cursor.next(line)) {
       line_ = cursor.line_number();
       io_detail::split_tokens(line, tokens);
-      if (tokens.empty()) continue;
+      if (tokens.empty() || tokens[0].front() == '#') continue;  // blank or a comment line
       handle(tokens);
     }
     if (state_ != State::outside) fail_at_line(path_, line_, "file ends inside a solid");
@@ -184,6 +202,11 @@ namespace io_detail {
 Mesh read_stl(const std::filesystem::path& path) { return parse_stl(path, read_whole_file(path)); }
 
 Mesh parse_stl(const std::filesystem::path& path, std::string_view data) {
+  // A UTF-8 byte order mark before an ascii `solid` (editors on Windows add one).
+  constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+  if (data.starts_with(kByteOrderMark) && starts_with_solid(data.substr(kByteOrderMark.size()))) {
+    data.remove_prefix(kByteOrderMark.size());
+  }
   // Binary files often start with "solid" too, so the size is the deciding evidence: a binary
   // file is exactly 84 + 50 * (facet count in bytes 80..83) bytes long.
   if (data.size() >= kHeaderBytes + 4) {

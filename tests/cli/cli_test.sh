@@ -458,11 +458,12 @@ run curvature long.off -o long.csv
 check "non-unit normal: exit 0, counted, and every vertex flat" \
   bash -c '[[ $1 -eq 0 && $3 == "flat=3 " ]] && grep -q "^Warning: long.off: found 1 non-unit normal" "$2"' _ "$rc" "$ERR" "$(classes long.csv)"
 
-# A single triangle without normals: nothing to report, three flat vertices.
+# A single triangle without normals: nothing to report, and no curvature to estimate (its three
+# estimated normals are the one face normal): three undefined rows, not flat ones (issue 13).
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >one.off
 run curvature one.off -o one.csv --strict
-check "single triangle: exit 0 with --strict, no warning, 3 flat rows" \
-  bash -c '[[ $1 -eq 0 && ! -s $2 && $3 == "flat=3 " ]]' _ "$rc" "$ERR" "$(classes one.csv)"
+check "single triangle: exit 0 with --strict, no warning, 3 undefined rows" \
+  bash -c '[[ $1 -eq 0 && ! -s $2 && $3 == "undefined=3 " ]]' _ "$rc" "$ERR" "$(classes one.csv)"
 
 # What the normals stage takes from the check stage (cli/estimator_flags.cpp reuses its findings
 # instead of recomputing the orientation and the face normals): each warning still appears.
@@ -623,6 +624,96 @@ expect_error "render -o r.jpg (not PNG): exit 1" 1 "r.jpg" r.jpg render s.ply -o
 expect_error "render of a missing input: exit 2" 2 "missing.ply" rb.png render missing.ply -o rb.png
 expect_error "render into a missing folder: exit 2, nothing written" 2 "rb.png" nofolder/rb.png render s.ply -o nofolder/rb.png
 check "render: no temporary files left behind" bash -c '! ls -A | grep -q "\.tmp-"'
+
+# ---------------------------------------------------------------------------------------------
+# Issue 13: STL is welded, bytes that are not a mesh are errors, inputs must be regular files,
+# focal-mesh writes both files or neither.
+run generate sphere -o so.obj --vertices 500
+# The OBJ sphere as ascii STL (facet corners written out, nothing shared); the numbers are the
+# OBJ's shortest round-trip text, so welding by exact equality recovers the vertices.
+awk '$1 == "v" { v[++n] = $2 " " $3 " " $4 }
+     $1 == "f" { split($2, a, "/"); split($3, b, "/"); split($4, c, "/")
+                 printf "facet normal 0 0 0\nouter loop\nvertex %s\nvertex %s\nvertex %s\nendloop\nendfacet\n", v[a[1]], v[b[1]], v[c[1]] }
+     BEGIN { print "solid s" } END { print "endsolid s" }' so.obj >so.stl
+SO_NV=$(grep -c '^v ' so.obj || true)
+run curvature so.stl -o so-stl.csv
+check "STL sphere: exit 0" test "$rc" -eq 0
+check "STL sphere: one row per welded vertex ($SO_NV)" test "$(data_rows so-stl.csv)" -eq "$SO_NV"
+# 500 vertices, normals from the positions: measured max |k - 1| about 0.02; 0.1 bounds it.
+check_within "STL sphere: k1, k2 = 1 within 0.1 (not 0)" "$(max_dev so-stl.csv "1 2" 1)" 0.1
+run info so.stl
+check "info on STL: the welded vertex count and the corners" \
+  bash -c 'grep -q "^vertices: *$1\$" "$2" && grep -q "^STL corners: *$3 " "$2"' _ "$SO_NV" "$OUT" "$(( 3 * $(grep -c '^f ' so.obj) ))"
+run curvature so.stl -o so-apart.csv --no-weld
+check "STL --no-weld: every row undefined, none flat" \
+  bash -c '[[ $1 -eq 0 && $3 == "undefined=$2 " ]]' _ "$rc" "$(( 3 * $(grep -c '^f ' so.obj) ))" "$(classes so-apart.csv)"
+run curvature so.stl -o so-tol.csv --weld-tolerance 1e-9
+check "STL --weld-tolerance 1e-9: the same vertices" test "$(data_rows so-tol.csv)" -eq "$SO_NV"
+expect_error "--no-weld with --weld-tolerance: exit 1" 1 "--weld" so-x.csv curvature so.stl -o so-x.csv --no-weld --weld-tolerance 1e-9
+expect_error "--weld-tolerance -1: exit 1" 1 "--weld-tolerance" so-x.csv curvature so.stl -o so-x.csv --weld-tolerance -1
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >lone.obj
+run curvature lone.obj -o lone.csv
+check "a lone triangle without normals: undefined, not flat" \
+  bash -c '[[ $1 -eq 0 && $2 == "undefined=3 " ]]' _ "$rc" "$(classes lone.csv)"
+run curvature lone.obj -o lone-p.csv --paper
+check "a lone triangle without normals, --paper: undefined" test "$(classes lone-p.csv)" = "undefined=3 "
+
+head -c 3000 /dev/urandom >random.obj
+printf 'hello\nworld\n' >words.obj
+printf 'v 0 0 0\n\0\0\0' >nul.obj
+printf '\177ELF\2\1\1\0' >elf.obj
+printf '\211PNG\r\n\032\n' >png.obj
+printf '<!DOCTYPE html>\n<html></html>\n' >page.obj
+cp s.ply renamed_ply.obj
+printf '\377\376v\0 \0001\0' >utf16.obj
+for f in random words nul elf png page renamed_ply utf16; do
+  expect_error "OBJ that is not OBJ ($f): exit 2" 2 "$f.obj" "fm-$f.focal1.ply" focal-mesh "$f.obj" -o "fm-$f"
+done
+check "OBJ that is not OBJ: no focal2 either" bash -c '! ls fm-*.focal2.ply 2>/dev/null'
+expect_error "curvature of an empty OBJ mesh: exit 2" 2 "no vertices" w.csv curvature words.obj -o w.csv
+printf 'ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >nov.ply
+expect_error "PLY with 0 vertices: exit 2, no empty output" 2 "no vertices" nov.csv curvature nov.ply -o nov.csv
+
+mkfifo fifo.obj
+# A FIFO nobody writes to: an error at once, not a wait (timeout guards the test).
+rc=0; timeout 10 "$FOCAL" info fifo.obj >"$OUT" 2>"$ERR" || rc=$?
+check "FIFO input: exit 2 at once, named" bash -c '[[ $1 -eq 2 ]] && grep -q "^Error: fifo.obj.*FIFO" "$2"' _ "$rc" "$ERR"
+ln -s /dev/zero zero.ply
+rc=0; timeout 10 "$FOCAL" curvature zero.ply -o zero.csv >"$OUT" 2>"$ERR" || rc=$?
+check "/dev/zero input: exit 2, not read until memory runs out" \
+  bash -c '[[ $1 -eq 2 ]] && grep -q "^Error: zero.ply.*character device" "$2" && [[ ! -e zero.csv ]]' _ "$rc" "$ERR"
+
+printf 'old\n' >fm.focal1.ply
+mkdir -p fm.focal2.ply
+run focal-mesh s.ply -o fm
+check "focal-mesh whose 2nd file fails: exit 2, the existing 1st file untouched" \
+  bash -c '[[ $1 -eq 2 && $(cat fm.focal1.ply) == old ]]' _ "$rc"
+check "focal-mesh: no temporary or backup files left behind" bash -c '! ls -A | grep -q "\.tmp-"'
+
+# Output paths (issue 13 item 6): never the input, a read-only file only with --force, a link
+# written through to its file.
+cp s.ply in6.ply
+expect_error "curvature -o the input file: exit 1" 1 "is the input file" in6-x.csv curvature in6.ply -o in6.ply
+check "... and the input is untouched" cmp -s s.ply in6.ply
+ln -s in6.ply in6-link.ply
+expect_error "curvature -o a link to the input: exit 1" 1 "is the input file" in6-x.csv curvature in6-link.ply -o in6.ply
+check "... and the input is still untouched" cmp -s s.ply in6.ply
+printf 'old\n' >ro.csv
+chmod a-w ro.csv
+run curvature s.ply -o ro.csv
+check "a read-only output is refused: exit 1, kept" bash -c '[[ $1 -eq 1 && $(cat ro.csv) == old ]] && grep -q "^Error: .*read-only.*--force" "$2"' _ "$rc" "$ERR"
+run curvature s.ply -o ro.csv --force
+check "--force replaces a read-only output" bash -c '[[ $1 -eq 0 && $(head -1 ro.csv) == k1,* ]]' _ "$rc"
+printf 'old\n' >ro.focal2.ply
+chmod a-w ro.focal2.ply
+expect_error "focal-mesh with a read-only 2nd output: exit 1, nothing written" 1 "read-only" ro.focal1.ply focal-mesh s.ply -o ro
+printf 'old\n' >target.csv
+ln -s target.csv link.csv
+run curvature s.ply -o link.csv
+check "an output that is a link is written through: the link stays, its file is replaced" \
+  bash -c '[[ $1 -eq 0 && -L link.csv && $(head -1 target.csv) == k1,* ]]' _ "$rc"
+ln -s missing-target.csv dangling.csv
+expect_error "an output that is a link to nothing: exit 2" 2 "dangling.csv" missing-target.csv curvature s.ply -o dangling.csv
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

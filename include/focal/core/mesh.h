@@ -21,7 +21,8 @@ using RowMatrixX3i = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3, Eigen::RowMa
 /// Per-element small codes (classes, flags).
 using VectorXu8 = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1>;
 
-/// Read-only views accepted by the API, so that numpy arrays and mapped buffers pass without copies.
+/// Read-only views accepted by the API, so that numpy arrays and mapped buffers pass without
+/// copies.
 using PositionsRef = Eigen::Ref<const RowMatrixX3d>;
 using FacesRef = Eigen::Ref<const RowMatrixX3i>;
 using NormalsRef = Eigen::Ref<const RowMatrixX3d>;
@@ -34,6 +35,10 @@ struct Mesh {
   RowMatrixX3d N;  ///< #V x 3 vertex normals as read, or 0 rows when the input had none.
   /// #F: index of the input polygon each triangle came from (identity for triangle input).
   Eigen::VectorXi face_source;
+  /// STL only (read_mesh welds its unshared facet corners, ReadOptions): for every corner in file
+  /// order (facet 0's corners, then facet 1's, ...), the row of V it became. Empty for indexed
+  /// formats, whose vertices are the file's.
+  Eigen::VectorXi corner_vertex;
 
   [[nodiscard]] bool has_normals() const { return N.rows() == V.rows() && V.rows() > 0; }
   /// N as the functions taking optional normals want it: std::nullopt when N has 0 rows.

@@ -25,4 +25,11 @@ void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
 void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,
                           const PlyWriteOptions& options = {});
 
+/// Both focal meshes (write_focal_mesh_ply) as `path1` (Gamma_1) and `path2` (Gamma_2), all or
+/// nothing: either both new files are in place or both paths are as they were (an existing file
+/// keeps its contents, a missing one stays missing).
+/// \throw IoError naming the path that failed.
+void write_focal_meshes_ply(const std::filesystem::path& path1, const std::filesystem::path& path2,
+                            const FocalMeshes& meshes, const PlyWriteOptions& options = {});
+
 }  // namespace focal

@@ -5,7 +5,9 @@
 /// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary).
 /// Vertex order and count of indexed formats (OBJ, PLY, OFF) are preserved exactly; polygons are
 /// fan-triangulated and Mesh::face_source maps each triangle to its input polygon. STL has no
-/// shared vertices: each facet's corners are three new vertices, in file order (nothing is merged).
+/// shared vertices: corners at the same position are welded into one vertex (ReadOptions), the
+/// vertices numbered in order of first appearance, and Mesh::corner_vertex maps each corner of
+/// the file to its vertex.
 /// Nothing is dropped or repaired: non-manifold and duplicate faces are kept as they are, a face
 /// with fewer than 3 vertices or an index out of range is an IoError. NaN and infinite coordinates
 /// are read as they are (later stages flag them). Counts declared in a header are checked against
@@ -37,6 +39,12 @@ struct ReadOptions {
   /// Threads of the parallel passes (binary PLY): 0 for FOCAL_NUM_THREADS if set, else all
   /// hardware threads. The mesh read does not depend on it.
   int threads = 0;
+  /// STL: weld facet corners into shared vertices (false: every corner is its own vertex, in file
+  /// order, as the file stores them; no triangle then shares an edge).
+  bool weld = true;
+  /// STL: 0 welds corners whose coordinates are exactly equal (-0.0 == 0.0); > 0 welds a corner
+  /// to the first earlier vertex within this Euclidean distance (grid hashing, deterministic).
+  double weld_tolerance = 0.0;
 };
 
 /// Reads a mesh; the format is taken from the extension.
@@ -48,7 +56,9 @@ struct ReadOptions {
 /// OBJ: negative (relative) and forward indices are accepted; texture coordinates, groups,
 /// materials, lines (`l`, `p`) and free-form geometry are ignored.
 /// \throw IoError naming the file and the line, byte offset or element index of the problem,
-/// also for a missing file, a directory or an unreadable path.
+/// also for a missing file, a path that is not a regular file (a directory, FIFO, device or
+/// socket) or an unreadable path; InvalidInput for negative threads or a negative or non-finite
+/// weld_tolerance.
 [[nodiscard]] Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 
 /// Scalar type a per-vertex property is stored as in PLY.
