@@ -21,9 +21,11 @@ deps-demo:
 
 venv: $(VENV)/.ready
 
-$(VENV)/.ready: | deps
+# Rebuilt when this Makefile changes (pip skips what is installed). dask[distributed]: the tests of
+# focal.distributed (python/focal/distributed.py) run on a LocalCluster.
+$(VENV)/.ready: Makefile | deps
 	@python3 -m venv $(VENV)
-	@$(PYTHON) -m pip install -q --disable-pip-version-check nanobind numpy pytest
+	@$(PYTHON) -m pip install -q --disable-pip-version-check nanobind numpy pytest "dask[distributed]"
 	@touch $@
 
 configure: deps venv

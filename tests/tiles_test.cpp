@@ -2,6 +2,8 @@
 // same bits as on the whole mesh, on meshes with boundaries, several components (one inward),
 // non-manifold parts, unreferenced and non-finite vertices; and the halos hold what the reach
 // says by construction.
+#include "focal/tiles/tiles.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,7 +15,6 @@
 #include "focal/core/error.h"
 #include "focal/curvature/estimate.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/tiles/tiles.h"
 #include "test_meshes.h"
 
 namespace focal {
@@ -81,8 +82,10 @@ void expect_identical(const CurvatureResult& a, const CurvatureResult& b, const 
                  same(a.K[i], b.K[i]) && same(a.residual[i], b.residual[i]) &&
                  a.point_class[i] == b.point_class[i] && a.rays_used[i] == b.rays_used[i] &&
                  a.rays_excluded[i] == b.rays_excluded[i];
-    for (int c = 0; c < 3; ++c) equal &= same(a.d1(i, c), b.d1(i, c)) && same(a.d2(i, c), b.d2(i, c));
-    ASSERT_TRUE(equal) << what << ": vertex " << i << " differs: k1 " << a.k1[i] << " vs " << b.k1[i];
+    for (int c = 0; c < 3; ++c)
+      equal &= same(a.d1(i, c), b.d1(i, c)) && same(a.d2(i, c), b.d2(i, c));
+    ASSERT_TRUE(equal) << what << ": vertex " << i << " differs: k1 " << a.k1[i] << " vs "
+                       << b.k1[i];
   }
 }
 
@@ -95,7 +98,8 @@ std::vector<Case> all_options() {
   std::vector<Case> cases{{"recommended", {}}};
   EstimateOptions paper{.estimator = Estimator::paper};
   cases.push_back({"paper", paper});
-  for (auto [source, name] : {std::pair{NormalsSource::area, "area"}, {NormalsSource::angle, "angle"},
+  for (auto [source, name] : {std::pair{NormalsSource::area, "area"},
+                              {NormalsSource::angle, "angle"},
                               {NormalsSource::max, "max"}}) {
     EstimateOptions o = paper;
     o.normals = source;
@@ -154,8 +158,9 @@ TEST(Tiles, RecommendedOnNoisyPositionsPlansWiderRingsAndStaysIdentical) {
       // 3% and 10% of the edge length: noise above each threshold of recommended.h (measured).
       EXPECT_EQ(plan.rings, fraction < 0.05 ? 2 : 3) << plan.noise;
       for (bool normals : {false, true}) {
-        expect_tiled_identical(noisy, normals, {}, 173,
-                               "noise " + std::to_string(fraction) + " seed " + std::to_string(seed));
+        expect_tiled_identical(
+            noisy, normals, {}, 173,
+            "noise " + std::to_string(fraction) + " seed " + std::to_string(seed));
       }
     }
   }

@@ -19,6 +19,7 @@
 #include <string>
 #include <utility>
 
+#include "ext_common.h"
 #include "focal/core/error.h"
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
@@ -35,63 +36,13 @@ using namespace nb::literals;
 
 namespace {
 
-using DoubleRows = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
-using IntRows = nb::ndarray<const std::int32_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
-
-using ConstMapX3d = Eigen::Map<const focal::RowMatrixX3d>;
-using ConstMapX3i = Eigen::Map<const focal::RowMatrixX3i>;
-
-ConstMapX3d view(const DoubleRows& a) {
-  return ConstMapX3d(a.data(), static_cast<Eigen::Index>(a.shape(0)), 3);
-}
-ConstMapX3i view(const IntRows& a) {
-  return ConstMapX3i(a.data(), static_cast<Eigen::Index>(a.shape(0)), 3);
-}
+using namespace focal_ext;
 
 // The Python exception types (python/focal/_errors.py), set once by the package at import.
 PyObject* invalid_input_error = nullptr;
 PyObject* io_error = nullptr;
 PyObject* device_error = nullptr;
 PyObject* focal_error = nullptr;
-
-// A matrix or vector moved to the heap and given to NumPy, which frees it through the capsule.
-template <class Matrix>
-nb::object to_numpy(Matrix&& m) {
-  using M = std::decay_t<Matrix>;
-  using Scalar = typename M::Scalar;
-  auto* owned = new M(std::forward<Matrix>(m));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<M*>(p); });
-  if constexpr (M::ColsAtCompileTime == 1) {
-    const size_t shape[1] = {static_cast<size_t>(owned->rows())};
-    return nb::cast(nb::ndarray<nb::numpy, Scalar>(owned->data(), 1, shape, owner));
-  } else {
-    static_assert(M::IsRowMajor, "results are row-major n x 3");
-    const size_t shape[2] = {static_cast<size_t>(owned->rows()),
-                             static_cast<size_t>(owned->cols())};
-    return nb::cast(nb::ndarray<nb::numpy, Scalar>(owned->data(), 2, shape, owner));
-  }
-}
-
-template <class Matrix>
-nb::object optional_to_numpy(std::optional<Matrix>&& m) {
-  if (!m) return nb::none();
-  return to_numpy(std::move(*m));
-}
-
-nb::dict curvature_dict(focal::CurvatureResult&& r) {
-  nb::dict d;
-  d["k1"] = to_numpy(std::move(r.k1));
-  d["k2"] = to_numpy(std::move(r.k2));
-  d["H"] = to_numpy(std::move(r.H));
-  d["K"] = to_numpy(std::move(r.K));
-  d["d1"] = to_numpy(std::move(r.d1));
-  d["d2"] = to_numpy(std::move(r.d2));
-  d["residual"] = to_numpy(std::move(r.residual));
-  d["point_class"] = to_numpy(std::move(r.point_class));
-  d["rays_used"] = to_numpy(std::move(r.rays_used));
-  d["rays_excluded"] = to_numpy(std::move(r.rays_excluded));
-  return d;
-}
 
 nb::dict mesh_dict(focal::Mesh&& mesh) {
   nb::dict d;
@@ -119,52 +70,6 @@ focal::NormalWeighting parse_weighting(const std::string& s) {
       {"angle", focal::NormalWeighting::angle},
       {"max", focal::NormalWeighting::max}};
   return parse_enum(s, "weighting", names);
-}
-
-/// The options of focal::estimate from the keywords of focal.curvature (python/focal/__init__.py
-/// documents them and checks which estimator they belong to).
-focal::EstimateOptions estimate_options(const nb::dict& o) {
-  static const std::pair<const char*, focal::Estimator> estimators[] = {
-      {"recommended", focal::Estimator::recommended}, {"paper", focal::Estimator::paper}};
-  static const std::pair<const char*, focal::NormalsSource> sources[] = {
-      {"auto", focal::NormalsSource::automatic},
-      {"file", focal::NormalsSource::file},
-      {"area", focal::NormalsSource::area},
-      {"angle", focal::NormalsSource::angle},
-      {"max", focal::NormalsSource::max}};
-  static const std::pair<const char*, focal::Method> methods[] = {
-      {"vertex", focal::Method::vertex}, {"triangle", focal::Method::triangle}};
-  static const std::pair<const char*, focal::Solver> solvers[] = {
-      {"closed-form", focal::Solver::closed_form},
-      {"levenberg-marquardt", focal::Solver::levenberg_marquardt}};
-  static const std::pair<const char*, focal::RayWeighting> weights[] = {
-      {"uniform", focal::RayWeighting::uniform}, {"gaussian", focal::RayWeighting::gaussian}};
-
-  focal::EstimateOptions e;
-  e.estimator = parse_enum(nb::cast<std::string>(o["estimator"]), "estimator", estimators);
-  e.normals = parse_enum(nb::cast<std::string>(o["normals"]), "normals", sources);
-  const int threads = nb::cast<int>(o["threads"]);
-  focal::CurvatureOptions& p = e.paper;
-  p.method = parse_enum(nb::cast<std::string>(o["method"]), "method", methods);
-  p.solver = parse_enum(nb::cast<std::string>(o["solver"]), "solver", solvers);
-  p.rings = nb::cast<int>(o["rings"]);
-  p.weighting = parse_enum(nb::cast<std::string>(o["ray_weighting"]), "ray_weighting", weights);
-  p.gaussian_width = nb::cast<double>(o["gaussian_width"]);
-  p.levenberg_marquardt.initial_angles = nb::cast<int>(o["lm_initial_angles"]);
-  p.levenberg_marquardt.max_iterations = nb::cast<int>(o["lm_max_iterations"]);
-  p.levenberg_marquardt.tolerance = nb::cast<double>(o["lm_tolerance"]);
-  p.zero_tolerance = nb::cast<double>(o["zero_tolerance"]);
-  p.umbilic_tolerance = nb::cast<double>(o["umbilic_tolerance"]);
-  p.threads = threads;
-  focal::RecommendedOptions& r = e.recommended;
-  r.noise_for_two_rings = nb::cast<double>(o["noise_for_two_rings"]);
-  r.noise_for_three_rings = nb::cast<double>(o["noise_for_three_rings"]);
-  r.file_agreement = nb::cast<double>(o["file_agreement"]);
-  r.outlier_disagreement = nb::cast<double>(o["outlier_disagreement"]);
-  r.zero_tolerance = p.zero_tolerance;
-  r.umbilic_tolerance = p.umbilic_tolerance;
-  r.threads = threads;
-  return e;
 }
 
 nb::dict default_options() {
@@ -358,6 +263,71 @@ nb::dict generate_surface(const std::string& kind, const std::string& triangulat
 
 }  // namespace
 
+namespace focal_ext {
+
+nb::dict curvature_dict(focal::CurvatureResult&& r) {
+  nb::dict d;
+  d["k1"] = to_numpy(std::move(r.k1));
+  d["k2"] = to_numpy(std::move(r.k2));
+  d["H"] = to_numpy(std::move(r.H));
+  d["K"] = to_numpy(std::move(r.K));
+  d["d1"] = to_numpy(std::move(r.d1));
+  d["d2"] = to_numpy(std::move(r.d2));
+  d["residual"] = to_numpy(std::move(r.residual));
+  d["point_class"] = to_numpy(std::move(r.point_class));
+  d["rays_used"] = to_numpy(std::move(r.rays_used));
+  d["rays_excluded"] = to_numpy(std::move(r.rays_excluded));
+  return d;
+}
+
+/// The options of focal::estimate from the keywords of focal.curvature (python/focal/__init__.py
+/// documents them and checks which estimator they belong to).
+focal::EstimateOptions estimate_options(const nb::dict& o) {
+  static const std::pair<const char*, focal::Estimator> estimators[] = {
+      {"recommended", focal::Estimator::recommended}, {"paper", focal::Estimator::paper}};
+  static const std::pair<const char*, focal::NormalsSource> sources[] = {
+      {"auto", focal::NormalsSource::automatic},
+      {"file", focal::NormalsSource::file},
+      {"area", focal::NormalsSource::area},
+      {"angle", focal::NormalsSource::angle},
+      {"max", focal::NormalsSource::max}};
+  static const std::pair<const char*, focal::Method> methods[] = {
+      {"vertex", focal::Method::vertex}, {"triangle", focal::Method::triangle}};
+  static const std::pair<const char*, focal::Solver> solvers[] = {
+      {"closed-form", focal::Solver::closed_form},
+      {"levenberg-marquardt", focal::Solver::levenberg_marquardt}};
+  static const std::pair<const char*, focal::RayWeighting> weights[] = {
+      {"uniform", focal::RayWeighting::uniform}, {"gaussian", focal::RayWeighting::gaussian}};
+
+  focal::EstimateOptions e;
+  e.estimator = parse_enum(nb::cast<std::string>(o["estimator"]), "estimator", estimators);
+  e.normals = parse_enum(nb::cast<std::string>(o["normals"]), "normals", sources);
+  const int threads = nb::cast<int>(o["threads"]);
+  focal::CurvatureOptions& p = e.paper;
+  p.method = parse_enum(nb::cast<std::string>(o["method"]), "method", methods);
+  p.solver = parse_enum(nb::cast<std::string>(o["solver"]), "solver", solvers);
+  p.rings = nb::cast<int>(o["rings"]);
+  p.weighting = parse_enum(nb::cast<std::string>(o["ray_weighting"]), "ray_weighting", weights);
+  p.gaussian_width = nb::cast<double>(o["gaussian_width"]);
+  p.levenberg_marquardt.initial_angles = nb::cast<int>(o["lm_initial_angles"]);
+  p.levenberg_marquardt.max_iterations = nb::cast<int>(o["lm_max_iterations"]);
+  p.levenberg_marquardt.tolerance = nb::cast<double>(o["lm_tolerance"]);
+  p.zero_tolerance = nb::cast<double>(o["zero_tolerance"]);
+  p.umbilic_tolerance = nb::cast<double>(o["umbilic_tolerance"]);
+  p.threads = threads;
+  focal::RecommendedOptions& r = e.recommended;
+  r.noise_for_two_rings = nb::cast<double>(o["noise_for_two_rings"]);
+  r.noise_for_three_rings = nb::cast<double>(o["noise_for_three_rings"]);
+  r.file_agreement = nb::cast<double>(o["file_agreement"]);
+  r.outlier_disagreement = nb::cast<double>(o["outlier_disagreement"]);
+  r.zero_tolerance = p.zero_tolerance;
+  r.umbilic_tolerance = p.umbilic_tolerance;
+  r.threads = threads;
+  return e;
+}
+
+}  // namespace focal_ext
+
 NB_MODULE(_focal_ext, m) {
   m.doc() = "focal's C++ library (the focal package wraps it; use that).";
 
@@ -396,4 +366,5 @@ NB_MODULE(_focal_ext, m) {
         "N"_a.none().noconvert());
   m.def("generate_surface", &generate_surface, "kind"_a, "triangulation"_a, "target_vertices"_a,
         "seed"_a, "a"_a, "b"_a, "c"_a);
+  bind_tiles(m);
 }

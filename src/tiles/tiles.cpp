@@ -152,7 +152,8 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
   detail::check_face_indices(V.rows(), F, "partition_mesh");
   const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, options.threads);
   const std::vector<int> order = morton_order(V, options.threads);
-  Marks marks{std::vector<int>(order.size(), -1), std::vector<int>(static_cast<std::size_t>(F.rows()), -1)};
+  Marks marks{std::vector<int>(order.size(), -1),
+              std::vector<int>(static_cast<std::size_t>(F.rows()), -1)};
   Tiling out;
   out.halo_rings = halo_rings;
   const auto step = static_cast<std::size_t>(options.tile_vertices);
@@ -161,8 +162,8 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
     std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
                            order.begin() + static_cast<std::ptrdiff_t>(last));
     std::sort(owned.begin(), owned.end());
-    out.tiles.push_back(make_tile(std::move(owned), F, inc, halo_rings,
-                                  static_cast<int>(out.tiles.size()), marks));
+    out.tiles.push_back(
+        make_tile(std::move(owned), F, inc, halo_rings, static_cast<int>(out.tiles.size()), marks));
   }
   return out;
 }
@@ -184,7 +185,8 @@ TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, c
       const int v = F(tile.faces[static_cast<std::size_t>(f)], c);
       const auto at = std::lower_bound(tile.vertices.begin(), tile.vertices.end(), v);
       if (at == tile.vertices.end() || *at != v) {
-        throw InvalidInput("extract_tile: face " + std::to_string(tile.faces[static_cast<std::size_t>(f)]) +
+        throw InvalidInput("extract_tile: face " +
+                           std::to_string(tile.faces[static_cast<std::size_t>(f)]) +
                            " has corner " + std::to_string(v) + ", which is not in the tile");
       }
       out.F(f, c) = static_cast<int>(at - tile.vertices.begin());
@@ -226,9 +228,8 @@ CurvatureResult estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& 
       partition_mesh(mesh.V(), F, estimate_reach(options_for_part(options, choices)), tiles);
   CurvatureResult out = detail::unwritten_result(mesh.vertex_count());
   for (const Tile& tile : tiling.tiles) {
-    const CurvatureResult part =
-        estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile), choices, options,
-                      tiles.threads);
+    const CurvatureResult part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
+                                               choices, options, tiles.threads);
     scatter_rows(part, tile.owned, tile.vertices, out);
   }
   return out;

@@ -33,8 +33,9 @@ struct TileOptions {
 /// One tile: global ids, ascending.
 struct Tile {
   std::vector<int> vertices;  ///< owned and halo vertices
-  std::vector<int> faces;     ///< every face with a corner within halo_rings - 1 rings of an owned vertex
-  std::vector<int> owned;     ///< positions in `vertices` of the owned ones
+  std::vector<int>
+      faces;  ///< every face with a corner within halo_rings - 1 rings of an owned vertex
+  std::vector<int> owned;  ///< positions in `vertices` of the owned ones
 };
 
 /// The tiles of a mesh: every vertex is owned by exactly one tile.
