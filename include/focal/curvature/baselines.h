@@ -6,8 +6,8 @@
 /// the faces, sphere of radius r: k1 = k2 = +1/r, d1 of k1, (d1, d2, n) right-handed where n is
 /// the area-weighted vertex normal) and the same classes and tolerances.
 
-#include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
+#include "focal/core/mesh.h"
 
 namespace focal::baselines {
 
