@@ -207,10 +207,11 @@ int estimate_reach(const EstimateOptions& options) {
 
 MeshWideChoices mesh_wide_choices(const PreparedMesh& mesh, const EstimateOptions& options) {
   // The normals the whole estimate would fit are needed only where they decide something
-  // mesh-wide: the file's (filled, made unit) for the recommended estimator's comparison.
+  // mesh-wide: the file's (filled, made unit) for the recommended estimator's comparison. Each
+  // tile prepares its own from its rows (the fixes are per row).
   PreparedNormals prepared;
   if (uses_mesh_normals(mesh, options.normals)) {
-    prepared = prepare_normals(mesh, options);
+    if (options.estimator == Estimator::recommended) prepared = prepare_normals(mesh, options);
   } else if (options.orient_faces) {
     orient_faces_outward(mesh, prepared);
   }
