@@ -14,6 +14,7 @@ Prints, for one mesh in one run (so that the times are comparable on a shared ma
 import argparse
 import os
 import resource
+import threading
 import time
 
 import numpy as np
@@ -27,6 +28,34 @@ def peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+def worker_rss_mb() -> float:
+    import psutil
+
+    return psutil.Process().memory_info().rss / 2**20
+
+
+class RssSampler:
+    """The largest RSS of every worker, sampled in a thread while a block runs."""
+
+    def __init__(self, client, period: float = 0.2):
+        self.client, self.period, self.peak = client, period, {}
+        self.done = threading.Event()
+
+    def run(self) -> None:
+        while not self.done.wait(self.period):
+            for w, mb in self.client.run(worker_rss_mb).items():
+                self.peak[w] = max(self.peak.get(w, 0.0), mb)
+
+    def __enter__(self):
+        self.thread = threading.Thread(target=self.run, daemon=True)
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.done.set()
+        self.thread.join()
+
+
 def main() -> None:
     p = argparse.ArgumentParser()
     p.add_argument("mesh")
@@ -38,6 +67,12 @@ def main() -> None:
     args = p.parse_args()
     from distributed import Client, LocalCluster
 
+    # Started before the mesh is read, so that the workers do not start as copies of a large driver.
+    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                           memory_limit=args.memory_limit, dashboard_address=":0")
+    client = Client(cluster)
+    client.run(lambda: __import__("focal"))  # import once, outside the timing
+    idle = client.run(worker_rss_mb)
     t = time.perf_counter()
     m = focal.read_mesh(args.mesh)
     print(f"read     {len(m.V):,} vertices, {len(m.F):,} faces in {time.perf_counter() - t:.2f} s"
@@ -77,23 +112,18 @@ def main() -> None:
               f"bit-identical: {same}")
     del plan
 
-    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                           memory_limit=args.memory_limit, dashboard_address=":0")
-    client = Client(cluster)
-    client.run(lambda: __import__("focal"))  # import once, outside the timing
-    t = time.perf_counter()
-    tiled = fd.curvature(m, client, tile_vertices=args.tile_vertices, threads=1,
-                         estimator=args.estimator)
-    t_tiled = time.perf_counter() - t
-    peaks = client.run(lambda: __import__("resource").getrusage(
-        __import__("resource").RUSAGE_SELF).ru_maxrss / 1024.0)
+    with RssSampler(client) as sampler:
+        t = time.perf_counter()
+        tiled = fd.curvature(m, client, tile_vertices=args.tile_vertices, threads=1,
+                             estimator=args.estimator)
+        t_tiled = time.perf_counter() - t
     line = f"tiled    {t_tiled:.2f} s"
     if single is not None:
         same = all(getattr(tiled, n).tobytes() == single[n].tobytes() for n in fd.FIELDS)
         line += f" = {t_tiled / t_single:.2f} x single; bit-identical: {same}"
     print(line)
-    print("workers  peak RSS " + ", ".join(f"{v:.0f} MB" for v in peaks.values()) +
-          f" (limit {args.memory_limit} each)")
+    print("workers  peak RSS " + ", ".join(f"{v:.0f} MB" for v in sampler.peak.values()) +
+          f" (idle {max(idle.values()):.0f} MB; limit {args.memory_limit} each)")
     client.close()
     cluster.close()
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fields_detail.h"
 #include "core/parallel.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
@@ -210,18 +211,6 @@ bool file_normals_agree(double median_angle, double noise, double agreement) {
 /// meet two slits exactly (spheres, cylinders, planes), and so does the fit.
 constexpr double kExactFitResidual = 1e-9;
 
-void copy_vertex(const CurvatureResult& from, Eigen::Index i, CurvatureResult& to) {
-  for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
-                     &CurvatureResult::K, &CurvatureResult::residual}) {
-    (to.*field)[i] = (from.*field)[i];
-  }
-  to.d1.row(i) = from.d1.row(i);
-  to.d2.row(i) = from.d2.row(i);
-  to.point_class[i] = from.point_class[i];
-  to.rays_used[i] = from.rays_used[i];
-  to.rays_excluded[i] = from.rays_excluded[i];
-}
-
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
@@ -234,7 +223,7 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureRes
   detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
     const bool exact_fit = fit.residual[i] <= kExactFitResidual;
     const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) copy_vertex(triangles, i, fit);
+    if (!exact_fit && triangles_defined) detail::copy_row(triangles, i, fit, i);
   });
 }
 

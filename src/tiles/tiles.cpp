@@ -236,18 +236,7 @@ CurvatureResult estimate_tile(const TileMesh& tile, const MeshWideChoices& choic
 
 void scatter_rows(const CurvatureResult& part, const std::vector<int>& rows,
                   const std::vector<int>& ids, CurvatureResult& whole) {
-  for (const int r : rows) {
-    const int i = ids[static_cast<std::size_t>(r)];
-    for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
-                       &CurvatureResult::K, &CurvatureResult::residual}) {
-      (whole.*field)[i] = (part.*field)[r];
-    }
-    whole.d1.row(i) = part.d1.row(r);
-    whole.d2.row(i) = part.d2.row(r);
-    whole.point_class[i] = part.point_class[r];
-    whole.rays_used[i] = part.rays_used[r];
-    whole.rays_excluded[i] = part.rays_excluded[r];
-  }
+  for (const int r : rows) detail::copy_row(part, r, whole, ids[static_cast<std::size_t>(r)]);
 }
 
 CurvatureResult estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& options,
