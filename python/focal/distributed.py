@@ -23,6 +23,7 @@ import os
 import sys
 import tempfile
 import uuid
+import warnings
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -137,9 +138,14 @@ def curvature(
         def submit(i: int):
             t = tiles[i]
             a = _ext.extract_tile(Va, faces, Na, t["vertices"], t["faces"])
-            fut = client.submit(_estimate_tile, a["V"], a["F"], a["N"], t["owned"], o,
-                                plan["choices"], key=f"focal-tile-{i}-{uuid.uuid4().hex}",
-                                retries=retries)
+            # The arrays travel inside the task, not scattered ahead: Dask can then rerun the
+            # task elsewhere when its worker dies (scattered data would die with the worker).
+            # Dask warns about such tasks ("Sending large graph"); here that is the intent.
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Sending large graph")
+                fut = client.submit(_estimate_tile, a["V"], a["F"], a["N"], t["owned"], o,
+                                    plan["choices"], key=f"focal-tile-{i}-{uuid.uuid4().hex}",
+                                    retries=retries)
             tile_of[fut.key] = i
             return fut
 

@@ -102,19 +102,27 @@ struct Marks {
   std::vector<int> vertex, face;
 };
 
-/// The tile owning `owned` (global ids, ascending): the vertices within halo_rings - 1 rings by a
-/// breadth-first search over the faces, then all their faces and those faces' corners.
+/// The tile owning `owned` (global ids, ascending): ring by ring, the faces of the vertices
+/// found so far and those faces' corners, halo_rings times. Round r takes the faces of the
+/// vertices r - 1 rings out, so the faces are those with a corner within halo_rings - 1 rings
+/// and the vertices are those within halo_rings rings; each vertex and face is visited once.
 Tile make_tile(std::vector<int> owned_ids, FacesRef F, const detail::VertexFaces& inc,
                int halo_rings, int stamp, Marks& marks) {
   std::vector<int> reached = owned_ids;
   for (int v : reached) marks.vertex[static_cast<std::size_t>(v)] = stamp;
+  Tile tile;
   std::size_t ring_begin = 0;
-  for (int ring = 1; ring < halo_rings; ++ring) {
+  for (int ring = 1; ring <= halo_rings; ++ring) {
     const std::size_t ring_end = reached.size();
     for (std::size_t k = ring_begin; k < ring_end; ++k) {
       const int v = reached[k];
       for (int j = inc.begin(v); j < inc.end(v); ++j) {
-        detail::for_each_distinct_corner(F, inc.faces[static_cast<std::size_t>(j)], [&](int w) {
+        const int f = inc.faces[static_cast<std::size_t>(j)];
+        int& face_mark = marks.face[static_cast<std::size_t>(f)];
+        if (face_mark == stamp) continue;  // its corners are marked already
+        face_mark = stamp;
+        tile.faces.push_back(f);
+        detail::for_each_distinct_corner(F, f, [&](int w) {
           int& m = marks.vertex[static_cast<std::size_t>(w)];
           if (m != stamp) {
             m = stamp;
@@ -124,27 +132,6 @@ Tile make_tile(std::vector<int> owned_ids, FacesRef F, const detail::VertexFaces
       }
     }
     ring_begin = ring_end;
-  }
-  Tile tile;
-  // The corners appended below lie beyond the searched rings: their faces do not belong.
-  const std::size_t searched = reached.size();
-  for (std::size_t k = 0; k < searched; ++k) {
-    const int v = reached[k];
-    for (int j = inc.begin(v); j < inc.end(v); ++j) {
-      const int f = inc.faces[static_cast<std::size_t>(j)];
-      int& m = marks.face[static_cast<std::size_t>(f)];
-      if (m == stamp) continue;
-      m = stamp;
-      tile.faces.push_back(f);
-      // The outer corners: reached by no search yet.
-      detail::for_each_distinct_corner(F, f, [&](int w) {
-        int& mv = marks.vertex[static_cast<std::size_t>(w)];
-        if (mv != stamp) {
-          mv = stamp;
-          reached.push_back(w);
-        }
-      });
-    }
   }
   sort_ids(tile.faces);
   tile.vertices = std::move(reached);
