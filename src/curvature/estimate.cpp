@@ -189,10 +189,6 @@ Estimate estimate(const PreparedMesh& mesh, const EstimateOptions& options) {
   return estimate(mesh, prepare_normals(mesh, options), options);
 }
 
-}  // namespace focal
-
-namespace focal {
-
 int estimate_reach(const EstimateOptions& options) {
   if (options.estimator == Estimator::recommended) {
     // Without the mesh's choices, the widest plan (3 rings) bounds every plan's reach.
