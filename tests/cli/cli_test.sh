@@ -168,6 +168,19 @@ run --version
 check "focal --version prints the version" bash -c '[[ $2 -eq 0 ]] && grep -qx "focal 0.1.0" "$1"' _ "$OUT" "$rc"
 
 # ---------------------------------------------------------------------------------------------
+# Devices: the backend, driver and GPUs, or why none is usable; --require turns "none" into
+# exit 2 (on a GPU machine it exits 0, as FOCAL_REQUIRE_GPU=1 runs of the suite expect).
+run devices
+check "focal devices exits 0 and names the backend" \
+  bash -c '[[ $2 -eq 0 ]] && grep -q "^CUDA backend: " "$1"' _ "$OUT" "$rc"
+if grep -q "^usable devices: *none: " "$OUT"; then
+  expect_error "focal devices --require without a usable GPU: exit 2 saying why" 2 "no usable CUDA device: " "" devices --require
+else
+  run devices --require
+  check "focal devices --require with a usable GPU exits 0" test "$rc" -eq 0
+fi
+
+# ---------------------------------------------------------------------------------------------
 # The test surface
 run generate sphere -o s.ply --truth t.csv
 check "generate sphere exits 0 and reports what it wrote" \
