@@ -314,5 +314,24 @@ TEST(Baselines, MidEdgeShapeOperator) {
   }
 }
 
+// Dirty input: two non-finite vertices, a duplicate and a zero-area face. The new baselines leave
+// exactly the two bad vertices undefined and compute every other one.
+TEST(Baselines, DirtyInputLeavesOnlyTheBadVerticesUndefined) {
+  Mesh m = surface(SurfaceKind::torus, Triangulation::irregular, 2000).mesh;
+  m.V(5, 0) = NAN;
+  m.V(9, 1) = INFINITY;
+  m.F.conservativeResize(m.F.rows() + 2, 3);
+  m.F.row(m.F.rows() - 2) = m.F.row(0);
+  m.F.row(m.F.rows() - 1) << 1, 1, 2;
+  const std::vector<CurvatureResult> results = {
+      baselines::lachaud_2020(m.V, m.F, m.normals()), baselines::lachaud_2020(m.V, m.F),
+      baselines::yang_2006(m.V, m.F), baselines::grinspun_2006(m.V, m.F)};
+  for (const CurvatureResult& r : results) {
+    EXPECT_EQ(r.class_of(5), PointClass::undefined);
+    EXPECT_EQ(r.class_of(9), PointClass::undefined);
+    EXPECT_EQ(r.H.array().isFinite().count(), m.V.rows() - 2);
+  }
+}
+
 }  // namespace
 }  // namespace focal

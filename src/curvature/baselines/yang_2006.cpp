@@ -80,14 +80,16 @@ Moments ball_moments(PositionsRef V, FacesRef F, const std::vector<int>& faces,
   return m;
 }
 
-/// The area-weighted normal of vertex i (sum of its faces' cross products), not normalised.
+/// The area-weighted normal of vertex i (sum of its finite faces' cross products), not normalised.
 Eigen::Vector3d area_normal(PositionsRef V, FacesRef F, const focal::detail::VertexFaces& inc,
                             std::int64_t i) {
   Eigen::Vector3d n = Eigen::Vector3d::Zero();
   for (int k = inc.begin(i); k < inc.end(i); ++k) {
     const int f = inc.faces[k];
     const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    n += (b - a).cross(c - a);
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    if (cross.allFinite())
+      n += cross;  // a non-finite corner leaves its faces out, as the clip does
   }
   return n;
 }
