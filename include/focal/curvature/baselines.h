@@ -4,8 +4,9 @@
 /// compares with (section 6), the two its section 7 names as future comparisons (integral
 /// invariants, the mid-edge shape operator) and the interpolated corrected curvature measures.
 /// All return the same CurvatureResult as the focal estimator, with the same conventions (outward
-/// orientation from the faces, sphere of radius r: k1 = k2 = +1/r, d1 of k1, (d1, d2, n)
-/// right-handed where n is the area-weighted vertex normal) and the same classes and tolerances.
+/// orientation from the faces, or from the given normals for LRTC20; sphere of radius r:
+/// k1 = k2 = +1/r, d1 of k1, (d1, d2, n) right-handed where n is the vertex normal, the
+/// area-weighted one unless a function names another) and the same classes and tolerances.
 
 #include <optional>
 
@@ -54,7 +55,7 @@ struct BallOptions {
 /// the ball: 1 with its three corners inside, 0 with none, else (r - d_min) / (d_max - d_min),
 /// d the corners' distances to x_i (linear in the distance; triangles reached from x_i through
 /// corners inside the ball). H = mu1 / (2 mu0), K = mu2 / mu0 (stored as they are, not as
-/// k1 k2); k1, k2, d1, d2 from the symmetrised muXY / mu0 projected to the plane of u_i.
+/// k1 k2); k1, k2, d1, d2 from -sym(muXY) / mu0 projected to the plane of u_i (n = u_i).
 /// \param N #V x 3 outward normals (normalised per row), or std::nullopt for Max's (1999)
 ///        face-weighted normals.
 /// Ball: default radius 1 mean edge length (docs/ESTIMATOR.md, "Baselines"). Uses

@@ -78,6 +78,26 @@ double fraction_in_ball(PositionsRef V, FacesRef F, int f, const Eigen::Vector3d
   return (r - near) / (far - near);
 }
 
+/// The measures of the ball: the faces reached, each weighted by its fraction inside.
+Measures ball_measures(PositionsRef V, FacesRef F, const std::vector<Measures>& face,
+                       const std::vector<int>& reached, const Eigen::Vector3d& centre, double r) {
+  Measures sum;
+  for (int f : reached) {
+    const Measures& m = face[static_cast<std::size_t>(f)];
+    if (std::isfinite(m.mu0)) sum.add(m, fraction_in_ball(V, F, f, centre, r));
+  }
+  return sum;
+}
+
+/// k1, k2, d1, d2 of -sym(muXY) / mu0 on the plane of `frame`.
+focal::detail::Principal2 principal_of(const Measures& sum, const TangentFrame& frame) {
+  const Eigen::Matrix<double, 3, 2> P =
+      (Eigen::Matrix<double, 3, 2>() << frame.x, frame.y).finished();
+  const Eigen::Matrix2d S =
+      -P.transpose() * (0.5 * (sum.muXY + sum.muXY.transpose())) * P / sum.mu0;
+  return focal::detail::principal_from_symmetric(S(0, 0), S(0, 1), S(1, 1));
+}
+
 /// Unit rows of the given normals, or Max's face-weighted normals.
 RowMatrixX3d corrected_normals(const PreparedMesh& mesh, std::optional<NormalsRef> N) {
   RowMatrixX3d u = N ? RowMatrixX3d(*N) : vertex_normals(mesh, NormalWeighting::max);
@@ -114,20 +134,11 @@ CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRe
   focal::detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     thread_local ball::Scratch scratch;
     ball::gather(V, *one_ring, *incidence, static_cast<int>(i), r, scratch);
-    const Eigen::Vector3d centre = V.row(i), normal = u.row(i);
-    Measures sum;
-    for (int f : scratch.faces) {
-      const Measures& m = face[static_cast<std::size_t>(f)];
-      if (std::isfinite(m.mu0)) sum.add(m, fraction_in_ball(V, F, f, centre, r));
-    }
+    const Eigen::Vector3d normal = u.row(i);
+    const Measures sum = ball_measures(V, F, face, scratch.faces, V.row(i), r);
     if (!(sum.mu0 > 0.0) || !normal.allFinite()) return;
     const TangentFrame frame = tangent_frame(normal);
-    const Eigen::Matrix<double, 3, 2> P =
-        (Eigen::Matrix<double, 3, 2>() << frame.x, frame.y).finished();
-    const Eigen::Matrix2d S =
-        -P.transpose() * (0.5 * (sum.muXY + sum.muXY.transpose())) * P / sum.mu0;
-    const focal::detail::Principal2 p =
-        focal::detail::principal_from_symmetric(S(0, 0), S(0, 1), S(1, 1));
+    const focal::detail::Principal2 p = principal_of(sum, frame);
     const double H = 0.5 * sum.mu1 / sum.mu0;
     // Residual: how far the anisotropic measure's mean curvature is from mu1's.
     focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);

@@ -94,6 +94,38 @@ Eigen::Vector3d area_normal(PositionsRef V, FacesRef F, const focal::detail::Ver
   return n;
 }
 
+/// The curvature read from the patch's moments (see the top of this file).
+struct PatchCurvature {
+  TangentFrame frame;  ///< n: the covariance's eigenvector of the smallest eigenvalue
+  focal::detail::Principal2 principal;
+  double residual;  ///< how far the variance is from any real pair (k1, k2); 0 when consistent
+};
+
+std::optional<PatchCurvature> patch_curvature(const Moments& m, const Eigen::Vector3d& orientation,
+                                              double r) {
+  const Eigen::Vector3d centroid = m.first / m.area;
+  const Eigen::Matrix3d C = m.second - m.area * centroid * centroid.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);  // ascending: n, then tangents
+  if (eig.info() != Eigen::Success) return std::nullopt;
+  Eigen::Vector3d n = eig.eigenvectors().col(0);
+  if (n.dot(orientation) < 0.0) n = -n;
+  const double r2 = r * r, r6 = r2 * r2 * r2;
+  const double sum = -8.0 * centroid.dot(n) / r2;  // k1 + k2
+  const double product =
+      (3.0 * sum * sum - 192.0 * eig.eigenvalues()[0] / (std::numbers::pi * r6)) / 8.0;
+  const double disc = sum * sum - 4.0 * product;
+  const double half_gap = 0.5 * std::sqrt(std::max(disc, 0.0));
+  PatchCurvature out{tangent_frame(n), {}, std::sqrt(std::max(-disc, 0.0))};
+  out.principal.k1 = 0.5 * sum + half_gap;
+  out.principal.k2 = 0.5 * sum - half_gap;
+  // The larger |k| bends the patch most along its direction: the smaller tangent variance.
+  const bool k1_steeper = std::abs(out.principal.k1) >= std::abs(out.principal.k2);
+  const Eigen::Vector3d d1 = eig.eigenvectors().col(k1_steeper ? 1 : 2);
+  out.principal.d1 = out.frame.to_plane(d1).normalized();
+  out.principal.d2 = Eigen::Vector2d(-out.principal.d1.y(), out.principal.d1.x());
+  return out;
+}
+
 }  // namespace
 
 CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball,
@@ -106,36 +138,15 @@ CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball,
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  const double r2 = r * r, r6 = r2 * r2 * r2;
   focal::detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     thread_local ball::Scratch scratch;
     ball::gather(V, *one_ring, *incidence, static_cast<int>(i), r, scratch);
     const Moments m = ball_moments(V, F, scratch.faces, V.row(i), r);
     const Eigen::Vector3d orientation = area_normal(V, F, *incidence, i);
     if (!(m.area > 0.0) || !(r > 0.0) || !(orientation.norm() > 0.0)) return;
-    const Eigen::Vector3d centroid = m.first / m.area;
-    const Eigen::Matrix3d C = m.second - m.area * centroid * centroid.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);  // ascending: n, then tangents
-    if (eig.info() != Eigen::Success) return;
-    Eigen::Vector3d n = eig.eigenvectors().col(0);
-    if (n.dot(orientation) < 0.0) n = -n;
-    const double sum = -8.0 * centroid.dot(n) / r2;  // k1 + k2
-    const double product =
-        (3.0 * sum * sum - 192.0 * eig.eigenvalues()[0] / (std::numbers::pi * r6)) / 8.0;
-    const double disc = sum * sum - 4.0 * product;
-    const double half_gap = 0.5 * std::sqrt(std::max(disc, 0.0));
-    const double ka = 0.5 * sum + half_gap, kb = 0.5 * sum - half_gap;
-    // The larger |k| bends the patch most along its direction: the smaller tangent variance.
-    const Eigen::Vector3d steep = eig.eigenvectors().col(1), flat = eig.eigenvectors().col(2);
-    const bool a_steep = std::abs(ka) >= std::abs(kb);
-    const TangentFrame frame = tangent_frame(n);
-    focal::detail::Principal2 p;
-    p.k1 = ka;
-    p.k2 = kb;
-    p.d1 = frame.to_plane(a_steep ? steep : flat).normalized();
-    p.d2 = Eigen::Vector2d(-p.d1.y(), p.d1.x());
-    // Residual: how far the variance is from any real pair (k1, k2), 0 when consistent.
-    focal::detail::store_vertex(result, i, frame, p, std::sqrt(std::max(-disc, 0.0)), tol);
+    const std::optional<PatchCurvature> c = patch_curvature(m, orientation, r);
+    if (!c) return;
+    focal::detail::store_vertex(result, i, c->frame, c->principal, c->residual, tol);
     result.rays_used[i] = static_cast<int>(scratch.faces.size());  // faces reached
   });
   return result;
