@@ -269,9 +269,10 @@ TEST(Baselines, IntegralInvariantsConvergeOnTheSphere) {
     EXPECT_LE(ef / ec, 0.35) << "coarse " << ec << " fine " << ef;
     const AnalyticSurface s = surface(SurfaceKind::sphere, tri, 2000);
     const CurvatureResult r = baselines::yang_2006(s.mesh.V, s.mesh.F);
-    EXPECT_LE(test::rms_error(r.H, Eigen::VectorXd::Ones(s.mesh.V.rows()), all_vertices(s.mesh)),
-              0.05);
-    EXPECT_GT(r.K.minCoeff(), 0.0);
+    const Eigen::VectorXd one = Eigen::VectorXd::Ones(s.mesh.V.rows());
+    EXPECT_LE(test::rms_error(r.H, one, all_vertices(s.mesh)), 0.05);
+    // K = k1 k2 doubles a relative error of k to first order: 6.1-6.7% measured, bounded by 10%.
+    EXPECT_LE(test::rms_error(r.K, one, all_vertices(s.mesh)), 0.1);
   }
 }
 
@@ -290,7 +291,7 @@ TEST(Baselines, IntegralInvariantsOnTheTorus) {
 // <= 0.35; d1 within 0.04-0.15 degrees, bounded by 1) and does not converge on irregular ones
 // (ratio 0.95-1.02; error 6.5% of the largest curvature measured, bounded by 10%, d1 within 2
 // degrees, bounded by 3). The sphere: relative H error 1.1e-2 regular, 7.8e-2 irregular
-// measured, bounded by 0.02 and 0.12.
+// measured, bounded by 0.02 and 0.12; K's error is twice H's to first order (K = k1 k2).
 TEST(Baselines, MidEdgeShapeOperator) {
   const AnalyticSurface coarse = surface(SurfaceKind::torus, Triangulation::regular, 2000);
   const AnalyticSurface fine = surface(SurfaceKind::torus, Triangulation::regular, 8000);
@@ -308,8 +309,9 @@ TEST(Baselines, MidEdgeShapeOperator) {
     const AnalyticSurface s = surface(SurfaceKind::sphere, tri, 2000);
     const CurvatureResult r = baselines::grinspun_2006(s.mesh.V, s.mesh.F);
     const double bound = tri == Triangulation::regular ? 0.02 : 0.12;
-    EXPECT_LE(test::rms_error(r.H, Eigen::VectorXd::Ones(s.mesh.V.rows()), all_vertices(s.mesh)),
-              bound);
+    const Eigen::VectorXd one = Eigen::VectorXd::Ones(s.mesh.V.rows());
+    EXPECT_LE(test::rms_error(r.H, one, all_vertices(s.mesh)), bound);
+    EXPECT_LE(test::rms_error(r.K, one, all_vertices(s.mesh)), 2 * bound);  // K = k1 k2: twice
     EXPECT_GT(r.H.minCoeff(), 0.0);
   }
 }
