@@ -90,16 +90,37 @@ def _shape_error(name: str, expected: str, got: Any) -> InvalidInputError:
     return InvalidInputError(f"{name} must have shape {expected}, got shape {got}")
 
 
+# DLPack device type of host memory (dlpack.h, kDLCPU).
+_DLPACK_CPU = 1
+
+
+def _array(a: Any, name: str) -> np.ndarray:
+    """``a`` as a NumPy array without copying where its memory allows: ndarrays as they are,
+    DLPack producers on the CPU (PyTorch, JAX, ...) through np.from_dlpack, anything else with
+    np.asarray (``__array_interface__``, buffers, nested lists). Arrays on a GPU are an error."""
+    if isinstance(a, np.ndarray):
+        return a
+    if hasattr(a, "__dlpack_device__"):
+        device_type, device_id = a.__dlpack_device__()
+        if int(device_type) != _DLPACK_CPU:
+            raise InvalidInputError(
+                f"{name} is in device memory (DLPack device type {int(device_type)}, id "
+                f"{int(device_id)}); focal takes host arrays: copy it to the CPU first"
+            )
+        try:
+            return np.from_dlpack(a)
+        except (TypeError, BufferError, RuntimeError):
+            pass  # a dtype DLPack cannot export to NumPy: asarray below
+    try:
+        return np.asarray(a)
+    except (ValueError, TypeError) as e:
+        raise InvalidInputError(f"{name} is not an array: {e}") from None
+
+
 def _as_rows(a: Any, name: str, dtype: type) -> np.ndarray:
     """``a`` as a C-ordered ``(n, 3)`` array of ``dtype``: ``a`` itself when it already is one,
     else one converted copy."""
-    if isinstance(a, np.ndarray):
-        arr = a
-    else:
-        try:
-            arr = np.asarray(a)
-        except (ValueError, TypeError) as e:
-            raise InvalidInputError(f"{name} is not an (n, 3) array: {e}") from None
+    arr = _array(a, name)
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise _shape_error(name, "(n, 3)", arr.shape)
     kind = arr.dtype.kind
@@ -530,7 +551,7 @@ def _normals_for_picture(Va: np.ndarray, Fa: np.ndarray, N: Any) -> np.ndarray:
 
 
 def _vector(a: Any, name: str, n: int, dtype: type) -> np.ndarray:
-    arr = np.asarray(a)
+    arr = _array(a, name)
     if arr.shape != (n,):
         raise _shape_error(name, f"({n},)", arr.shape)
     return np.ascontiguousarray(arr, dtype=dtype)
@@ -646,7 +667,7 @@ def rasterise_gbuffer(
 
 
 def _pixels(a: Any, name: str, channels: int, dtype: type, shape=None) -> np.ndarray:
-    arr = np.asarray(a)
+    arr = _array(a, name)
     expected = "(h, w, 3)" if channels == 3 else "(h, w)"
     if arr.ndim != (3 if channels == 3 else 2) or (channels == 3 and arr.shape[2] != 3):
         raise _shape_error(name, expected, arr.shape)
@@ -688,7 +709,7 @@ def image_space_curvature(
     if mask is None:
         m = np.ones(pos.shape[:2], dtype=np.uint8)
     else:
-        m = _pixels(np.asarray(mask) != 0, "mask", 1, np.uint8, pos.shape[:2])
+        m = _pixels(_array(mask, "mask") != 0, "mask", 1, np.uint8, pos.shape[:2])
     d = _ext.image_space_curvature(pos, nor, m, float(discontinuity_ratio), int(window),
                                    _threads(threads), None if device is None else int(device))
     return ImageCurvature(**d)

@@ -3,6 +3,10 @@
 
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <chrono>
+#include <vector>
 
 #include "bindings.h"
 #include "focal/core/fields.h"
@@ -121,6 +125,13 @@ nb::dict default_options() {
 
 /// The estimate of focal.curvature: the CLI's pipeline (focal::estimate on a PreparedMesh of the
 /// arrays as given).
+focal::Estimate run_estimate(const DoubleRows& V, const IntRows& F,
+                             const std::optional<DoubleRows>& N, const focal::EstimateOptions& o,
+                             int threads) {
+  const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+  return focal::estimate(mesh, o);
+}
+
 nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                    const nb::dict& options) {
   const focal::EstimateOptions o = estimate_options(options);
@@ -128,8 +139,7 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   focal::Estimate e;
   {
     nb::gil_scoped_release release;
-    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
-    e = focal::estimate(mesh, o);
+    e = run_estimate(V, F, N, o, threads);
   }
   nb::dict d = curvature_dict(std::move(e.curvature));
   d["N"] = optional_to_numpy(std::move(e.N));
@@ -150,6 +160,24 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   d["file_disagreement"] = e.file_disagreement;
   d["file_normals_used"] = e.file_normals_used;
   return d;
+}
+
+/// Seconds of each of `repeats` runs of the C++ call under focal.curvature, timed in C++: the
+/// Python call's overhead is measured against it (bench/python/bench.py).
+std::vector<double> estimate_seconds(const DoubleRows& V, const IntRows& F,
+                                     const std::optional<DoubleRows>& N, const nb::dict& options,
+                                     int repeats) {
+  const focal::EstimateOptions o = estimate_options(options);
+  const int threads = nb::cast<int>(options["threads"]);
+  std::vector<double> seconds;
+  nb::gil_scoped_release release;
+  for (int i = 0; i < repeats; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    const focal::Estimate e = run_estimate(V, F, N, o, threads);
+    seconds.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return seconds;
 }
 
 nb::dict focal_mesh_dict(focal::FocalMesh&& m) {
@@ -286,6 +314,8 @@ void bind_meshes(nb::module_& m) {
   m.def("default_options", &default_options);
   m.def("curvature", &curvature, "V"_a.noconvert(), "F"_a.noconvert(), "N"_a.none().noconvert(),
         "options"_a);
+  m.def("_estimate_seconds", &estimate_seconds, "V"_a.noconvert(), "F"_a.noconvert(),
+        "N"_a.none().noconvert(), "options"_a, "repeats"_a);
   m.def("focal_meshes", &focal_meshes, "V"_a.noconvert(), "F"_a.noconvert(),
         "N"_a.none().noconvert(), "options"_a, "max_distance"_a, "drop_faces_at_infinity"_a);
   m.def("check_mesh", &check_mesh, "V"_a.noconvert(), "F"_a.noconvert(), "N"_a.none().noconvert(),
