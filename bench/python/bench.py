@@ -33,9 +33,9 @@ def trueform_principal(V, F, N):
     # trueform's principal curvatures over the k = 2 ring (its tutorial's setting); its sign
     # convention is checked on the sphere by `signs` below and brought to focal's.
     mesh = tf.Mesh(np.ascontiguousarray(F, dtype=np.int32), np.ascontiguousarray(V))
-    k1, k2 = tf.principal_curvatures(mesh, k=2)[:2]
-    k1, k2 = np.maximum(k1, k2) * TRUEFORM_SIGN, np.minimum(k1, k2) * TRUEFORM_SIGN
-    k1, k2 = np.maximum(k1, k2), np.minimum(k1, k2)
+    a, b = (TRUEFORM_SIGN * np.asarray(k, dtype=np.float64)
+            for k in tf.principal_curvatures(mesh, k=2))
+    k1, k2 = np.maximum(a, b), np.minimum(a, b)
     return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2}
 
 
