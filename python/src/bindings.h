@@ -34,27 +34,28 @@ inline ConstMapX3i view(const IntRows& a) {
 }
 
 // A matrix or vector moved to the heap and given to NumPy, which frees it through the capsule.
+// (Returned as an ndarray type, not an object, so that the generated stub says NDArray.)
 template <class Matrix>
-nb::object to_numpy(Matrix&& m) {
+nb::ndarray<nb::numpy, typename std::decay_t<Matrix>::Scalar> to_numpy(Matrix&& m) {
   using M = std::decay_t<Matrix>;
   using Scalar = typename M::Scalar;
   auto* owned = new M(std::forward<Matrix>(m));
   nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<M*>(p); });
   if constexpr (M::ColsAtCompileTime == 1) {
     const size_t shape[1] = {static_cast<size_t>(owned->rows())};
-    return nb::cast(nb::ndarray<nb::numpy, Scalar>(owned->data(), 1, shape, owner));
+    return nb::ndarray<nb::numpy, Scalar>(owned->data(), 1, shape, owner);
   } else {
-    static_assert(M::IsRowMajor, "results are row-major n x 3");
+    static_assert(M::IsRowMajor, "results are row-major n x 3 (or n x 2)");
     const size_t shape[2] = {static_cast<size_t>(owned->rows()),
                              static_cast<size_t>(owned->cols())};
-    return nb::cast(nb::ndarray<nb::numpy, Scalar>(owned->data(), 2, shape, owner));
+    return nb::ndarray<nb::numpy, Scalar>(owned->data(), 2, shape, owner);
   }
 }
 
 template <class Matrix>
 nb::object optional_to_numpy(std::optional<Matrix>&& m) {
   if (!m) return nb::none();
-  return to_numpy(std::move(*m));
+  return nb::cast(to_numpy(std::move(*m)));
 }
 
 template <class Enum, size_t n>
@@ -77,12 +78,12 @@ inline std::optional<focal::NormalsRef> normals_ref(const std::optional<DoubleRo
 /// An image of h * w * channels values as an (h, w) (one channel) or (h, w, channels) array over
 /// its buffer, moved to the heap and freed with the last array.
 template <class T>
-nb::object pixels(std::vector<T>&& values, int height, int width, int channels) {
+nb::ndarray<nb::numpy, T> pixels(std::vector<T>&& values, int height, int width, int channels) {
   auto* owned = new std::vector<T>(std::move(values));
   nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
   const size_t shape[3] = {static_cast<size_t>(height), static_cast<size_t>(width),
                            static_cast<size_t>(channels)};
-  return nb::cast(nb::ndarray<nb::numpy, T>(owned->data(), channels == 1 ? 2 : 3, shape, owner));
+  return nb::ndarray<nb::numpy, T>(owned->data(), channels == 1 ? 2 : 3, shape, owner);
 }
 
 }  // namespace focal_python

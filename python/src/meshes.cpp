@@ -42,7 +42,7 @@ nb::dict mesh_dict(focal::Mesh&& mesh) {
   nb::dict d;
   d["V"] = to_numpy(std::move(mesh.V));
   d["F"] = to_numpy(std::move(mesh.F));
-  d["N"] = mesh.N.rows() > 0 ? to_numpy(std::move(mesh.N)) : nb::none();
+  d["N"] = mesh.N.rows() > 0 ? nb::cast(to_numpy(std::move(mesh.N))) : nb::none();
   return d;
 }
 
@@ -246,8 +246,8 @@ nb::dict check_mesh(const DoubleRows& V, const IntRows& F, const std::optional<D
   return d;
 }
 
-nb::object vertex_normals(const DoubleRows& V, const IntRows& F, const std::string& weighting,
-                          int threads) {
+nb::ndarray<nb::numpy, double> vertex_normals(const DoubleRows& V, const IntRows& F,
+                                              const std::string& weighting, int threads) {
   const focal::NormalWeighting w = parse_weighting(weighting);
   focal::RowMatrixX3d N;
   {
@@ -299,12 +299,7 @@ nb::dict generate_surface(const std::string& kind, const std::string& triangulat
   d["k2"] = to_numpy(std::move(s.k2));
   d["d1"] = to_numpy(std::move(s.d1));
   d["d2"] = to_numpy(std::move(s.d2));
-  // uv is n x 2: returned as its own array.
-  using UV = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
-  auto* uv = new UV(std::move(s.uv));
-  nb::capsule owner(uv, [](void* p) noexcept { delete static_cast<UV*>(p); });
-  const size_t shape[2] = {static_cast<size_t>(uv->rows()), 2};
-  d["uv"] = nb::cast(nb::ndarray<nb::numpy, double>(uv->data(), 2, shape, owner));
+  d["uv"] = to_numpy(std::move(s.uv));
   return d;
 }
 

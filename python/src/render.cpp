@@ -54,10 +54,12 @@ focal::FocalMesh focal_mesh(const DoubleRows& V, const IntRows& F, const ByteVec
   return m;
 }
 
-nb::object render(const DoubleRows& V, const IntRows& F, const DoubleRows& N,
-                  const DoubleVector& field, const nb::dict& o,
-                  const std::optional<DoubleRows>& directions,
-                  const std::optional<nb::tuple>& gammas, const std::optional<std::string>& path) {
+nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& F,
+                                            const DoubleRows& N, const DoubleVector& field,
+                                            const nb::dict& o,
+                                            const std::optional<DoubleRows>& directions,
+                                            const std::optional<nb::tuple>& gammas,
+                                            const std::optional<std::string>& path) {
   static const std::pair<const char*, focal::ColourMap> maps[] = {
       {"diverging", focal::ColourMap::diverging}, {"classes", focal::ColourMap::classes}};
   focal::FieldPictureOptions p;

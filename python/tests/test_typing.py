@@ -1,6 +1,7 @@
 """The package is typed: py.typed, annotated Python code and the extension's stub generated at
-build time by nanobind's stubgen (python/CMakeLists.txt). mypy checks a use of the API and must
-find a deliberate type error in it (so the check cannot pass by seeing no types at all)."""
+build time by nanobind's stubgen (python/CMakeLists.txt). mypy checks a use of the API, the
+package's own code included, and must find the two deliberate type errors in it (so the check
+cannot pass by seeing no types at all)."""
 
 import os
 import pathlib
@@ -35,7 +36,8 @@ def test_mypy_checks_a_use_of_the_api(tmp_path):
         img: np.ndarray = focal.render(s.V, s.F, c.H)
         g: focal.GBuffer = focal.rasterise_gbuffer(s.V, s.F, s.N)
         k: focal.ImageCurvature = focal.image_space_curvature(g.position, g.normal, g.mask)
-        wrong: str = focal.curvature(s.V, s.F)  # the deliberate error
+        wrong: str = focal.curvature(s.V, s.F)  # a deliberate error in the annotated package
+        focal._focal_ext.read_mesh(1, 0)  # one that only the extension's stub can show
     """))
     env = dict(os.environ, MYPYPATH=str(PACKAGE.parent))
     r = subprocess.run(
@@ -43,5 +45,6 @@ def test_mypy_checks_a_use_of_the_api(tmp_path):
          str(program)],
         env=env, capture_output=True, text=True, timeout=240)
     errors = [line for line in r.stdout.splitlines() if ": error:" in line]
-    assert len(errors) == 1, r.stdout + r.stderr
+    assert len(errors) == 2, r.stdout + r.stderr
     assert "use_focal.py:11:" in errors[0] and "Curvature" in errors[0], errors[0]
+    assert "use_focal.py:12:" in errors[1] and '"str"' in errors[1], errors[1]
