@@ -10,6 +10,8 @@ on the same NumPy arrays (bench/python/run.sh runs it; docs/PYTHON.md shows its 
 Peers are bench/peers/peers.py's (libigl, pymeshlab, trimesh, VTK through pyvista; their
 outputs brought to focal's sign convention there) plus trueform. Every peer gets the positions
 and faces only, as does focal (its normals from the faces): no one gets exact normals.
+(pymeshlab's mesh takes a normal matrix: zeros are passed; its curvature filters recompute the
+normals, measured: the same H with zeros or area-weighted normals given.)
 """
 import argparse
 import gc
@@ -93,7 +95,7 @@ def cmd_accuracy(args):
         inside = interior(s.F, len(s.V))
         for name, method in METHODS.items():
             try:
-                rows[name].append(relative_rms(np.asarray(method(s.V, s.F, None)["H"]), truth,
+                rows[name].append(relative_rms(np.asarray(method(s.V, s.F, np.zeros_like(s.V))["H"]), truth,
                                                inside))
             except Exception as e:  # a peer that fails on a surface is reported, not hidden
                 rows[name].append((float("nan"), f"error: {type(e).__name__}"))
@@ -113,11 +115,12 @@ def cmd_accuracy(args):
 
 
 def median_seconds(method, V, F, repeats):
+    N = np.zeros_like(V)  # see the module's docstring (pymeshlab)
     times = []
     for _ in range(repeats):
         gc.collect()
         start = time.perf_counter()
-        method(V, F, None)
+        method(V, F, N)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
 

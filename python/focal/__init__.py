@@ -59,6 +59,7 @@ __all__ = [
     "read_mesh",
     "render",
     "vertex_normals",
+    "write_fields",
     "write_mesh",
 ]
 
@@ -297,6 +298,51 @@ def write_mesh(path: "str | os.PathLike", V: Any, F: Any, N: Any = None) -> None
     InvalidInputError for invalid arrays, FocalIOError on failure or for .stl."""
     Va, Fa, Na = _mesh_arrays(V, F, N)
     _ext.write_mesh(os.fspath(path), Va, Fa, Na)
+
+
+def write_fields(
+    path: "str | os.PathLike",
+    curvature: "Curvature",
+    V: Any = None,
+    F: Any = None,
+    N: Any = None,
+    *,
+    ascii: bool = False,
+    threads: Optional[int] = None,
+) -> None:
+    """Writes a Curvature as ``focal curvature -o`` does (the same bytes for the same estimate).
+
+    ``.csv``: one row per vertex, columns k1,k2,H,K,d1x..d1z,d2x..d2z,residual,class (the class
+    as a word, NaN as ``nan``); V, F, N are not needed. ``.ply``: the mesh V (n, 3), F (m, 3)
+    with the fields as per-vertex properties (class as uchar codes), binary unless ``ascii``;
+    the faces and normals written are those the estimate used (``curvature.F``,
+    ``curvature.N``) where it reports them, else F and N as given. Written to a temporary file
+    and renamed. Raises InvalidInputError for arrays that do not match, FocalIOError on failure.
+    """
+    path = os.fspath(path)
+    ext = os.path.splitext(path)[1].lower()
+    n = np.asarray(curvature.k1).shape[0]
+    fields = {name: _vector(getattr(curvature, name), name, n, dtype) for name, dtype in (
+        ("k1", np.float64), ("k2", np.float64), ("H", np.float64), ("K", np.float64),
+        ("residual", np.float64), ("point_class", np.uint8), ("rays_used", np.int32),
+        ("rays_excluded", np.int32))}
+    for name in ("d1", "d2"):
+        fields[name] = _as_rows(getattr(curvature, name), name, np.float64)
+        if fields[name].shape[0] != n:
+            raise _shape_error(name, f"({n}, 3)", fields[name].shape)
+    if ext == ".csv":
+        _ext.write_fields(path, fields, None, None, None, True, _threads(threads))
+        return
+    if ext != ".ply":
+        raise InvalidInputError(f"{path}: fields are written as .csv or .ply, not {ext!r}")
+    if V is None or F is None:
+        raise InvalidInputError("write_fields to .ply needs the mesh: V and F")
+    used_F = curvature.F if curvature.F is not None else F
+    used_N = curvature.N if curvature.N is not None else N
+    Va, Fa, Na = _mesh_arrays(V, used_F, used_N)
+    if Va.shape[0] != n:
+        raise _shape_error("V", f"({n}, 3) like the fields", Va.shape)
+    _ext.write_fields(path, fields, Va, Fa, Na, not ascii, _threads(threads))
 
 
 _PAPER_OPTIONS = {

@@ -12,6 +12,7 @@
 #include "focal/core/fields.h"
 #include "focal/curvature/estimate.h"
 #include "focal/curvature/focal_mesh.h"
+#include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/normals.h"
@@ -277,6 +278,47 @@ void write_mesh(const std::string& path, const DoubleRows& V, const IntRows& F,
   focal::write_mesh(path, mesh);
 }
 
+template <class Vector, class Scalar>
+Vector vector_of(const nb::handle& a) {
+  const auto arr =
+      nb::cast<nb::ndarray<const Scalar, nb::ndim<1>, nb::c_contig, nb::device::cpu>>(a);
+  return Eigen::Map<const Vector>(arr.data(), static_cast<Eigen::Index>(arr.shape(0)));
+}
+
+/// The fields of a focal.Curvature (its arrays, checked by the package) as the library's result.
+focal::CurvatureResult curvature_result(const nb::dict& c) {
+  focal::CurvatureResult r;
+  r.k1 = vector_of<Eigen::VectorXd, double>(c["k1"]);
+  r.k2 = vector_of<Eigen::VectorXd, double>(c["k2"]);
+  r.H = vector_of<Eigen::VectorXd, double>(c["H"]);
+  r.K = vector_of<Eigen::VectorXd, double>(c["K"]);
+  r.residual = vector_of<Eigen::VectorXd, double>(c["residual"]);
+  r.point_class = vector_of<focal::VectorXu8, std::uint8_t>(c["point_class"]);
+  r.rays_used = vector_of<Eigen::VectorXi, std::int32_t>(c["rays_used"]);
+  r.rays_excluded = vector_of<Eigen::VectorXi, std::int32_t>(c["rays_excluded"]);
+  r.d1 = view(nb::cast<DoubleRows>(c["d1"]));
+  r.d2 = view(nb::cast<DoubleRows>(c["d2"]));
+  return r;
+}
+
+/// focal.write_fields: the files of `focal curvature -o` (.csv, or .ply with the mesh). The
+/// writers take owning structs: the arrays are copied once, here.
+void write_fields(const std::string& path, const nb::dict& fields,
+                  const std::optional<DoubleRows>& V, const std::optional<IntRows>& F,
+                  const std::optional<DoubleRows>& N, bool binary, int threads) {
+  const focal::CurvatureResult r = curvature_result(fields);
+  nb::gil_scoped_release release;
+  if (!V) {
+    focal::write_curvature_csv(path, r);
+    return;
+  }
+  focal::Mesh mesh;
+  mesh.V = view(*V);
+  mesh.F = view(*F);
+  if (N) mesh.N = view(*N);
+  focal::write_curvature_ply(path, mesh, r, {.binary = binary, .comments = {}, .threads = threads});
+}
+
 nb::dict generate_surface(const std::string& kind, const std::string& triangulation,
                           int target_vertices, std::uint64_t seed, double a, double b, double c) {
   static const std::pair<const char*, focal::Triangulation> triangulations[] = {
@@ -320,6 +362,8 @@ void bind_meshes(nb::module_& m) {
   m.def("read_mesh", &read_mesh, "path"_a, "threads"_a);
   m.def("write_mesh", &write_mesh, "path"_a, "V"_a.noconvert(), "F"_a.noconvert(),
         "N"_a.none().noconvert());
+  m.def("write_fields", &write_fields, "path"_a, "fields"_a, "V"_a.none().noconvert(),
+        "F"_a.none().noconvert(), "N"_a.none().noconvert(), "binary"_a, "threads"_a);
   m.def("generate_surface", &generate_surface, "kind"_a, "triangulation"_a, "target_vertices"_a,
         "seed"_a, "a"_a, "b"_a, "c"_a);
 }
