@@ -39,5 +39,6 @@ echo "## Accuracy"
 $py bench/python/bench.py accuracy
 echo
 echo "## Timing"
+# Above 200K vertices the peers that take many minutes there are left out.
 $py bench/python/bench.py timing "${meshes[@]}" torus:1e5 torus:1e6 --skip-large \
   "trimesh ball measures / pi r^2" "pymeshlab APSS" "pymeshlab normal cycles"
