@@ -5,7 +5,8 @@ BUILD_DIR := build/$(PRESET)
 JOBS ?= $(shell nproc)
 # The Python environment of the bindings' build and tests (python/): nanobind, NumPy and pytest
 # from PyPI in a venv, so that the extension is built in the same CMake build as the library (one
-# library build) and the `python` ctest runs pytest on it. Users install with `pip install ./python`.
+# library build) and the `python` ctest runs pytest on it. Users install with `pip install .`.
+# The packages are listed in python/requirements-test.txt (a change there updates the venv).
 VENV := build/venv
 PYTHON := $(VENV)/bin/python
 
@@ -21,11 +22,9 @@ deps-demo:
 
 venv: $(VENV)/.ready
 
-# Rebuilt when this Makefile changes (pip skips what is installed). dask[distributed]: the tests of
-# focal.distributed (python/focal/distributed.py) run on a LocalCluster.
-$(VENV)/.ready: Makefile | deps
+$(VENV)/.ready: python/requirements-test.txt | deps
 	@python3 -m venv $(VENV)
-	@$(PYTHON) -m pip install -q --disable-pip-version-check nanobind numpy pytest "dask[distributed]"
+	@$(PYTHON) -m pip install -q --disable-pip-version-check -r python/requirements-test.txt
 	@touch $@
 
 configure: deps venv

@@ -215,7 +215,7 @@ void BM_ReadPly(benchmark::State& state) {
 }
 BENCHMARK(BM_ReadPly)->Apply(sizes_and_threads);
 
-// ---- The paper's comparison estimators (focal/baselines.h) against focal on the same mesh and
+// ---- The comparison estimators (focal/curvature/baselines.h) against focal on the same mesh and
 // threads. Counters: `x_focal_fit`, the baseline's time over focal's estimate_curvature on
 // normals at hand (the fit step with its 1-ring and unit normals), and `x_focal_with_normals`,
 // over vertex_normals (Max) + estimate_curvature, i.e. both starting from positions and faces
@@ -283,6 +283,27 @@ void BM_BaselineCohenSteinerMorvan2003(benchmark::State& state) {
   });
 }
 BENCHMARK(BM_BaselineCohenSteinerMorvan2003)->Apply(meshes_and_threads);
+
+void BM_BaselineLachaud2020(benchmark::State& state) {  // Max normals, as in focal eval
+  baseline_benchmark(state, [](const Mesh& m, const CurvatureOptions& o) {
+    return baselines::lachaud_2020(m.V, m.F, std::nullopt, {}, o);
+  });
+}
+BENCHMARK(BM_BaselineLachaud2020)->Apply(meshes_and_threads);
+
+void BM_BaselineYang2006(benchmark::State& state) {
+  baseline_benchmark(state, [](const Mesh& m, const CurvatureOptions& o) {
+    return baselines::yang_2006(m.V, m.F, {}, o);
+  });
+}
+BENCHMARK(BM_BaselineYang2006)->Apply(meshes_and_threads);
+
+void BM_BaselineGrinspun2006(benchmark::State& state) {
+  baseline_benchmark(state, [](const Mesh& m, const CurvatureOptions& o) {
+    return baselines::grinspun_2006(m.V, m.F, o);
+  });
+}
+BENCHMARK(BM_BaselineGrinspun2006)->Apply(meshes_and_threads);
 
 }  // namespace
 }  // namespace focal::bench

@@ -13,5 +13,6 @@ void add_curvature_command(CLI::App& app, const Log& log);
 void add_focal_mesh_command(CLI::App& app, const Log& log);
 void add_eval_command(CLI::App& app, const Log& log);
 void add_render_command(CLI::App& app, const Log& log);
+void add_devices_command(CLI::App& app, const Log& log);
 
 }  // namespace focal::cli

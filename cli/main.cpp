@@ -33,6 +33,7 @@ int run(int argc, char** argv) {
   focal::cli::add_focal_mesh_command(app, log);
   focal::cli::add_eval_command(app, log);
   focal::cli::add_render_command(app, log);
+  focal::cli::add_devices_command(app, log);
   app.footer(
       "Examples:\n"
       "  focal info mesh.ply\n"
@@ -42,6 +43,7 @@ int run(int argc, char** argv) {
       "  focal focal-mesh mesh.ply -o prefix   # prefix.focal1.ply, prefix.focal2.ply\n"
       "  focal eval --markdown eval.md         # every estimator against analytic truth\n"
       "  focal render mesh.ply -o mesh-H.png --field H   # a picture of H\n"
+      "  focal devices                      # the GPUs the CUDA backend can use\n"
       "Run 'focal COMMAND -h' for the options and examples of a command.\n"
       "Exit codes: 0 success, 1 usage error, 2 unreadable input or invalid data, 3 internal "
       "error.");
@@ -56,7 +58,7 @@ int run(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr,
-                 "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|eval|render ... "
+                 "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|eval|render|devices ... "
                  "(see focal -h)\n",
                  e.what());
     return kUsageError;

@@ -23,6 +23,7 @@ rm -f "$docs"/*.png "$docs"/*.ply "$docs"/*.md "$docs"/{peers,merged,scans-focal
 say "focal eval (48 cases, about 4000 vertices each)"
 "$focal" eval --vertices 4000 --seed 1 --csv "$docs/eval.csv" --markdown "$work/focal.md" \
   --export "$work/cases" >/dev/null
+python3 scripts/baseline_medians.py "$docs/eval.csv" >"$work/baselines.md"
 
 have_scans=0
 if [[ -f $cgal_data ]]; then
@@ -89,7 +90,21 @@ exact normals ("file normals"); normal noise perturbs the normals by up to 5% an
 positions. "Max normals" ignores the file's normals and estimates them from the faces (Max 1999),
 so under normal noise it sees noise-free data. "focal default" is
 `estimate_curvature_recommended` (include/focal/curvature/recommended.h), with the file's normals or
-without normals. MDSB03 and CSM03 (the paper's baselines, `focal/curvature/baselines.h`) use positions only.
+without normals. The baselines (`focal/curvature/baselines.h`, in the library, written from
+their papers) read positions only, except LRTC20 with the file's normals:
+
+- **MDSB03** (Meyer et al. 2003) and **CSM03** (Cohen-Steiner and Morvan 2003, 1-ring): the
+  paper's comparisons (its section 6).
+- **LRTC20** (Lachaud, Romon, Thibert, Coeurjolly 2020): interpolated corrected curvature
+  measures over a ball of 1 mean edge length, with the file's normals or with Max's normals from
+  the faces (the estimator of CGAL 6's `interpolated_corrected_curvatures`; Debian 12 has CGAL
+  5.5, so this is focal's own implementation from the papers, not CGAL's).
+- **YLHP06** (Yang, Lai, Hu, Pottmann 2006): integral invariants, the covariance of the surface
+  patch inside a ball of 4 mean edge lengths.
+- **GGRZ06** (Grinspun, Gingold, Reisman, Zorin 2006): the mid-edge shape operator, mid-edge
+  normals from the two faces, averaged to vertices by area.
+
+Their formulas, defaults and the reasons for them are in docs/ESTIMATOR.md, "Baselines".
 
 The peers measure the same vertices with the same metrics: `focal eval --export DIR` writes every
 case as the estimators see it (`<case>.ply` with the file normals) and its truth with the interior
@@ -97,7 +112,24 @@ flag (`<case>.truth.csv`); `bench/peers/peers.py accuracy DIR` reads them. Relat
 RMS(error) / RMS(truth) over the interior vertices (more than 2 rings from a boundary) whose
 estimate is finite; the others are counted as undefined in the CSVs.
 
+## focal's baselines by category
+
+From `focal eval --vertices 4000 --seed 1` (accuracy/eval.csv) by `scripts/baseline_medians.py`.
+
 HEAD
+  cat "$work/baselines.md"
+  cat <<'BASELINES'
+How to read it: LRTC20 with the file's normals has the lowest H error on clean irregular meshes
+and is close to the default under vertex noise: with exact normals the corrected measures
+converge at second order on irregular triangulations too (docs/ESTIMATOR.md, "Baselines"), where
+the default's fit is first order. It trusts the file's normals, so noisy normals go into it
+unfiltered (the normal-noise rows), and with normals from the faces (Max) the advantage is gone.
+YLHP06's surface-patch covariance needs wide balls: at 4 edge lengths its H error is mostly the
+O(h^2 / r^2) discretisation bias, and its directions rest on k1^2 - k2^2, which vanishes on
+saddles. GGRZ06 with mid-edge normals averaged from the faces weights each edge by
+sin(theta / 2) where CSM03 weights it by theta / 2: off regular grids its errors follow CSM03's.
+
+BASELINES
   if ((have_peers)); then
     cat <<PEERS
 ## Peers

@@ -34,6 +34,7 @@
 #include "focal/cuda/device.h"
 #include "focal/core/error.h"
 #include "focal/surfaces/surfaces.h"
+#include "gpu_required.h"
 #include "test_meshes.h"
 
 namespace focal {
@@ -241,20 +242,8 @@ TEST(CudaVertexFitOnHost, RejectsWhatTheDeviceDoesNotRun) {
 
 // --- (b) on a GPU -----------------------------------------------------------------------------
 
-bool no_gpu(std::string& why) {
-  if (!cuda_built()) {
-    why = "this build has no CUDA backend (FOCAL_WITH_CUDA off or no nvcc)";
-    return true;
-  }
-  if (cuda_devices().empty()) {
-    why = "the CUDA backend is built but no CUDA device is visible (no GPU or no driver)";
-    return true;
-  }
-  return false;
-}
-
 TEST(CudaVertexFitOnDevice, MatchesCpuEstimator) {
-  if (std::string why; no_gpu(why)) GTEST_SKIP() << why;
+  FOCAL_NEEDS_GPU();
   for (const Case& k : cases()) {
     const Mesh m = mesh_of(k);
     const CurvatureOptions o = options_of(k);
@@ -265,7 +254,7 @@ TEST(CudaVertexFitOnDevice, MatchesCpuEstimator) {
 }
 
 TEST(CudaVertexFitOnDevice, InvalidInputBeforeAnyWork) {
-  if (std::string why; no_gpu(why)) GTEST_SKIP() << why;
+  FOCAL_NEEDS_GPU();
   const Mesh m = test::flat_grid(4);
   CurvatureOptions o;
   o.method = Method::triangle;

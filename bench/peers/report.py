@@ -45,11 +45,20 @@ def label(key):
     return ", ".join(key)
 
 
+# focal's in-library baselines (focal/curvature/baselines.h) that read positions only; LRTC20
+# comes in two rows, "/ file normals" and "/ Max normals".
+BASELINES = ("MDSB03", "CSM03", "YLHP06", "GGRZ06")
+
+
+def is_baseline(method):
+    return method in BASELINES or method.startswith("LRTC20")
+
+
 def positions_only(method):
     """Methods that never read the file's normals: Max-normal focal variants, the baselines,
     the focal default without normals and every peer (the pymeshlab filters return the same
     values with noisy and with exact normals: measured)."""
-    return ("Max normals" in method or method in ("MDSB03", "CSM03", DEFAULT_NONE)
+    return ("Max normals" in method or method in BASELINES or method == DEFAULT_NONE
             or method in PEERS)
 
 
@@ -133,9 +142,9 @@ def count_target(by_case, methods):
             f"compared with all {len(file_rivals)} other methods; without normals (the irregular "
             f"and the vertex-noise cases: under normal noise positions-only methods see the clean "
             f"case) with the {len(none_rivals)} positions-only ones: focal with Max normals, "
-            f"MDSB03, CSM03 and every peer. Ties count as wins (errors both below 1e-12 are "
+            f"the positions-only baselines and every peer. Ties count as wins (errors both below 1e-12 are "
             f"exact up to rounding and tie). Against the other libraries "
-            f"only (MDSB03, CSM03 and the peers, no other focal variant): {xo} of {y} with file "
+            f"only (focal's baselines and the peers, no other focal variant): {xo} of {y} with file "
             f"normals, {zo} of {w} without.\n\n")
     text += loss_table(
         by_case, [(k, DEFAULT_FILE, b) for k, b in file_losses] +
@@ -176,7 +185,7 @@ def colour(method):
         return "tab:red"
     if method.startswith("focal"):
         return "tab:blue"
-    if method in ("MDSB03", "CSM03"):
+    if is_baseline(method):
         return "tab:green"
     return "tab:orange"
 
@@ -197,7 +206,7 @@ def plot_surface(surface, by_case, methods, out):
     axes[0].set_yticks(y)
     axes[0].set_yticklabels(methods, fontsize=8)
     fig.suptitle(f"{surface}: relative RMS error of H at interior vertices (log scale; red: focal "
-                 f"default, blue: other focal, green: MDSB03/CSM03, orange: peers)", fontsize=10)
+                 f"default, blue: other focal, green: baselines, orange: peers)", fontsize=10)
     fig.tight_layout()
     path = os.path.join(out, f"relH-{surface}.png")
     fig.savefig(path, dpi=80)

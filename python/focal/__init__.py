@@ -43,6 +43,8 @@ __all__ = [
     "FocalMesh",
     "FocalMeshes",
     "FocalPointFlag",
+    "GBuffer",
+    "ImageCurvature",
     "InvalidInputError",
     "Mesh",
     "MeshFindings",
@@ -52,13 +54,14 @@ __all__ = [
     "curvature",
     "focal_meshes",
     "generate_surface",
+    "image_space_curvature",
+    "rasterise_gbuffer",
     "read_mesh",
+    "render",
     "vertex_normals",
+    "write_fields",
     "write_mesh",
 ]
-
-
-
 
 class PointClass(enum.IntEnum):
     """Class of a vertex from its principal curvatures (the codes of ``Curvature.point_class``,
@@ -88,16 +91,37 @@ def _shape_error(name: str, expected: str, got: Any) -> InvalidInputError:
     return InvalidInputError(f"{name} must have shape {expected}, got shape {got}")
 
 
+# DLPack device type of host memory (dlpack.h, kDLCPU).
+_DLPACK_CPU = 1
+
+
+def _array(a: Any, name: str) -> np.ndarray:
+    """``a`` as a NumPy array without copying where its memory allows: ndarrays as they are,
+    DLPack producers on the CPU (PyTorch, JAX, ...) through np.from_dlpack, anything else with
+    np.asarray (``__array_interface__``, buffers, nested lists). Arrays on a GPU are an error."""
+    if isinstance(a, np.ndarray):
+        return a
+    if hasattr(a, "__dlpack_device__"):
+        device_type, device_id = a.__dlpack_device__()
+        if int(device_type) != _DLPACK_CPU:
+            raise InvalidInputError(
+                f"{name} is in device memory (DLPack device type {int(device_type)}, id "
+                f"{int(device_id)}); focal takes host arrays: copy it to the CPU first"
+            )
+        try:
+            return np.from_dlpack(a)
+        except (TypeError, BufferError, RuntimeError):
+            pass  # a dtype DLPack cannot export to NumPy: asarray below
+    try:
+        return np.asarray(a)
+    except (ValueError, TypeError) as e:
+        raise InvalidInputError(f"{name} is not an array: {e}") from None
+
+
 def _as_rows(a: Any, name: str, dtype: type) -> np.ndarray:
     """``a`` as a C-ordered ``(n, 3)`` array of ``dtype``: ``a`` itself when it already is one,
     else one converted copy."""
-    if isinstance(a, np.ndarray):
-        arr = a
-    else:
-        try:
-            arr = np.asarray(a)
-        except (ValueError, TypeError) as e:
-            raise InvalidInputError(f"{name} is not an (n, 3) array: {e}") from None
+    arr = _array(a, name)
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise _shape_error(name, "(n, 3)", arr.shape)
     kind = arr.dtype.kind
@@ -274,6 +298,51 @@ def write_mesh(path: "str | os.PathLike", V: Any, F: Any, N: Any = None) -> None
     InvalidInputError for invalid arrays, FocalIOError on failure or for .stl."""
     Va, Fa, Na = _mesh_arrays(V, F, N)
     _ext.write_mesh(os.fspath(path), Va, Fa, Na)
+
+
+def write_fields(
+    path: "str | os.PathLike",
+    curvature: "Curvature",
+    V: Any = None,
+    F: Any = None,
+    N: Any = None,
+    *,
+    ascii: bool = False,
+    threads: Optional[int] = None,
+) -> None:
+    """Writes a Curvature as ``focal curvature -o`` does (the same bytes for the same estimate).
+
+    ``.csv``: one row per vertex, columns k1,k2,H,K,d1x..d1z,d2x..d2z,residual,class (the class
+    as a word, NaN as ``nan``); V, F, N are not needed. ``.ply``: the mesh V (n, 3), F (m, 3)
+    with the fields as per-vertex properties (class as uchar codes), binary unless ``ascii``;
+    the faces and normals written are those the estimate used (``curvature.F``,
+    ``curvature.N``) where it reports them, else F and N as given. Written to a temporary file
+    and renamed. Raises InvalidInputError for arrays that do not match, FocalIOError on failure.
+    """
+    path = os.fspath(path)
+    ext = os.path.splitext(path)[1].lower()
+    n = np.asarray(curvature.k1).shape[0]
+    fields = {name: _vector(getattr(curvature, name), name, n, dtype) for name, dtype in (
+        ("k1", np.float64), ("k2", np.float64), ("H", np.float64), ("K", np.float64),
+        ("residual", np.float64), ("point_class", np.uint8), ("rays_used", np.int32),
+        ("rays_excluded", np.int32))}
+    for name in ("d1", "d2"):
+        fields[name] = _as_rows(getattr(curvature, name), name, np.float64)
+        if fields[name].shape[0] != n:
+            raise _shape_error(name, f"({n}, 3)", fields[name].shape)
+    if ext == ".csv":
+        _ext.write_fields(path, fields, None, None, None, True, _threads(threads))
+        return
+    if ext != ".ply":
+        raise InvalidInputError(f"{path}: fields are written as .csv or .ply, not {ext!r}")
+    if V is None or F is None:
+        raise InvalidInputError("write_fields to .ply needs the mesh: V and F")
+    used_F = curvature.F if curvature.F is not None else F
+    used_N = curvature.N if curvature.N is not None else N
+    Va, Fa, Na = _mesh_arrays(V, used_F, used_N)
+    if Va.shape[0] != n:
+        raise _shape_error("V", f"({n}, 3) like the fields", Va.shape)
+    _ext.write_fields(path, fields, Va, Fa, Na, not ascii, _threads(threads))
 
 
 _PAPER_OPTIONS = {
@@ -467,3 +536,226 @@ def generate_surface(
     d = _ext.generate_surface(str(kind), str(triangulation), int(n), int(seed), float(a),
                               float(b), float(c))
     return Surface(**d)
+
+
+# --------------------------------------------------------------------------------------------
+# Pictures and G-buffers (headless OpenGL through EGL; docs/RENDER.md) and the image-space
+# estimator (paper section 5.1; docs/IMAGE_SPACE.md).
+
+
+@dataclasses.dataclass
+class GBuffer:
+    """One view rasterised: per pixel the world position and the unit normal interpolated from
+    the vertex normals, row 0 at the top of the image."""
+
+    position: np.ndarray  #: (h, w, 3) float32 world positions, 0 where not covered
+    normal: np.ndarray  #: (h, w, 3) float32 unit outward normals, 0 where not covered
+    mask: np.ndarray  #: (h, w) uint8, 1 where a triangle covers the pixel
+    eye: tuple  #: the camera's eye, world coordinates
+
+
+@dataclasses.dataclass
+class ImageCurvature:
+    """Per-pixel curvature of a G-buffer ((h, w) float32 unless stated), in the units of its
+    positions. Outward normals: a sphere of radius r has k1 = k2 = +1/r. NaN where not valid."""
+
+    k1: np.ndarray  #: larger principal curvature
+    k2: np.ndarray  #: smaller principal curvature, k1 >= k2
+    H: np.ndarray  #: (k1 + k2) / 2
+    K: np.ndarray  #: k1 k2
+    focal_depth1: np.ndarray  #: -1 / k1: the focal point along the normal (+-inf at k1 = 0)
+    focal_depth2: np.ndarray  #: -1 / k2
+    d1: np.ndarray  #: (h, w, 3) unit principal direction of k1
+    d2: np.ndarray  #: (h, w, 3) unit principal direction of k2; (d1, d2, normal) right-handed
+    valid: np.ndarray  #: (h, w) uint8, 1 where the fields hold an estimate
+
+
+def _camera_options(V: np.ndarray, azimuth, elevation, orthographic, field_of_view, margin, eye,
+                    target, up, half_extent) -> dict:
+    if eye is not None and target is None:
+        target = V.mean(axis=0) if V.shape[0] else (0.0, 0.0, 0.0)
+    return {
+        "azimuth": float(azimuth),
+        "elevation": float(elevation),
+        "orthographic": bool(orthographic),
+        "field_of_view": float(field_of_view),
+        "margin": float(margin),
+        "eye": None if eye is None else [float(x) for x in eye],
+        "target": None if target is None else [float(x) for x in target],
+        "up": [float(x) for x in up],
+        "half_extent": None if half_extent is None else float(half_extent),
+    }
+
+
+def _normals_for_picture(Va: np.ndarray, Fa: np.ndarray, N: Any) -> np.ndarray:
+    if N is None:
+        return _ext.vertex_normals(Va, Fa, "max", 0)
+    Na = _as_rows(N, "N", np.float64)
+    if Na.shape[0] != Va.shape[0]:
+        raise _shape_error("N", f"({Va.shape[0]}, 3) like V", Na.shape)
+    return Na
+
+
+def _vector(a: Any, name: str, n: int, dtype: type) -> np.ndarray:
+    arr = _array(a, name)
+    if arr.shape != (n,):
+        raise _shape_error(name, f"({n},)", arr.shape)
+    return np.ascontiguousarray(arr, dtype=dtype)
+
+
+def render(
+    V: Any,
+    F: Any,
+    field: Any,
+    N: Any = None,
+    *,
+    path: "str | os.PathLike | None" = None,
+    width: int = 1200,
+    height: int = 900,
+    colour_map: str = "diverging",
+    range: Optional[tuple] = None,
+    range_percentile: float = 95.0,
+    title: str = "",
+    directions: Any = None,
+    glyph_count: int = 2500,
+    focal_meshes: Optional[FocalMeshes] = None,
+    azimuth: float = 0.0,
+    elevation: float = 0.0,
+    orthographic: bool = False,
+    field_of_view: float = 30.0,
+    margin: float = 1.05,
+    eye: Any = None,
+    target: Any = None,
+    up: Any = (0.0, 1.0, 0.0),
+    half_extent: Optional[float] = None,
+    samples: int = 4,
+    threads: Optional[int] = None,
+) -> np.ndarray:
+    """A picture of a per-vertex field on a mesh, as ``focal render``: Lambert shading under a
+    headlight, coloured per vertex, white background, title on top, colour bar (or class legend)
+    on the right. Rendered with OpenGL on a headless EGL context (Mesa's llvmpipe needs no GPU).
+
+    V (n, 3), F (m, 3); field (n,) values (H, K, k1, k2; or PointClass codes with
+    ``colour_map="classes"``); N (n, 3) outward normals for the shading, None: Max's normals
+    from the faces.
+    colour_map : "diverging" (blue - white - red, white at 0, red positive) or "classes".
+    range : (lo, hi) of the diverging map; None: [-P, P], P the range_percentile of |field|.
+    directions : (n, 3) d1 or d2, drawn as short segments through about glyph_count vertices.
+    focal_meshes : a FocalMeshes of this mesh: two more panels show Gamma_1 and Gamma_2.
+    Camera: fitted to the mesh's bounding sphere from (azimuth, elevation) in degrees (0, 0 looks
+    along -z), perspective with field_of_view degrees or orthographic; or, with eye, a look-at
+    camera from eye to target (default: the mean of V) with up.
+    path : also write the picture there as PNG (written to a temporary and renamed).
+
+    Returns the picture as an (height, width, 3) uint8 RGB array, row 0 at the top.
+    Raises InvalidInputError for wrong shapes or options, DeviceError when no OpenGL context can
+    be had (the message says what was tried), FocalIOError when the PNG cannot be written.
+    """
+    Va, Fa, _ = _mesh_arrays(V, F)
+    Na = _normals_for_picture(Va, Fa, N)
+    values = _vector(field, "field", Va.shape[0], np.float64)
+    dirs = None if directions is None else _as_rows(directions, "directions", np.float64)
+    gammas = None
+    if focal_meshes is not None:
+        gammas = tuple(
+            a
+            for g in (focal_meshes.gamma1, focal_meshes.gamma2)
+            for a in (
+                _as_rows(g.V, "focal_meshes V", np.float64),
+                _as_rows(g.F, "focal_meshes F", np.int32),
+                _vector(g.flag, "focal_meshes flag", Va.shape[0], np.uint8),
+            )
+        )
+    options = _camera_options(Va, azimuth, elevation, orthographic, field_of_view, margin, eye,
+                              target, up, half_extent)
+    options.update(
+        width=int(width),
+        height=int(height),
+        colour_map=str(colour_map),
+        range=None if range is None else (float(range[0]), float(range[1])),
+        range_percentile=float(range_percentile),
+        title=str(title),
+        glyph_count=int(glyph_count),
+        samples=int(samples),
+        threads=_threads(threads),
+    )
+    return _ext.render(Va, Fa, Na, values, options, dirs, gammas,
+                       None if path is None else os.fspath(path))
+
+
+def rasterise_gbuffer(
+    V: Any,
+    F: Any,
+    N: Any = None,
+    *,
+    width: int = 512,
+    height: int = 512,
+    azimuth: float = 0.0,
+    elevation: float = 0.0,
+    orthographic: bool = False,
+    field_of_view: float = 30.0,
+    margin: float = 1.05,
+    eye: Any = None,
+    target: Any = None,
+    up: Any = (0.0, 1.0, 0.0),
+    half_extent: Optional[float] = None,
+) -> GBuffer:
+    """Rasterises the mesh into a G-buffer (the input of ``image_space_curvature``): per covered
+    pixel the world position and the unit normal interpolated (perspective-correct) from N at the
+    pixel centre; no multisampling. N None: Max's normals from the faces. The camera keywords are
+    those of ``render``. Raises DeviceError when no OpenGL context can be had."""
+    Va, Fa, _ = _mesh_arrays(V, F)
+    Na = _normals_for_picture(Va, Fa, N)
+    options = _camera_options(Va, azimuth, elevation, orthographic, field_of_view, margin, eye,
+                              target, up, half_extent)
+    options.update(width=int(width), height=int(height))
+    return GBuffer(**_ext.rasterise_gbuffer(Va, Fa, Na, options))
+
+
+def _pixels(a: Any, name: str, channels: int, dtype: type, shape=None) -> np.ndarray:
+    arr = _array(a, name)
+    expected = "(h, w, 3)" if channels == 3 else "(h, w)"
+    if arr.ndim != (3 if channels == 3 else 2) or (channels == 3 and arr.shape[2] != 3):
+        raise _shape_error(name, expected, arr.shape)
+    if shape is not None and arr.shape[:2] != shape:
+        raise _shape_error(name, f"{shape[:2]} like position", arr.shape)
+    if arr.dtype.kind not in ("fiub"):
+        raise InvalidInputError(f"{name} must hold numbers, got dtype {arr.dtype}")
+    return np.ascontiguousarray(arr, dtype=dtype)
+
+
+def image_space_curvature(
+    position: Any,
+    normal: Any,
+    mask: Any = None,
+    *,
+    discontinuity_ratio: float = 4.0,
+    window: int = 0,
+    threads: Optional[int] = None,
+    device: Optional[int] = None,
+) -> ImageCurvature:
+    """The paper's image-space estimator (section 5.1) on a G-buffer: every pixel solves the
+    characteristic equation of the normal rays of its triplet (x, y), (x + 1, y), (x, y + 1).
+
+    position : (h, w, 3) world positions (any units; results are in their inverse units).
+    normal : (h, w, 3) **outward** normals (need not be unit): k1 = k2 = +1/r on a sphere of
+        radius r seen from outside; inward normals flip the signs.
+    mask : (h, w), non-zero where a surface covers the pixel; None: every pixel.
+    discontinuity_ratio : a triplet edge longer than this many local pixel footprints is a depth
+        discontinuity (invalid); > 1. window : average the shape operators of the
+        (2 window + 1)^2 triplets around each pixel (0: none; at most 16).
+    device : a CUDA device index to run on the GPU (DeviceError without one); None: the CPU.
+
+    Computes in float32 (the G-buffer's precision): inputs are converted to float32 and copied
+    once into the library's G-buffer. Pixels in the last row and column, outside the mask, across
+    a discontinuity or with a normal outside the triplet's hemisphere are invalid (NaN, valid 0).
+    """
+    pos = _pixels(position, "position", 3, np.float32)
+    nor = _pixels(normal, "normal", 3, np.float32, pos.shape[:2])
+    if mask is None:
+        m = np.ones(pos.shape[:2], dtype=np.uint8)
+    else:
+        m = _pixels(_array(mask, "mask") != 0, "mask", 1, np.uint8, pos.shape[:2])
+    d = _ext.image_space_curvature(pos, nor, m, float(discontinuity_ratio), int(window),
+                                   _threads(threads), None if device is None else int(device))
+    return ImageCurvature(**d)

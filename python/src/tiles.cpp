@@ -11,27 +11,22 @@
 #include <utility>
 #include <vector>
 
-#include "ext_common.h"
+#include "bindings.h"
 #include "focal/curvature/estimate.h"
 #include "focal/mesh/prepared.h"
 
-namespace focal_ext {
+namespace focal_python {
 namespace {
 
 using namespace nb::literals;
 using Ids = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 
 nb::object ids_to_numpy(const std::vector<int>& ids) {
-  return to_numpy(Eigen::VectorXi(
-      Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size()))));
+  return nb::cast(to_numpy(Eigen::VectorXi(
+      Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size())))));
 }
 
 std::vector<int> ids_from(const Ids& a) { return {a.data(), a.data() + a.shape(0)}; }
-
-std::optional<focal::NormalsRef> normals_of(const std::optional<DoubleRows>& N) {
-  if (!N) return std::nullopt;
-  return focal::NormalsRef(view(*N));
-}
 
 nb::dict choices_dict(const focal::MeshWideChoices& c) {
   nb::dict d;
@@ -65,7 +60,7 @@ nb::dict tile_plan(const DoubleRows& V, const IntRows& F, const std::optional<Do
   focal::Tiling tiling;
   {
     nb::gil_scoped_release release;
-    const focal::PreparedMesh mesh(view(V), view(F), normals_of(N), {.threads = threads});
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
     choices = focal::mesh_wide_choices(mesh, o);
     const focal::FacesRef faces = choices.F ? focal::FacesRef(*choices.F) : mesh.F();
     tiling = focal::partition_mesh(mesh.V(), faces,
@@ -94,7 +89,7 @@ nb::dict extract_tile(const DoubleRows& V, const IntRows& F, const std::optional
   focal::TileMesh t;
   {
     nb::gil_scoped_release release;
-    t = focal::extract_tile(view(V), view(F), normals_of(N), tile);
+    t = focal::extract_tile(view(V), view(F), normals_ref(N), tile);
   }
   nb::dict d;
   d["V"] = to_numpy(std::move(t.V));
@@ -130,4 +125,4 @@ void bind_tiles(nb::module_& m) {
         "N"_a.none().noconvert(), "options"_a, "choices"_a);
 }
 
-}  // namespace focal_ext
+}  // namespace focal_python

@@ -186,6 +186,37 @@ def test_identical_to_cli(tmp_path, estimator, flags, with_normals):
     assert same_bits(c.point_class, expected["class"])
 
 
+@pytest.mark.parametrize("estimator, flags, with_normals", [
+    ("recommended", [], False),
+    ("paper", ["--paper"], True),
+])
+@pytest.mark.parametrize("ext", [".csv", ".ply"])
+def test_write_fields_writes_the_clis_bytes(tmp_path, estimator, flags, with_normals, ext):
+    s = focal.generate_surface("torus", 1500, triangulation="irregular", seed=4)
+    mesh_path = tmp_path / "torus.ply"
+    focal.write_mesh(mesh_path, s.V, s.F, s.N if with_normals else None)
+    expected, got = tmp_path / ("cli" + ext), tmp_path / ("python" + ext)
+    subprocess.run([cli(), "curvature", str(mesh_path), "-o", str(expected), *flags], check=True,
+                   capture_output=True)
+    m = focal.read_mesh(mesh_path)
+    c = focal.curvature(m.V, m.F, m.N, estimator=estimator)
+    focal.write_fields(got, c, m.V, m.F, m.N)
+    assert got.read_bytes() == expected.read_bytes()
+
+
+def test_write_fields_errors(tmp_path, sphere):
+    c = focal.curvature(sphere.V, sphere.F, sphere.N, estimator="paper")
+    with pytest.raises(focal.InvalidInputError, match="needs the mesh"):
+        focal.write_fields(tmp_path / "x.ply", c)
+    with pytest.raises(focal.InvalidInputError, match=".csv or .ply"):
+        focal.write_fields(tmp_path / "x.obj", c, sphere.V, sphere.F)
+    with pytest.raises(focal.InvalidInputError, match="V must have shape"):
+        focal.write_fields(tmp_path / "x.ply", c, sphere.V[:10], sphere.F)
+    with pytest.raises(focal.FocalIOError):
+        focal.write_fields(tmp_path / "no" / "x.csv", c)
+    assert not (tmp_path / "no").exists() and not list(tmp_path.iterdir())
+
+
 # --- inputs: dtypes, layouts, one conversion ------------------------------------------------
 
 

@@ -22,6 +22,22 @@ inline void check(cudaError_t status, const char* what) {
 /// Checks a kernel launch (configuration errors) without waiting for the kernel.
 inline void check_launch(const char* kernel) { check(cudaGetLastError(), kernel); }
 
+/// Makes `device` current for its lifetime and restores the caller's device afterwards, so that
+/// a library call does not change the calling thread's CUDA state.
+class DeviceScope {
+ public:
+  explicit DeviceScope(int device) {
+    check(cudaGetDevice(&previous_), "cudaGetDevice");
+    check(cudaSetDevice(device), "cudaSetDevice");
+  }
+  ~DeviceScope() { cudaSetDevice(previous_); }  // no throw from a destructor
+  DeviceScope(const DeviceScope&) = delete;
+  DeviceScope& operator=(const DeviceScope&) = delete;
+
+ private:
+  int previous_ = 0;
+};
+
 /// n elements of T in device memory, freed on scope exit.
 template <class T>
 class DeviceBuffer {

@@ -4,6 +4,7 @@
 // the host and calls image_curvature_on_device.
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -23,32 +24,46 @@ struct ImageKernelParams {
   int window;
 };
 
-/// The pixel of this thread; false outside the image.
-__device__ bool thread_pixel(const image_kernel::ImageView& v, int& x, int& y) {
-  x = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
-  y = static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  return x < v.width && y < v.height;
-}
+// Threads cover the image's columns with the grid's x and stride over its rows with the grid's
+// y, whose size is limited to 65,535 blocks (kMaxGridRows): an image taller than 65,535 x 16
+// rows is covered in several passes of the same threads.
+constexpr unsigned kMaxGridRows = 65535;
+
+__device__ int thread_column() { return static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); }
+__device__ int first_row() { return static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y); }
+__device__ int row_stride() { return static_cast<int>(gridDim.y * blockDim.y); }
 
 __global__ void triplet_pixels(ImageKernelParams p) {
-  int x, y;
-  if (!thread_pixel(p.view, x, y)) return;
-  image_kernel::store_pixel(p.out, image_kernel::pixel_index(p.view, x, y),
-                            image_kernel::pixel_result(p.view, x, y, p.ratio));
+  const int x = thread_column();
+  if (x >= p.view.width) return;
+  for (int y = first_row(); y < p.view.height; y += row_stride()) {
+    image_kernel::store_pixel(p.out, image_kernel::pixel_index(p.view, x, y),
+                              image_kernel::pixel_result(p.view, x, y, p.ratio));
+  }
 }
 
 __global__ void operator_pixels(ImageKernelParams p) {
-  int x, y;
-  if (!thread_pixel(p.view, x, y)) return;
-  p.ops[image_kernel::pixel_index(p.view, x, y)] =
-      image_kernel::pixel_operator(p.view, x, y, p.ratio);
+  const int x = thread_column();
+  if (x >= p.view.width) return;
+  for (int y = first_row(); y < p.view.height; y += row_stride()) {
+    p.ops[image_kernel::pixel_index(p.view, x, y)] =
+        image_kernel::pixel_operator(p.view, x, y, p.ratio);
+  }
 }
 
 __global__ void window_pixels(ImageKernelParams p) {
-  int x, y;
-  if (!thread_pixel(p.view, x, y)) return;
-  image_kernel::store_pixel(p.out, image_kernel::pixel_index(p.view, x, y),
-                            image_kernel::window_result(p.view, p.ops, x, y, p.window));
+  const int x = thread_column();
+  if (x >= p.view.width) return;
+  for (int y = first_row(); y < p.view.height; y += row_stride()) {
+    image_kernel::store_pixel(p.out, image_kernel::pixel_index(p.view, x, y),
+                              image_kernel::window_result(p.view, p.ops, x, y, p.window));
+  }
+}
+
+/// The launch grid for an image: all columns, rows up to the y limit (the kernels stride).
+dim3 image_grid(int width, int height, dim3 block) {
+  const unsigned rows = (static_cast<unsigned>(height) + block.y - 1) / block.y;
+  return {(static_cast<unsigned>(width) + block.x - 1) / block.x, std::min(rows, kMaxGridRows)};
 }
 
 template <class T>
@@ -89,7 +104,7 @@ struct DeviceFields {
 
 void image_curvature_on_device(const image_kernel::ImageView& image, float discontinuity_ratio,
                                int window, const image_kernel::ImageFields& out, int device) {
-  cuda::check(cudaSetDevice(device), "cudaSetDevice");
+  const cuda::DeviceScope scope(device);
   const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
   const auto position = upload(image.position, 3 * pixels);
   const auto normal = upload(image.normal, 3 * pixels);
@@ -103,7 +118,7 @@ void image_curvature_on_device(const image_kernel::ImageView& image, float disco
       discontinuity_ratio,
       window};
   const dim3 block(16, 16);
-  const dim3 grid((image.width + block.x - 1) / block.x, (image.height + block.y - 1) / block.y);
+  const dim3 grid = image_grid(image.width, image.height, block);
   if (window == 0) {
     triplet_pixels<<<grid, block>>>(params);
     cuda::check_launch("triplet_pixels");

@@ -24,7 +24,7 @@ __global__ void triangle_faces(triangle_kernel::TriangleKernelParams k) {
 
 void triangle_faces_on_device(const TriangleInput& in, std::vector<float>& values,
                               std::vector<std::uint8_t>& classes, int device) {
-  cuda::check(cudaSetDevice(device), "cudaSetDevice");
+  const cuda::DeviceScope scope(device);
   const auto V = cuda::DeviceBuffer<double>::from_host(in.V);
   const auto N = cuda::DeviceBuffer<double>::from_host(in.N);
   const auto F = cuda::DeviceBuffer<std::int32_t>::from_host(in.F);
@@ -34,7 +34,9 @@ void triangle_faces_on_device(const TriangleInput& in, std::vector<float>& value
       V.data(),        N.data(),        F.data(), in.faces, in.zero_tolerance, in.umbilic_tolerance,
       d_values.data(), d_classes.data()};
   constexpr int kBlock = 256;
-  triangle_faces<<<(in.faces + kBlock - 1) / kBlock, kBlock>>>(k);
+  const auto blocks =
+      static_cast<unsigned>((static_cast<long long>(in.faces) + kBlock - 1) / kBlock);
+  triangle_faces<<<blocks, kBlock>>>(k);
   cuda::check_launch("triangle_faces");
   cuda::check(cudaDeviceSynchronize(), "triangle_faces");
   d_values.download(values.data(), values.size());

@@ -28,22 +28,6 @@ __global__ void vertex_fit_kernel(VertexFitParams<float> p) {
   if (i < p.vertex_count) fit_vertex(p, i);
 }
 
-/// Makes `device` current for its lifetime and restores the caller's device afterwards, so that
-/// a library call does not change the calling thread's CUDA state.
-class DeviceScope {
- public:
-  explicit DeviceScope(int device) {
-    check(cudaGetDevice(&previous_), "cudaGetDevice");
-    check(cudaSetDevice(device), "cudaSetDevice");
-  }
-  ~DeviceScope() { cudaSetDevice(previous_); }  // no throw from a destructor
-  DeviceScope(const DeviceScope&) = delete;
-  DeviceScope& operator=(const DeviceScope&) = delete;
-
- private:
-  int previous_ = 0;
-};
-
 /// A pair of CUDA events timing a stretch of the default stream.
 class EventTimer {
  public:
@@ -114,8 +98,9 @@ struct ResidentVertexFit::State {
     p.vertices = vertices.data();
     p.offsets = offsets.data();
     p.indices = indices.data();
-    p.out = {k1.data(), k2.data(),       H.data(),           K.data(),         d1.data(),
-             d2.data(), residual.data(), point_class.data(), rays_used.data(), rays_excluded.data()};
+    p.out = {k1.data(),        k2.data(),           H.data(),        K.data(),
+             d1.data(),        d2.data(),           residual.data(), point_class.data(),
+             rays_used.data(), rays_excluded.data()};
     const auto blocks = static_cast<unsigned>((n() + kBlock - 1) / kBlock);
     vertex_fit_kernel<<<blocks, kBlock>>>(p);
     check_launch("vertex_fit_kernel");

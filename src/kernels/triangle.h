@@ -37,14 +37,14 @@ struct TriangleKernelParams {
 FOCAL_HD inline triplet::TripletSolution<float> face_triplet(const TriangleKernelParams& k, int f) {
   Vec3<double> p[3], centroid{0.0, 0.0, 0.0};
   for (int c = 0; c < 3; ++c) {
-    p[c] = kernels::load3(k.V + 3 * k.F[3 * f + c]);
+    p[c] = kernels::load3(k.V + 3LL * k.F[3LL * f + c]);
     centroid = centroid + p[c];
   }
   centroid = (1.0 / 3.0) * centroid;
   Vec3<float> q[3], n[3];
   for (int c = 0; c < 3; ++c) {
     q[c] = kernels::vec_cast<float>(p[c] - centroid);
-    n[c] = kernels::vec_cast<float>(kernels::load3(k.N + 3 * k.F[3 * f + c]));
+    n[c] = kernels::vec_cast<float>(kernels::load3(k.N + 3LL * k.F[3LL * f + c]));
   }
   return triplet::solve_triplet(q, n);
 }

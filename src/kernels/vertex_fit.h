@@ -63,12 +63,12 @@ struct VertexFitParams {
   const int* offsets;               ///< CSR of the neighbourhoods (#V + 1)
   const int* indices;
   int vertex_count;
-  bool gaussian;                      ///< Gaussian weights; else uniform
-  T inverse_two_width_squared;        ///< Gaussian weights exp(-d^2 * this), d in scaled units
-  T curvature_unit;                   ///< 1 / length_unit: k = (eigenvalue of W) x this (exact)
-  T zero_tolerance;                   ///< |k| at or below this is zero (absolute curvature)
-  T umbilic_tolerance;                ///< relative gap at or below this is umbilic
-  T min_relative_determinant;         ///< det / (trace/3)^3 at or below this: undefined
+  bool gaussian;                ///< Gaussian weights; else uniform
+  T inverse_two_width_squared;  ///< Gaussian weights exp(-d^2 * this), d in scaled units
+  T curvature_unit;             ///< 1 / length_unit: k = (eigenvalue of W) x this (exact)
+  T zero_tolerance;             ///< |k| at or below this is zero (absolute curvature)
+  T umbilic_tolerance;          ///< relative gap at or below this is umbilic
+  T min_relative_determinant;   ///< det / (trace/3)^3 at or below this: undefined
   VertexFitOutput<T> out;
 };
 
@@ -116,7 +116,7 @@ template <class T>
 FOCAL_HD inline void store_undefined(const VertexFitOutput<T>& o, int i) {
   const T nan = static_cast<T>(NAN);  // numeric_limits is not callable in device code
   o.k1[i] = o.k2[i] = o.H[i] = o.K[i] = o.residual[i] = nan;
-  for (int c = 0; c < 3; ++c) o.d1[3 * i + c] = o.d2[3 * i + c] = nan;
+  for (int c = 0; c < 3; ++c) o.d1[3LL * i + c] = o.d2[3LL * i + c] = nan;
   o.point_class[i] = static_cast<std::uint8_t>(PointClass::undefined);
 }
 
@@ -175,8 +175,8 @@ FOCAL_HD inline void fit_vertex(const VertexFitParams<T>& p, int i) {
   o.k2[i] = k2;
   o.H[i] = T(0.5) * (k1 + k2);
   o.K[i] = k1 * k2;
-  kernels::store3(o.d1 + 3 * i, f.from_plane(e.d1x, e.d1y));
-  kernels::store3(o.d2 + 3 * i, f.from_plane(-e.d1y, e.d1x));
+  kernels::store3(o.d1 + 3LL * i, f.from_plane(e.d1x, e.d1y));
+  kernels::store3(o.d2 + 3LL * i, f.from_plane(-e.d1y, e.d1x));
   o.residual[i] = std::sqrt(energy / weight_sum);
   o.point_class[i] = kernels::classify(k1, k2, p.zero_tolerance, p.umbilic_tolerance);
 }

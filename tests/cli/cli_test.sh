@@ -168,6 +168,19 @@ run --version
 check "focal --version prints the version" bash -c '[[ $2 -eq 0 ]] && grep -qx "focal 0.1.0" "$1"' _ "$OUT" "$rc"
 
 # ---------------------------------------------------------------------------------------------
+# Devices: the backend, driver and GPUs, or why none is usable; --require turns "none" into
+# exit 2 (on a GPU machine it exits 0, as FOCAL_REQUIRE_GPU=1 runs of the suite expect).
+run devices
+check "focal devices exits 0 and names the backend" \
+  bash -c '[[ $2 -eq 0 ]] && grep -q "^CUDA backend: " "$1"' _ "$OUT" "$rc"
+if grep -q "^usable devices: *none: " "$OUT"; then
+  expect_error "focal devices --require without a usable GPU: exit 2 saying why" 2 "no usable CUDA device: " "" devices --require
+else
+  run devices --require
+  check "focal devices --require with a usable GPU exits 0" test "$rc" -eq 0
+fi
+
+# ---------------------------------------------------------------------------------------------
 # The test surface
 run generate sphere -o s.ply --truth t.csv
 check "generate sphere exits 0 and reports what it wrote" \
@@ -558,7 +571,7 @@ check "-v generate: a generate timing" stages_ok "$ERR" generate
 # eval: every estimator on every analytic case (8 surfaces x 2 triangulations x 3 noise models)
 run eval --vertices 300 --csv ev.csv --markdown ev.md --export evx
 check "eval: exit 0" test "$rc" -eq 0
-check "eval: 48 cases x 12 estimators in the CSV" test "$(data_rows ev.csv)" -eq 576
+check "eval: 48 cases x 16 estimators in the CSV" test "$(data_rows ev.csv)" -eq 768
 check "eval: focal default with and without normals in every case" \
   test "$(grep -c ',focal default / \(file\|no\) normals,' ev.csv)" -eq 96
 check "eval: the Markdown table has a row per case" test "$(grep -c '^| [a-z-]*, ' ev.md)" -eq 48
@@ -579,9 +592,9 @@ check "eval: a wrong report extension is a usage error" test "$rc" -eq 1
 # eval --scan: smoothness of H on meshes without truth (paper Fig. 7)
 run eval --scan s.ply --csv sc.csv --markdown sc.md --export scx
 check "eval --scan: exit 0" test "$rc" -eq 0
-check "eval --scan: a row per method (s.ply has normals: 5 methods)" test "$(data_rows sc.csv)" -eq 5
+check "eval --scan: a row per method (s.ply has normals: 8 methods)" test "$(data_rows sc.csv)" -eq 8
 check "eval --scan: H keeps its sign on the sphere" \
-  awk -F, 'NR > 1 { n++; if ($12 != 0) exit 1 } END { exit n != 5 }' sc.csv
+  awk -F, 'NR > 1 { n++; if ($12 != 0) exit 1 } END { exit n != 8 }' sc.csv
 check "eval --scan: coloured PLYs of H" \
   grep -q "^property uchar red" <(ply_header scx/s.focal-default-no-normals.ply)
 run eval --scan no-such-mesh.off

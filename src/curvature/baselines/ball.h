@@ -1,0 +1,34 @@
+#pragma once
+// The ball neighbourhood B(x_i, r) of the ball-based baselines (LRTC20, YLHP06).
+
+#include <cstdint>
+#include <vector>
+
+#include "focal/core/mesh.h"
+#include "focal/curvature/baselines.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/topology.h"
+
+namespace focal::baselines::ball {
+
+/// The radius of `ball` on a mesh of mean edge length `edge_length`, `default_in_edges` edge
+/// lengths where the options give neither a radius nor a radius in edges.
+/// \throw InvalidInput (naming `what`) when a radius is negative or not finite.
+double radius(const BallOptions& ball, double default_in_edges, double edge_length,
+              const char* what);
+
+/// What one thread reuses from vertex to vertex.
+struct Scratch {
+  std::vector<int> vertices;         ///< inside the ball, connected to the centre inside it
+  std::vector<int> faces;            ///< incident to those vertices, sorted, each once
+  std::vector<std::uint64_t> stamp;  ///< per mesh vertex: the visit that last reached it
+  std::uint64_t visit = 0;
+};
+
+/// Fills s.vertices and s.faces for the ball of radius r around vertex `centre`: the vertices
+/// reached from it along edges without leaving the ball, and their incident faces (a face cut
+/// by the sphere with no corner inside is left out: its part inside is O(h^3 / r) in area).
+void gather(PositionsRef V, const Neighbourhoods& one_ring,
+            const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s);
+
+}  // namespace focal::baselines::ball
