@@ -22,6 +22,7 @@
 #include "focal/curvature/estimate.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/curvature/baselines.h"
+#include "focal/tiles/tiles.h"
 #include "focal/cuda/device.h"
 #include "focal/cuda/curvature.h"
 #include "focal/image_space/image_space.h"

@@ -14,7 +14,9 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/fields.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/estimate.h"
 
 namespace focal_python {
 
@@ -69,6 +71,12 @@ Enum parse_enum(const std::string& value, const char* argument,
   throw focal::InvalidInput(std::string(argument) + ": unknown value '" + value + "' (expected " +
                             known + ")");
 }
+
+/// The per-vertex fields of a result as a dict of NumPy arrays (meshes.cpp).
+nb::dict curvature_dict(focal::CurvatureResult&& r);
+
+/// The options of focal::estimate from the keywords of focal.curvature (meshes.cpp).
+focal::EstimateOptions estimate_options(const nb::dict& o);
 
 inline std::optional<focal::NormalsRef> normals_ref(const std::optional<DoubleRows>& N) {
   if (!N) return std::nullopt;

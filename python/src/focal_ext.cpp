@@ -8,7 +8,8 @@
 // that owns it (moved, never copied).
 //
 // One file per area, each with one bind_* function called here: meshes.cpp (curvature, focal
-// meshes, checks, normals, files, analytic surfaces), render.cpp, image_space.cpp.
+// meshes, checks, normals, files, analytic surfaces), render.cpp, image_space.cpp, tiles.cpp
+// (focal/tiles for focal.distributed).
 // Nothing in src/ includes these files: the bindings are the top layer.
 
 #include <nanobind/nanobind.h>
@@ -21,6 +22,7 @@ namespace focal_python {
 void bind_meshes(nb::module_& m);
 void bind_render(nb::module_& m);
 void bind_image_space(nb::module_& m);
+void bind_tiles(nb::module_& m);
 }  // namespace focal_python
 
 namespace {
@@ -62,4 +64,5 @@ NB_MODULE(_focal_ext, m) {
   focal_python::bind_meshes(m);
   focal_python::bind_render(m);
   focal_python::bind_image_space(m);
+  focal_python::bind_tiles(m);
 }

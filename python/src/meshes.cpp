@@ -20,9 +20,6 @@
 #include "focal/surfaces/surfaces.h"
 
 namespace focal_python {
-namespace {
-
-using namespace nb::literals;
 
 nb::dict curvature_dict(focal::CurvatureResult&& r) {
   nb::dict d;
@@ -37,22 +34,6 @@ nb::dict curvature_dict(focal::CurvatureResult&& r) {
   d["rays_used"] = to_numpy(std::move(r.rays_used));
   d["rays_excluded"] = to_numpy(std::move(r.rays_excluded));
   return d;
-}
-
-nb::dict mesh_dict(focal::Mesh&& mesh) {
-  nb::dict d;
-  d["V"] = to_numpy(std::move(mesh.V));
-  d["F"] = to_numpy(std::move(mesh.F));
-  d["N"] = mesh.N.rows() > 0 ? nb::cast(to_numpy(std::move(mesh.N))) : nb::none();
-  return d;
-}
-
-focal::NormalWeighting parse_weighting(const std::string& s) {
-  static const std::pair<const char*, focal::NormalWeighting> names[] = {
-      {"area", focal::NormalWeighting::area},
-      {"angle", focal::NormalWeighting::angle},
-      {"max", focal::NormalWeighting::max}};
-  return parse_enum(s, "weighting", names);
 }
 
 /// The options of focal::estimate from the keywords of focal.curvature (python/focal/__init__.py
@@ -99,6 +80,26 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   r.umbilic_tolerance = p.umbilic_tolerance;
   r.threads = threads;
   return e;
+}
+
+namespace {
+
+using namespace nb::literals;
+
+nb::dict mesh_dict(focal::Mesh&& mesh) {
+  nb::dict d;
+  d["V"] = to_numpy(std::move(mesh.V));
+  d["F"] = to_numpy(std::move(mesh.F));
+  d["N"] = mesh.N.rows() > 0 ? nb::cast(to_numpy(std::move(mesh.N))) : nb::none();
+  return d;
+}
+
+focal::NormalWeighting parse_weighting(const std::string& s) {
+  static const std::pair<const char*, focal::NormalWeighting> names[] = {
+      {"area", focal::NormalWeighting::area},
+      {"angle", focal::NormalWeighting::angle},
+      {"max", focal::NormalWeighting::max}};
+  return parse_enum(s, "weighting", names);
 }
 
 nb::dict default_options() {

@@ -32,6 +32,20 @@ inline CurvatureResult unwritten_result(Eigen::Index n) {
   return r;
 }
 
+/// Copies row `from_row` of every field of `from` into row `to_row` of `to`.
+inline void copy_row(const CurvatureResult& from, Eigen::Index from_row, CurvatureResult& to,
+                     Eigen::Index to_row) {
+  for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
+                     &CurvatureResult::K, &CurvatureResult::residual}) {
+    (to.*field)[to_row] = (from.*field)[from_row];
+  }
+  to.d1.row(to_row) = from.d1.row(from_row);
+  to.d2.row(to_row) = from.d2.row(from_row);
+  to.point_class[to_row] = from.point_class[from_row];
+  to.rays_used[to_row] = from.rays_used[from_row];
+  to.rays_excluded[to_row] = from.rays_excluded[from_row];
+}
+
 /// Marks vertex i `undefined`: NaN in every numeric field. Leaves the ray counts alone.
 inline void store_undefined(CurvatureResult& r, Eigen::Index i) {
   const double nan = std::numeric_limits<double>::quiet_NaN();

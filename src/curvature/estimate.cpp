@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -148,7 +149,7 @@ PreparedNormals prepare_normals(const PreparedMesh& mesh, const EstimateOptions&
   }
   // Normals from the faces (or, for the recommended estimator, from the positions later) take
   // their side from the faces.
-  orient_faces_outward(mesh, out);
+  if (options.orient_faces) orient_faces_outward(mesh, out);
   if (!recommended) {
     const PreparedMesh faces = mesh_to_fit(mesh.with_normals(std::nullopt), out);
     out.N = vertex_normals(faces, weighting_of(source));
@@ -186,6 +187,47 @@ Estimate estimate(const PreparedMesh& mesh, PreparedNormals normals,
 
 Estimate estimate(const PreparedMesh& mesh, const EstimateOptions& options) {
   return estimate(mesh, prepare_normals(mesh, options), options);
+}
+
+int estimate_reach(const EstimateOptions& options) {
+  if (options.estimator == Estimator::recommended) {
+    // Without the mesh's choices, the widest plan (3 rings) bounds every plan's reach.
+    const double noise = options.recommended.mesh_wide ? options.recommended.mesh_wide->noise
+                                                       : std::numeric_limits<double>::infinity();
+    return recommended_reach(recommended_plan_for_noise(noise, options.recommended));
+  }
+  // The corners of a vertex's faces, whose normals read their own faces.
+  if (options.paper.method == Method::triangle) return 2;
+  return options.paper.rings + 1;
+}
+
+MeshWideChoices mesh_wide_choices(const PreparedMesh& mesh, const EstimateOptions& options) {
+  // The normals the whole estimate would fit are needed only where they decide something
+  // mesh-wide: the file's (filled, made unit) for the recommended estimator's comparison. Each
+  // tile prepares its own from its rows (the fixes are per row).
+  PreparedNormals prepared;
+  if (uses_mesh_normals(mesh, options.normals)) {
+    if (options.estimator == Estimator::recommended) prepared = prepare_normals(mesh, options);
+  } else if (options.orient_faces) {
+    orient_faces_outward(mesh, prepared);
+  }
+  MeshWideChoices out;
+  {
+    const PreparedMesh fit = mesh_to_fit(mesh, prepared);
+    out.mean_edge_length = fit.mean_edge_length();
+    if (options.estimator == Estimator::recommended) {
+      out.recommended = recommended_mesh_wide(fit, options.recommended);
+    }
+  }
+  out.F = std::move(prepared.F);
+  return out;
+}
+
+EstimateOptions options_for_part(const EstimateOptions& options, const MeshWideChoices& choices) {
+  EstimateOptions out = options;
+  out.orient_faces = false;
+  out.recommended.mesh_wide = choices.recommended;
+  return out;
 }
 
 }  // namespace focal

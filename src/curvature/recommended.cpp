@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fields_detail.h"
 #include "core/parallel.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
@@ -210,18 +211,6 @@ bool file_normals_agree(double median_angle, double noise, double agreement) {
 /// meet two slits exactly (spheres, cylinders, planes), and so does the fit.
 constexpr double kExactFitResidual = 1e-9;
 
-void copy_vertex(const CurvatureResult& from, Eigen::Index i, CurvatureResult& to) {
-  for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
-                     &CurvatureResult::K, &CurvatureResult::residual}) {
-    (to.*field)[i] = (from.*field)[i];
-  }
-  to.d1.row(i) = from.d1.row(i);
-  to.d2.row(i) = from.d2.row(i);
-  to.point_class[i] = from.point_class[i];
-  to.rays_used[i] = from.rays_used[i];
-  to.rays_excluded[i] = from.rays_excluded[i];
-}
-
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
@@ -234,8 +223,33 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureRes
   detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
     const bool exact_fit = fit.residual[i] <= kExactFitResidual;
     const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) copy_vertex(triangles, i, fit);
+    if (!exact_fit && triangles_defined) detail::copy_row(triangles, i, fit, i);
   });
+}
+
+/// The file's normals compared with the jet normals: the side they point to, and per vertex the
+/// angle between the two (empty without file normals).
+struct FileComparison {
+  double side = 1.0;
+  Eigen::VectorXd disagreement;
+};
+
+FileComparison compare_file_normals(const Context& c, const JetNormals& jets) {
+  const std::optional<NormalsRef> file = c.mesh.normals();
+  if (!file) return {};
+  // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
+  // normals from the positions take the side of the faces until turned. A tile takes the whole
+  // mesh's side.
+  const double side =
+      c.options.mesh_wide ? c.options.mesh_wide->side : majority_side(*file, jets.N);
+  return {side, angles_between(*file, jets.N, side, c.threads)};
+}
+
+/// The per-mesh choices measured on the context's mesh: medians over all its vertices.
+RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
+                                      const FileComparison& file) {
+  return {finite_median(jets.residual) / c.edge_length,
+          c.mesh.has_normals() ? finite_median(file.disagreement) : NAN, file.side};
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -244,13 +258,13 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   const std::optional<NormalsRef> file = c.mesh.normals();
   const bool has_normals = file.has_value();
   const JetNormals jets = local_jets(c, 2, 3);
-  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, c.options);
-  // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
-  // normals from the positions take the side of the faces until turned.
-  const double side = has_normals ? majority_side(*file, jets.N) : 1.0;
-  const Eigen::VectorXd disagreement =
-      has_normals ? angles_between(*file, jets.N, side, c.threads) : Eigen::VectorXd();
-  out.file_disagreement = has_normals ? finite_median(disagreement) : NAN;
+  const FileComparison compared = compare_file_normals(c, jets);
+  const RecommendedMeshWide mesh_wide =
+      c.options.mesh_wide ? *c.options.mesh_wide : measure_mesh_wide(c, jets, compared);
+  out.plan = recommended_plan_for_noise(mesh_wide.noise, c.options);
+  const double side = compared.side;
+  const Eigen::VectorXd& disagreement = compared.disagreement;
+  out.file_disagreement = mesh_wide.file_disagreement;
   out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise,
                                                             c.options.file_agreement);
   Eigen::VectorXd roughness;
@@ -293,6 +307,35 @@ RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOpti
   const Context c = make_context(mesh, options);
   const JetNormals jets = local_jets(c, 2, 3);
   return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, options);
+}
+
+RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
+                                          const RecommendedOptions& options) {
+  validate_options(options, "recommended_mesh_wide");
+  RecommendedOptions measured = options;
+  measured.mesh_wide.reset();
+  const Context c = make_context(mesh, measured);
+  const JetNormals jets = local_jets(c, 2, 3);
+  return measure_mesh_wide(c, jets, compare_file_normals(c, jets));
+}
+
+int recommended_reach(const RecommendedPlan& plan) {
+  // What the estimate at a vertex v reads, in rings from v (a vertex's Max normal reads its
+  // incident faces, whose corners are one ring further; jets read their k-ring's positions and
+  // Max's normal at their centre only):
+  //  - the final fit: the fitted normals within plan.rings; on the 1-ring also the per-triangle
+  //    pass, the fitted normals at the corners of v's faces (1 ring);
+  //  - a fitted normal at u is either (noisy positions, file normals ignored) the jet of u over
+  //    plan.jet_rings rings, or chosen between candidates by their 1-ring fits' residuals at u:
+  //    candidates (jets over 2 rings, Max's, the file's) on u's 1-ring, so a jet over 2 rings
+  //    around a vertex one ring from u: 1 + 2 rings from u;
+  //  - a jet over k rings around w needs w's whole k-ring, so every face within k rings of w,
+  //    i.e. vertices up to k rings from w with all their faces: k rings suffice for positions,
+  //    as the k-ring is made of the 1-rings of the (k-1)-ring;
+  //  - Max's normal at w reads w's incident faces: their corners are 1 ring from w.
+  const int chosen = 1 + 2;  // a candidate's 1-ring fit, of jets over 2 rings
+  const int noisy = plan.jet_rings;
+  return std::max(plan.rings, 1) + std::max(chosen, noisy);
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {

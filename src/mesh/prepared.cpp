@@ -1,5 +1,6 @@
 #include "focal/mesh/prepared.h"
 
+#include <cmath>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -97,9 +98,14 @@ namespace detail {
 PreparedMesh PreparedAccess::make(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
                                   const PrepareOptions& options, const char* what) {
   if (options.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
+  if (!(options.mean_edge_length >= 0.0 && std::isfinite(options.mean_edge_length))) {
+    throw InvalidInput(std::string(what) + ": mean_edge_length must be finite and >= 0");
+  }
   check_normal_rows(V.rows(), N, what);
   validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), what, options.threads);
-  return {std::make_shared<PreparedMesh::Geometry>(V, F, options.threads), std::move(N)};
+  auto geometry = std::make_shared<PreparedMesh::Geometry>(V, F, options.threads);
+  if (options.mean_edge_length > 0.0) geometry->mean_edge_length = options.mean_edge_length;
+  return {std::move(geometry), std::move(N)};
 }
 
 std::shared_ptr<const VertexFaces> PreparedAccess::incidence(const PreparedMesh& mesh) {

@@ -56,7 +56,39 @@ struct EstimateOptions {
   CurvatureOptions paper{};
   /// Estimator::recommended: its options.
   RecommendedOptions recommended{};
+  /// Whether prepare_normals reverses the faces of closed components oriented inward (when the
+  /// normals do not come from the mesh). false: the faces are taken as they are, e.g. a tile's,
+  /// cut from the faces that MeshWideChoices::F oriented over the whole mesh.
+  bool orient_faces = true;
 };
+
+/// The rings around a vertex whose positions, faces and normals its estimate reads: a part of a
+/// mesh (a tile, focal/tiles/tiles.h) holding every face within this many rings of its vertices
+/// gives them the whole mesh's estimate. Paper, per vertex: its rings + 1 (the normals of the
+/// ring's vertices read their faces); per triangle: 2 (the corners' normals); recommended:
+/// recommended_reach of the plan of options.recommended.mesh_wide, or the widest plan's.
+[[nodiscard]] int estimate_reach(const EstimateOptions& options);
+
+/// What an estimate takes from the whole mesh, measured once on it, so that a part of the mesh
+/// (with its halo of estimate_reach rings) is estimated exactly as in the whole.
+struct MeshWideChoices {
+  /// #F x 3 faces with the closed components oriented inward reversed (prepare_normals), when
+  /// some were; std::nullopt: F as given. A tile cuts its faces from these.
+  std::optional<RowMatrixX3i> F;
+  /// The mean edge length of the faces the estimator fits: PrepareOptions::mean_edge_length of
+  /// a tile.
+  double mean_edge_length = NAN;
+  /// Estimator::recommended: recommended_mesh_wide of the mesh the estimator gets.
+  std::optional<RecommendedMeshWide> recommended;
+};
+
+/// The choices of a whole mesh, and the options that make an estimate on a part of it take them
+/// (orient_faces off, recommended.mesh_wide given). The mean edge length goes into the part's
+/// PrepareOptions. \throw InvalidInput as prepare_normals.
+[[nodiscard]] MeshWideChoices mesh_wide_choices(const PreparedMesh& mesh,
+                                                const EstimateOptions& options = {});
+[[nodiscard]] EstimateOptions options_for_part(const EstimateOptions& options,
+                                               const MeshWideChoices& choices);
 
 /// What prepare_normals did, for a caller to report.
 struct NormalsReport {

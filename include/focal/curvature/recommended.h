@@ -49,6 +49,17 @@ inline constexpr double kNoiseForTwoRings = 0.015;
 /// ... and above which it uses 3 rings.
 inline constexpr double kNoiseForThreeRings = 0.035;
 
+/// The choices of steps 1 to 3 that are made once per mesh, from all its vertices (medians and
+/// a majority): given in RecommendedOptions::mesh_wide instead of measured, they let a part of a
+/// mesh (a tile with its halo, focal/tiles/tiles.h) be estimated exactly as in the whole mesh.
+struct RecommendedMeshWide {
+  double noise = NAN;              ///< RecommendedPlan::noise: decides the plan
+  double file_disagreement = NAN;  ///< RecommendedResult::file_disagreement (NaN: no normals)
+  /// +1, or -1 when most file normals point against the jet normals (the positions' normals are
+  /// then turned to the file's side).
+  double side = 1.0;
+};
+
 /// Options of the recommended estimator. The defaults are the measured choices of
 /// docs/ESTIMATOR.md; each field is a knob of one of the steps above.
 struct RecommendedOptions {
@@ -70,6 +81,10 @@ struct RecommendedOptions {
   /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
   /// PrepareOptions::threads.
   int threads = 0;
+  /// The per-mesh choices, when given, instead of measuring them on this mesh: a tile takes
+  /// recommended_mesh_wide() of the whole mesh (with PrepareOptions::mean_edge_length, the scale
+  /// they are measured in).
+  std::optional<RecommendedMeshWide> mesh_wide;
 };
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
@@ -93,6 +108,17 @@ struct RecommendedPlan {
 /// recommended_plan of the arrays. \throw InvalidInput also when F indexes outside V.
 [[nodiscard]] RecommendedPlan recommended_plan(PositionsRef V, FacesRef F,
                                                const RecommendedOptions& options = {});
+
+/// The per-mesh choices of the recommended estimator on `mesh` (its normals as the file's, as
+/// estimate_curvature_recommended takes them): cubic jets over the 2-ring of every vertex.
+/// \throw InvalidInput when an option is out of range.
+[[nodiscard]] RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
+                                                        const RecommendedOptions& options = {});
+
+/// The rings around a vertex whose positions, faces and normals its recommended estimate reads,
+/// for a plan: a tile needs a halo this wide (focal/tiles/tiles.h). Derived in recommended.cpp
+/// from the steps above.
+[[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
 /// The recommended estimate with what it decided and the normals it fitted.
 struct RecommendedResult {

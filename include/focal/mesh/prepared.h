@@ -31,6 +31,10 @@ struct PrepareOptions {
   /// Threads of what the PreparedMesh builds, and of every function given it whose own `threads`
   /// option is 0. 0: FOCAL_NUM_THREADS if set, else all hardware threads.
   int threads = 0;
+  /// The mean edge length to use instead of measuring it (0: measured): a tile of a larger mesh
+  /// (focal/tiles/tiles.h) takes the whole mesh's, so that the scale of its classes, Gaussian
+  /// weights and noise estimate is the whole mesh's. Must be finite and >= 0.
+  double mean_edge_length = 0.0;
 };
 
 namespace detail {
@@ -42,7 +46,8 @@ class PreparedMesh {
   /// Validates the arrays once. \param V #V x 3 positions (NaN and infinities allowed: the
   /// estimators flag the vertices they touch). \param F #F x 3 triangles. \param N #V x 3
   /// normals as given (need not be unit), or std::nullopt when there are none.
-  /// \throw InvalidInput when F indexes outside V, N does not have #V rows, or threads < 0.
+  /// \throw InvalidInput when F indexes outside V, N does not have #V rows, threads < 0 or
+  /// mean_edge_length is negative or not finite.
   PreparedMesh(PositionsRef V, FacesRef F, std::optional<NormalsRef> N = std::nullopt,
                const PrepareOptions& options = {});
   /// The arrays of `mesh` (its normals when it has them), which must outlive the object.
@@ -64,7 +69,8 @@ class PreparedMesh {
 
   /// The 1-ring (vertex_adjacency), built on first call and kept.
   [[nodiscard]] const Neighbourhoods& one_ring() const;
-  /// focal::mean_edge_length of V and F, computed on first call.
+  /// focal::mean_edge_length of V and F, computed on first call (or PrepareOptions::
+  /// mean_edge_length when given).
   [[nodiscard]] double mean_edge_length() const;
 
   /// The same V and F, sharing what has been built for them, with other normals (or none).

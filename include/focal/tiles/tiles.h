@@ -1,0 +1,82 @@
+#pragma once
+/// \file tiles.h
+/// A mesh cut into spatial tiles with halos, each estimated on its own (in another process or
+/// on another machine: python/focal/distributed.py runs them on Dask) and giving its owned
+/// vertices exactly the whole mesh's estimate, bit for bit. docs/SCALE.md.
+///
+/// Why the result is identical: a tile holds every face within `halo_rings` rings of its owned
+/// vertices, with halo_rings = estimate_reach(options) (estimate.h: the rings an estimate reads,
+/// derived from the estimator's steps), so each owned vertex sees the same neighbours, normals and
+/// faces as in the whole mesh. The tile keeps the whole mesh's order: its vertices and faces are
+/// sorted by global id, so every neighbour list, incidence list and sum runs in the same order.
+/// What is decided from the whole mesh (the mean edge length, the recommended estimator's noise
+/// and file-normal choices, the orientation of closed components) is measured once by
+/// mesh_wide_choices and given to every tile.
+
+#include <optional>
+#include <vector>
+
+#include "focal/core/fields.h"
+#include "focal/core/mesh.h"
+#include "focal/curvature/estimate.h"
+#include "focal/mesh/prepared.h"
+
+namespace focal {
+
+struct TileOptions {
+  /// Owned vertices per tile, at most (a tile also holds its halo). >= 1.
+  int tile_vertices = 1 << 20;
+  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads.
+  int threads = 0;
+};
+
+/// One tile: global ids, ascending.
+struct Tile {
+  std::vector<int> vertices;  ///< owned and halo vertices
+  std::vector<int>
+      faces;  ///< every face with a corner within halo_rings - 1 rings of an owned vertex
+  std::vector<int> owned;  ///< positions in `vertices` of the owned ones
+};
+
+/// The tiles of a mesh: every vertex is owned by exactly one tile.
+struct Tiling {
+  std::vector<Tile> tiles;
+  int halo_rings = 0;
+};
+
+/// Cuts a mesh into tiles of consecutive vertices in Morton (Z) order of their positions, within
+/// the bounding box of the finite ones (vertices with NaN or infinite coordinates come last),
+/// ties by index; each tile gets the faces and vertices within `halo_rings` rings of its owned
+/// vertices. \param halo_rings >= 1: estimate_reach(options) for an estimate.
+/// \throw InvalidInput when F indexes outside V, halo_rings < 1 or tile_vertices < 1.
+[[nodiscard]] Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings,
+                                    const TileOptions& options = {});
+
+/// A tile's arrays, renumbered 0 .. #vertices - 1 in the tile's (global) order.
+struct TileMesh {
+  RowMatrixX3d V;
+  RowMatrixX3i F;
+  std::optional<RowMatrixX3d> N;  ///< when the mesh has normals
+};
+
+/// The rows of `tile` of V, F and N. \throw InvalidInput when the tile's ids are out of range.
+[[nodiscard]] TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
+                                    const Tile& tile);
+
+/// estimate() of a tile's arrays with the whole mesh's choices: `options` as given to the whole
+/// mesh (options_for_part is applied here). Rows of every tile vertex; those of its owned
+/// vertices are the whole mesh's.
+[[nodiscard]] CurvatureResult estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
+                                            const EstimateOptions& options, int threads = 0);
+
+/// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
+/// .curvature, with the memory of the largest tile in place of the whole mesh's estimate.
+[[nodiscard]] CurvatureResult estimate_tiled(const PreparedMesh& mesh,
+                                             const EstimateOptions& options = {},
+                                             const TileOptions& tiles = {});
+
+/// Writes the rows `rows` of `part` into the rows `ids[rows]` of `whole` (sized #V).
+void scatter_rows(const CurvatureResult& part, const std::vector<int>& rows,
+                  const std::vector<int>& ids, CurvatureResult& whole);
+
+}  // namespace focal

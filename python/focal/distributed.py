@@ -1,0 +1,276 @@
+"""focal on a Dask cluster: a mesh cut into spatial tiles with halos, one task per tile, and the
+owned vertices of every tile written back, giving the same bits as ``focal.curvature`` on the
+whole mesh (include/focal/tiles/tiles.h, docs/SCALE.md).
+
+The driver (this process) holds the whole mesh, measures once what the estimate takes from the
+whole mesh (the mean edge length, the recommended estimator's noise and file-normal choices, the
+orientation of closed components) and cuts the tiles; the workers each hold one tile at a time.
+Tasks are submitted a few per worker thread at a time, so that the scheduler holds only those
+tiles' arrays; results are written into the output as they arrive. A task whose worker dies is
+run again elsewhere by Dask; a task that raises is retried ``retries`` times.
+
+    import focal.distributed
+    c = focal.distributed.curvature("scan.ply", tile_vertices=250_000)   # a LocalCluster
+    c = focal.distributed.curvature((V, F, N), client=Client("tcp://scheduler:8786"))
+
+or from a shell: ``python -m focal.distributed scan.ply -o fields.npz --scheduler ADDRESS``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import uuid
+import warnings
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+import focal
+from focal import _focal_ext as _ext
+
+__all__ = ["curvature", "main"]
+
+#: The per-vertex fields of focal.Curvature that tiles write back.
+FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
+          "rays_excluded")
+
+#: Tasks in flight per worker thread: enough to keep workers busy while results come back,
+#: few enough that the scheduler holds only a few tiles' arrays.
+_TASKS_PER_THREAD = 2
+
+
+def _estimate_tile(V: np.ndarray, F: np.ndarray, N: Optional[np.ndarray], owned: np.ndarray,
+                   options: dict, choices: dict) -> dict:
+    """The task: a tile's estimate with the whole mesh's choices, its owned rows only."""
+    d = _ext.estimate_tile(V, F, N, options, choices)
+    return {name: d[name][owned] for name in FIELDS}
+
+
+def _mesh_of(path_or_arrays: Any):
+    if isinstance(path_or_arrays, (str, os.PathLike)):
+        m = focal.read_mesh(path_or_arrays)
+        return m.V, m.F, m.N
+    if isinstance(path_or_arrays, focal.Mesh):
+        return path_or_arrays.V, path_or_arrays.F, path_or_arrays.N
+    if isinstance(path_or_arrays, tuple) and len(path_or_arrays) in (2, 3):
+        return (*path_or_arrays, None) if len(path_or_arrays) == 2 else path_or_arrays
+    raise focal.InvalidInputError(
+        "path_or_arrays must be a path, a focal.Mesh or a tuple (V, F) or (V, F, N), "
+        f"got {type(path_or_arrays).__name__}"
+    )
+
+
+def _local_client(workers: Optional[int], memory_limit: Any):
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(
+        n_workers=workers or os.cpu_count() or 1,
+        threads_per_worker=1,
+        memory_limit=memory_limit if memory_limit is not None else "auto",
+        processes=True,
+        dashboard_address=":0",
+    )
+    return Client(cluster), cluster
+
+
+def curvature(
+    path_or_arrays: Any,
+    client: Any = None,
+    *,
+    tile_vertices: int = 250_000,
+    workers: Optional[int] = None,
+    memory_limit: Any = None,
+    retries: int = 2,
+    progress: bool = False,
+    on_tile: Optional[Callable[[int, np.ndarray, dict], None]] = None,
+    **options: Any,
+) -> focal.Curvature:
+    """``focal.curvature`` of a mesh, tile by tile on a Dask cluster: the same bits.
+
+    Parameters
+    ----------
+    path_or_arrays : a mesh file (read by ``focal.read_mesh``), a ``focal.Mesh`` or a tuple
+        ``(V, F)`` / ``(V, F, N)``.
+    client : a ``distributed.Client``; None: a ``LocalCluster`` of ``workers`` processes (default
+        one per core) with one thread each and ``memory_limit`` per worker (Dask's "auto"
+        default), closed at the end.
+    tile_vertices : owned vertices per tile (each tile also holds a halo of the estimate's reach,
+        a few rings). A worker's memory is about that of ``focal.curvature`` on one tile.
+    retries : how many times a task that raised is run again (a task whose worker died is
+        rescheduled by Dask whatever this is).
+    progress : show Dask's progress bar (it waits for all tasks, then results are collected).
+    on_tile : called in the driver as each tile's result arrives, with the tile's index, the
+        global ids of its owned vertices and their fields (a dict of arrays by name), e.g. to
+        write the result in parts.
+    options : the keywords of ``focal.curvature`` (estimator, normals, threads, ...). threads is
+        per task; None with the default LocalCluster: 1 (one thread per worker).
+
+    Returns a ``focal.Curvature`` with the per-vertex fields (N, F, plan and the reports of a
+    whole run are not filled: the fields are what a tiled run writes back).
+
+    Raises InvalidInputError as ``focal.curvature``, FocalIOError for an unreadable file.
+    """
+    from distributed import as_completed
+
+    V, F, N = _mesh_of(path_or_arrays)
+    if int(tile_vertices) < 1:
+        raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
+    own_cluster = client is None
+    if own_cluster and options.get("threads") is None:
+        options["threads"] = 1
+    estimator, threads, opts = focal._curvature_options(options)
+    o = focal._estimate_options(estimator, threads, opts)
+    Va, Fa, Na = focal._mesh_arrays(V, F, N)
+    plan = _ext.tile_plan(Va, Fa, Na, o, int(tile_vertices))
+    faces = plan["F"] if plan["F"] is not None else Fa
+    out = _empty_fields(Va.shape[0])
+
+    cluster = None
+    if own_cluster:
+        client, cluster = _local_client(workers, memory_limit)
+    try:
+        tiles = plan["tiles"]
+        in_flight = max(1, _TASKS_PER_THREAD * sum(client.nthreads().values()))
+
+        def submit(i: int):
+            t = tiles[i]
+            a = _ext.extract_tile(Va, faces, Na, t["vertices"], t["faces"])
+            # The arrays travel inside the task, not scattered ahead: Dask can then rerun the
+            # task elsewhere when its worker dies (scattered data would die with the worker).
+            # Dask warns about such tasks ("Sending large graph"); here that is the intent.
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Sending large graph")
+                fut = client.submit(_estimate_tile, a["V"], a["F"], a["N"], t["owned"], o,
+                                    plan["choices"], key=f"focal-tile-{i}-{uuid.uuid4().hex}",
+                                    retries=retries)
+            tile_of[fut.key] = i
+            return fut
+
+        tile_of = {}
+        first = [submit(i) for i in range(min(in_flight, len(tiles)))]
+        if progress:
+            from distributed import progress as dask_progress
+
+            dask_progress(first)
+        pending = as_completed(first, with_results=True)
+        next_tile = len(first)
+        for fut, fields in pending:
+            i = tile_of.pop(fut.key)
+            ids = tiles[i]["vertices"][tiles[i]["owned"]]
+            for name in FIELDS:
+                out[name][ids] = fields[name]
+            if on_tile is not None:
+                on_tile(i, ids, fields)
+            fut.release()
+            if next_tile < len(tiles):
+                pending.add(submit(next_tile))
+                next_tile += 1
+    finally:
+        if cluster is not None:
+            client.close()
+            cluster.close()
+    return focal.Curvature(**out)
+
+
+def _empty_fields(n: int) -> dict:
+    return {
+        "k1": np.empty(n), "k2": np.empty(n), "H": np.empty(n), "K": np.empty(n),
+        "d1": np.empty((n, 3)), "d2": np.empty((n, 3)), "residual": np.empty(n),
+        "point_class": np.empty(n, np.uint8), "rays_used": np.empty(n, np.int32),
+        "rays_excluded": np.empty(n, np.int32),
+    }
+
+
+def _write_atomically(path: str, write: Callable[[str], None]) -> None:
+    """Writes through a temporary file beside `path`, renamed at the end: no half-written file."""
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".focal-", suffix=os.path.splitext(path)[1], dir=folder)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def _write_fields(path: str, c: focal.Curvature) -> None:
+    if path.endswith(".npz"):
+        def write_npz(tmp: str) -> None:
+            with open(tmp, "wb") as f:
+                np.savez(f, **c.to_dict())
+
+        _write_atomically(path, write_npz)
+    elif path.endswith(".csv"):
+        columns = np.column_stack([c.k1, c.k2, c.H, c.K, c.d1, c.d2, c.residual])
+        header = "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class"
+
+        def write(tmp: str) -> None:
+            with open(tmp, "w") as f:
+                f.write(header + "\n")
+                for row, cls in zip(columns, c.point_class):
+                    f.write(",".join(repr(float(x)) for x in row) + f",{int(cls)}\n")
+
+        _write_atomically(path, write)
+    else:
+        raise focal.InvalidInputError(f"{path}: the output must end in .npz or .csv")
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors exit 1, as the focal command line's (2 is for unreadable input)."""
+
+    def error(self, message: str):
+        self.print_usage(sys.stderr)
+        print(f"Error: {message}", file=sys.stderr)
+        sys.exit(1)
+
+
+def main(argv: Optional[list] = None) -> int:
+    """``python -m focal.distributed``: the command line of ``curvature``. Exit codes as
+    ``focal``: 0 success, 1 usage error, 2 unreadable input or invalid data."""
+    p = _Parser(
+        prog="python -m focal.distributed",
+        description="focal curvature of a mesh, tile by tile on a Dask cluster (the same "
+        "numbers as `focal curvature`).",
+    )
+    p.add_argument("input", help="mesh file (.ply, .obj, .off, .stl)")
+    p.add_argument("-o", "--output", required=True, help="fields, .npz or .csv (input order)")
+    p.add_argument("--scheduler", help="address of a running Dask scheduler "
+                   "(default: a LocalCluster here)")
+    p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
+    p.add_argument("--memory-limit", help="LocalCluster memory per worker, e.g. 2GB")
+    p.add_argument("--tile-vertices", type=int, default=250_000,
+                   help="owned vertices per tile (default 250000)")
+    p.add_argument("--paper", action="store_true", help="the paper's estimator, not the default")
+    p.add_argument("--threads", type=int, help="threads per task")
+    p.add_argument("--progress", action="store_true", help="show Dask's progress bar")
+    args = p.parse_args(argv)
+    if args.scheduler and (args.workers or args.memory_limit):
+        p.error("--workers and --memory-limit configure a LocalCluster: not with --scheduler")
+    if not args.output.endswith((".npz", ".csv")):
+        p.error(f"{args.output}: the output must end in .npz or .csv")
+    client = None
+    try:
+        if args.scheduler:
+            from distributed import Client
+
+            client = Client(args.scheduler)
+        c = curvature(args.input, client, tile_vertices=args.tile_vertices,
+                      workers=args.workers, memory_limit=args.memory_limit,
+                      progress=args.progress, threads=args.threads,
+                      estimator="paper" if args.paper else "recommended")
+        _write_fields(args.output, c)
+    except (focal.FocalIOError, focal.InvalidInputError, OSError) as e:
+        print(f"Error: {e}", file=sys.stderr)
+        return 2
+    finally:
+        if client is not None:
+            client.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,128 @@
+// focal._focal_ext's functions of focal/tiles/tiles.h, for python/focal/distributed.py: the plan
+// of a tiled run (the whole mesh's choices and its tiles), a tile's arrays, a tile's estimate.
+#include "focal/tiles/tiles.h"
+
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "bindings.h"
+#include "focal/curvature/estimate.h"
+#include "focal/mesh/prepared.h"
+
+namespace focal_python {
+namespace {
+
+using namespace nb::literals;
+using Ids = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+nb::object ids_to_numpy(const std::vector<int>& ids) {
+  return nb::cast(to_numpy(Eigen::VectorXi(
+      Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size())))));
+}
+
+std::vector<int> ids_from(const Ids& a) { return {a.data(), a.data() + a.shape(0)}; }
+
+nb::dict choices_dict(const focal::MeshWideChoices& c) {
+  nb::dict d;
+  d["mean_edge_length"] = c.mean_edge_length;
+  if (c.recommended) {
+    d["noise"] = c.recommended->noise;
+    d["file_disagreement"] = c.recommended->file_disagreement;
+    d["side"] = c.recommended->side;
+  }
+  return d;
+}
+
+focal::MeshWideChoices choices_from(const nb::dict& d) {
+  focal::MeshWideChoices c;
+  c.mean_edge_length = nb::cast<double>(d["mean_edge_length"]);
+  if (d.contains("noise")) {
+    c.recommended = focal::RecommendedMeshWide{nb::cast<double>(d["noise"]),
+                                               nb::cast<double>(d["file_disagreement"]),
+                                               nb::cast<double>(d["side"])};
+  }
+  return c;
+}
+
+/// The whole mesh's choices and its tiles (partition_mesh with the estimate's reach), with the
+/// faces the tiles are cut from when the choices reoriented some.
+nb::dict tile_plan(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
+                   const nb::dict& options, int tile_vertices) {
+  const focal::EstimateOptions o = estimate_options(options);
+  const int threads = nb::cast<int>(options["threads"]);
+  focal::MeshWideChoices choices;
+  focal::Tiling tiling;
+  {
+    nb::gil_scoped_release release;
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+    choices = focal::mesh_wide_choices(mesh, o);
+    const focal::FacesRef faces = choices.F ? focal::FacesRef(*choices.F) : mesh.F();
+    tiling = focal::partition_mesh(mesh.V(), faces,
+                                   focal::estimate_reach(focal::options_for_part(o, choices)),
+                                   {.tile_vertices = tile_vertices, .threads = threads});
+  }
+  nb::list tiles;
+  for (const focal::Tile& t : tiling.tiles) {
+    nb::dict d;
+    d["vertices"] = ids_to_numpy(t.vertices);
+    d["faces"] = ids_to_numpy(t.faces);
+    d["owned"] = ids_to_numpy(t.owned);
+    tiles.append(d);
+  }
+  nb::dict d;
+  d["choices"] = choices_dict(choices);
+  d["halo_rings"] = tiling.halo_rings;
+  d["F"] = optional_to_numpy(std::move(choices.F));
+  d["tiles"] = tiles;
+  return d;
+}
+
+nb::dict extract_tile(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
+                      const Ids& vertices, const Ids& faces) {
+  const focal::Tile tile{ids_from(vertices), ids_from(faces), {}};
+  focal::TileMesh t;
+  {
+    nb::gil_scoped_release release;
+    t = focal::extract_tile(view(V), view(F), normals_ref(N), tile);
+  }
+  nb::dict d;
+  d["V"] = to_numpy(std::move(t.V));
+  d["F"] = to_numpy(std::move(t.F));
+  d["N"] = optional_to_numpy(std::move(t.N));
+  return d;
+}
+
+/// The estimate of every vertex of a tile, with the whole mesh's choices.
+nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
+                       const nb::dict& options, const nb::dict& choices) {
+  const focal::EstimateOptions o = estimate_options(options);
+  const focal::MeshWideChoices c = choices_from(choices);
+  const int threads = nb::cast<int>(options["threads"]);
+  focal::CurvatureResult r;
+  {
+    nb::gil_scoped_release release;
+    focal::TileMesh tile{view(V), view(F), std::nullopt};
+    if (N) tile.N = focal::RowMatrixX3d(view(*N));
+    r = focal::estimate_tile(tile, c, o, threads);
+  }
+  return curvature_dict(std::move(r));
+}
+
+}  // namespace
+
+void bind_tiles(nb::module_& m) {
+  m.def("tile_plan", &tile_plan, "V"_a.noconvert(), "F"_a.noconvert(), "N"_a.none().noconvert(),
+        "options"_a, "tile_vertices"_a);
+  m.def("extract_tile", &extract_tile, "V"_a.noconvert(), "F"_a.noconvert(),
+        "N"_a.none().noconvert(), "vertices"_a.noconvert(), "faces"_a.noconvert());
+  m.def("estimate_tile", &estimate_tile, "V"_a.noconvert(), "F"_a.noconvert(),
+        "N"_a.none().noconvert(), "options"_a, "choices"_a);
+}
+
+}  // namespace focal_python

@@ -1,0 +1,172 @@
+"""focal.distributed on a Dask LocalCluster of 2 worker processes: tile by tile, the same bits as
+focal.curvature on the whole mesh (meshes with boundaries, several components, one inward, a
+non-manifold fin), also when a worker is killed during the run; the command line's outputs and
+exit codes.
+
+`import distributed` is not guarded: `make test` installs dask[distributed] into its venv, and a
+missing one fails the run.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from distributed import Client, LocalCluster
+
+import focal
+import focal.distributed as fd
+
+
+def same_fields(a, b):
+    return all(getattr(a, n).tobytes() == getattr(b, n).tobytes() for n in fd.FIELDS)
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                           dashboard_address=":0", memory_limit="1GB")
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def joined(*meshes):
+    V = np.vstack([m[0] for m in meshes])
+    N = np.vstack([m[2] for m in meshes])
+    offsets = np.cumsum([0] + [len(m[0]) for m in meshes[:-1]])
+    F = np.vstack([m[1] + o for m, o in zip(meshes, offsets)]).astype(np.int32)
+    return V, F, N
+
+
+@pytest.fixture(scope="module")
+def awkward():
+    """A torus (closed), a saddle (boundary), an ellipsoid turned inward and a fin: three faces on
+    one edge of the torus."""
+    torus = focal.generate_surface("torus", 1500, triangulation="irregular", seed=2)
+    saddle = focal.generate_surface("saddle", 700, triangulation="irregular", seed=3)
+    ellipsoid = focal.generate_surface("ellipsoid", 500, triangulation="irregular", seed=4)
+    inward = ellipsoid.F[:, [0, 2, 1]]
+    V, F, N = joined((torus.V, torus.F, torus.N), (saddle.V + [3, 0, 0], saddle.F, saddle.N),
+                     (ellipsoid.V + [0, 3, 0], inward, ellipsoid.N))
+    tip = len(V)
+    V = np.vstack([V, [[1.0, 0.1, 0.9]]])
+    N = np.vstack([N, [[0.0, 0.0, 1.0]]])
+    F = np.vstack([F, [[F[0, 0], F[0, 1], tip]]]).astype(np.int32)
+    return V, F, N
+
+
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"normals": None}, {"estimator": "paper"}, {"estimator": "paper", "normals": "area"},
+     {"estimator": "paper", "rings": 2, "ray_weighting": "gaussian"},
+     {"estimator": "paper", "method": "triangle", "normals": "max"}],
+    ids=["recommended", "recommended-no-normals", "paper", "paper-area", "paper-2-rings",
+         "paper-triangle"],
+)
+def test_tiles_on_dask_give_the_whole_mesh_bits(client, awkward, options):
+    V, F, N = awkward
+    options = dict(options)
+    if "normals" in options and options["normals"] is None:
+        options.pop("normals")
+        N = None
+    whole = focal.curvature(V, F, N, **options)
+    tiled = fd.curvature((V, F, N), client, tile_vertices=400, threads=1, **options)
+    assert same_fields(whole, tiled)
+    assert not tiled.undefined.all()
+
+
+def test_noisy_positions_plan_wider_rings_and_stay_identical(client):
+    s = focal.generate_surface("monkey-saddle", 2500, triangulation="irregular", seed=5)
+    rng = np.random.default_rng(5)
+    h = np.mean(np.linalg.norm(s.V[s.F[:, 0]] - s.V[s.F[:, 1]], axis=1))
+    V = s.V + (0.1 * h * rng.uniform(-1, 1, len(s.V)))[:, None] * s.N
+    whole = focal.curvature(V, s.F)
+    assert whole.plan["rings"] == 3  # 10% vertex noise: the widest plan (recommended.h)
+    tiled = fd.curvature((V, s.F), client, tile_vertices=300, threads=1)
+    assert same_fields(whole, tiled)
+
+
+def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward):
+    V, F, N = awkward
+    whole = focal.curvature(V, F, N)
+    pids = client.run(os.getpid)
+    victim = next(iter(pids.values()))
+    killed = []
+
+    def kill_on_first_tile(index, ids, fields):
+        if not killed:
+            os.kill(victim, signal.SIGKILL)
+            killed.append(index)
+
+    tiled = fd.curvature((V, F, N), client, tile_vertices=60, threads=1,
+                         on_tile=kill_on_first_tile)
+    assert killed
+    assert same_fields(whole, tiled)
+    client.wait_for_workers(2, timeout=60)
+    assert victim not in client.run(os.getpid).values()  # the nanny started a new process
+
+
+def test_on_tile_streams_every_vertex_once(client, awkward):
+    V, F, N = awkward
+    seen = np.zeros(len(V), int)
+
+    def count(index, ids, fields):
+        seen[ids] += 1
+        assert len(fields["k1"]) == len(ids)
+
+    fd.curvature((V, F, N), client, tile_vertices=500, threads=1, on_tile=count)
+    assert (seen == 1).all()
+
+
+def test_bad_input_is_an_error_before_any_task(client, awkward):
+    V, F, N = awkward
+    with pytest.raises(focal.InvalidInputError, match="tile_vertices"):
+        fd.curvature((V, F, N), client, tile_vertices=0)
+    with pytest.raises(focal.InvalidInputError, match="face 0 refers to vertex"):
+        fd.curvature((V, F + len(V), N), client)
+    with pytest.raises(focal.InvalidInputError, match="path_or_arrays"):
+        fd.curvature(42, client)
+    with pytest.raises(focal.FocalIOError):
+        fd.curvature("/nonexistent/mesh.ply", client)
+
+
+def run_cli(*args):
+    env = dict(os.environ)
+    return subprocess.run([sys.executable, "-m", "focal.distributed", *args],
+                          capture_output=True, text=True, env=env, timeout=240)
+
+
+def test_command_line_writes_the_whole_mesh_fields(tmp_path, client, awkward):
+    V, F, N = awkward
+    mesh = tmp_path / "mesh.ply"
+    focal.write_mesh(mesh, V, F, N)
+    out = tmp_path / "fields.npz"
+    address = client.scheduler.address
+    r = run_cli(str(mesh), "-o", str(out), "--scheduler", address, "--tile-vertices", "700",
+                "--threads", "1", "--paper")
+    assert r.returncode == 0, r.stderr
+    whole = focal.curvature(*(lambda m: (m.V, m.F, m.N))(focal.read_mesh(mesh)), estimator="paper")
+    saved = np.load(out)
+    assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
+    csv = tmp_path / "fields.csv"
+    assert run_cli(str(mesh), "-o", str(csv), "--scheduler", address).returncode == 0
+    lines = csv.read_text().splitlines()
+    assert lines[0] == "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class"
+    assert len(lines) == len(V) + 1
+
+
+def test_command_line_errors(tmp_path, client):
+    address = client.scheduler.address
+    r = run_cli(str(tmp_path / "missing.ply"), "-o", str(tmp_path / "x.npz"), "--scheduler",
+                address)
+    assert r.returncode == 2 and "Error:" in r.stderr
+    assert not (tmp_path / "x.npz").exists()
+    r = run_cli(str(tmp_path / "m.ply"), "-o", str(tmp_path / "x.txt"))
+    assert r.returncode == 1 and ".npz or .csv" in r.stderr
+    r = run_cli(str(tmp_path / "m.ply"), "-o", str(tmp_path / "x.npz"), "--scheduler", address,
+                "--workers", "2")
+    assert r.returncode == 1

@@ -1,0 +1,244 @@
+#include "focal/tiles/tiles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/fields_detail.h"
+#include "core/parallel.h"
+#include "focal/core/error.h"
+#include "mesh/topology.h"
+
+namespace focal {
+namespace {
+
+/// Bits per axis of the Morton code: 3 x 21 = 63 bits, a cell of 2^-21 of the box.
+constexpr int kMortonBits = 21;
+
+/// The bits of x spread to every third position.
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= (1ULL << kMortonBits) - 1;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Morton codes of the vertices in the box of the finite ones; non-finite ones get the largest
+/// code, so that they come last.
+std::vector<std::uint64_t> morton_codes(PositionsRef V, int threads) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Eigen::Vector3d p = V.row(i).transpose();
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double cells = static_cast<double>((1ULL << kMortonBits) - 1);
+  std::vector<std::uint64_t> codes(static_cast<std::size_t>(V.rows()));
+  detail::parallel_for(V.rows(), threads, [&](std::int64_t i) {
+    const Eigen::Vector3d p = V.row(i).transpose();
+    if (!p.allFinite()) {
+      codes[static_cast<std::size_t>(i)] = std::numeric_limits<std::uint64_t>::max();
+      return;
+    }
+    std::uint64_t code = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double extent = hi[a] - lo[a];
+      const double t = extent > 0.0 ? (p[a] - lo[a]) / extent : 0.0;
+      const auto cell = static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * cells);
+      code |= spread_bits(cell) << a;
+    }
+    codes[static_cast<std::size_t>(i)] = code;
+  });
+  return codes;
+}
+
+/// The vertices in Morton order, ties by index: (code, index) pairs sorted in place, which is
+/// cache-friendlier than sorting indices by a looked-up code.
+std::vector<int> morton_order(PositionsRef V, int threads) {
+  const std::vector<std::uint64_t> codes = morton_codes(V, threads);
+  std::vector<std::pair<std::uint64_t, int>> keyed(codes.size());
+  for (std::size_t i = 0; i < codes.size(); ++i) keyed[i] = {codes[i], static_cast<int>(i)};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<int> order(keyed.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
+  return order;
+}
+
+/// Sorts non-negative ids ascending: two passes of a counting sort on 16-bit digits (the ids
+/// of a tile number hundreds of thousands; measured 3 to 4 times faster than std::sort here).
+void sort_ids(std::vector<int>& ids) {
+  constexpr int kDigitBits = 16;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  if (ids.size() < 4096) {
+    std::sort(ids.begin(), ids.end());
+    return;
+  }
+  std::vector<int> scratch(ids.size());
+  std::vector<std::size_t> start(kBuckets + 1);
+  for (int shift : {0, kDigitBits}) {
+    std::fill(start.begin(), start.end(), 0);
+    for (int id : ids) ++start[((static_cast<std::uint32_t>(id) >> shift) & (kBuckets - 1)) + 1];
+    for (std::size_t b = 1; b <= kBuckets; ++b) start[b] += start[b - 1];
+    for (int id : ids)
+      scratch[start[(static_cast<std::uint32_t>(id) >> shift) & (kBuckets - 1)]++] = id;
+    ids.swap(scratch);
+  }
+}
+
+/// Marks of one search, per vertex or face: `mark[i] == stamp` means i was reached by the search
+/// of that stamp, so the marks are never cleared between tiles.
+struct Marks {
+  std::vector<int> vertex, face;
+};
+
+/// The tile owning `owned` (global ids, ascending): ring by ring, the faces of the vertices
+/// found so far and those faces' corners, halo_rings times. Round r takes the faces of the
+/// vertices r - 1 rings out, so the faces are those with a corner within halo_rings - 1 rings
+/// and the vertices are those within halo_rings rings; each vertex and face is visited once.
+Tile make_tile(std::vector<int> owned_ids, FacesRef F, const detail::VertexFaces& inc,
+               int halo_rings, int stamp, Marks& marks) {
+  std::vector<int> reached = owned_ids;
+  for (int v : reached) marks.vertex[static_cast<std::size_t>(v)] = stamp;
+  Tile tile;
+  std::size_t ring_begin = 0;
+  for (int ring = 1; ring <= halo_rings; ++ring) {
+    const std::size_t ring_end = reached.size();
+    for (std::size_t k = ring_begin; k < ring_end; ++k) {
+      const int v = reached[k];
+      for (int j = inc.begin(v); j < inc.end(v); ++j) {
+        const int f = inc.faces[static_cast<std::size_t>(j)];
+        int& face_mark = marks.face[static_cast<std::size_t>(f)];
+        if (face_mark == stamp) continue;  // its corners are marked already
+        face_mark = stamp;
+        tile.faces.push_back(f);
+        detail::for_each_distinct_corner(F, f, [&](int w) {
+          int& m = marks.vertex[static_cast<std::size_t>(w)];
+          if (m != stamp) {
+            m = stamp;
+            reached.push_back(w);
+          }
+        });
+      }
+    }
+    ring_begin = ring_end;
+  }
+  sort_ids(tile.faces);
+  tile.vertices = std::move(reached);
+  sort_ids(tile.vertices);
+  tile.owned.reserve(owned_ids.size());
+  // Both ascending: one walk finds each owned vertex's row.
+  std::size_t row = 0;
+  for (int v : owned_ids) {
+    while (tile.vertices[row] != v) ++row;
+    tile.owned.push_back(static_cast<int>(row));
+  }
+  return tile;
+}
+
+void check_ids(const std::vector<int>& ids, Eigen::Index size, const char* what) {
+  for (int i : ids) {
+    if (i < 0 || i >= size) {
+      throw InvalidInput(std::string("extract_tile: ") + what + " " + std::to_string(i) +
+                         " is out of range [0, " + std::to_string(size) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOptions& options) {
+  if (halo_rings < 1) throw InvalidInput("partition_mesh: halo_rings must be >= 1");
+  if (options.tile_vertices < 1) throw InvalidInput("partition_mesh: tile_vertices must be >= 1");
+  detail::check_face_indices(V.rows(), F, "partition_mesh");
+  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, options.threads);
+  const std::vector<int> order = morton_order(V, options.threads);
+  Marks marks{std::vector<int>(order.size(), -1),
+              std::vector<int>(static_cast<std::size_t>(F.rows()), -1)};
+  Tiling out;
+  out.halo_rings = halo_rings;
+  const auto step = static_cast<std::size_t>(options.tile_vertices);
+  for (std::size_t first = 0; first < order.size(); first += step) {
+    const std::size_t last = std::min(order.size(), first + step);
+    std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
+                           order.begin() + static_cast<std::ptrdiff_t>(last));
+    sort_ids(owned);
+    out.tiles.push_back(
+        make_tile(std::move(owned), F, inc, halo_rings, static_cast<int>(out.tiles.size()), marks));
+  }
+  return out;
+}
+
+TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, const Tile& tile) {
+  check_ids(tile.vertices, V.rows(), "vertex");
+  check_ids(tile.faces, F.rows(), "face");
+  TileMesh out;
+  const auto n = static_cast<Eigen::Index>(tile.vertices.size());
+  out.V.resize(n, 3);
+  if (N) out.N.emplace(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    out.V.row(i) = V.row(tile.vertices[static_cast<std::size_t>(i)]);
+    if (N) out.N->row(i) = N->row(tile.vertices[static_cast<std::size_t>(i)]);
+  }
+  // Global id -> tile row, written only at the tile's vertices: the untouched rest of the
+  // table is never read (a lookup is checked against tile.vertices), so its pages stay unmapped.
+  const auto local = std::make_unique_for_overwrite<int[]>(static_cast<std::size_t>(V.rows()));
+  for (std::size_t i = 0; i < tile.vertices.size(); ++i) {
+    local[static_cast<std::size_t>(tile.vertices[i])] = static_cast<int>(i);
+  }
+  out.F.resize(static_cast<Eigen::Index>(tile.faces.size()), 3);
+  for (Eigen::Index f = 0; f < out.F.rows(); ++f) {
+    const int face = tile.faces[static_cast<std::size_t>(f)];
+    for (int c = 0; c < 3; ++c) {
+      const int v = F(face, c);
+      const int i = local[static_cast<std::size_t>(v)];
+      if (i < 0 || i >= n || tile.vertices[static_cast<std::size_t>(i)] != v) {
+        throw InvalidInput("extract_tile: face " + std::to_string(face) + " has corner " +
+                           std::to_string(v) + ", which is not in the tile");
+      }
+      out.F(f, c) = i;
+    }
+  }
+  return out;
+}
+
+CurvatureResult estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
+                              const EstimateOptions& options, int threads) {
+  const std::optional<NormalsRef> N =
+      tile.N ? std::optional<NormalsRef>(*tile.N) : std::optional<NormalsRef>();
+  const PreparedMesh mesh(tile.V, tile.F, N,
+                          {.threads = threads, .mean_edge_length = choices.mean_edge_length});
+  return estimate(mesh, options_for_part(options, choices)).curvature;
+}
+
+void scatter_rows(const CurvatureResult& part, const std::vector<int>& rows,
+                  const std::vector<int>& ids, CurvatureResult& whole) {
+  for (const int r : rows) detail::copy_row(part, r, whole, ids[static_cast<std::size_t>(r)]);
+}
+
+CurvatureResult estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& options,
+                               const TileOptions& tiles) {
+  const MeshWideChoices choices = mesh_wide_choices(mesh, options);
+  const FacesRef F = choices.F ? FacesRef(*choices.F) : mesh.F();
+  const Tiling tiling =
+      partition_mesh(mesh.V(), F, estimate_reach(options_for_part(options, choices)), tiles);
+  CurvatureResult out = detail::unwritten_result(mesh.vertex_count());
+  for (const Tile& tile : tiling.tiles) {
+    const CurvatureResult part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
+                                               choices, options, tiles.threads);
+    scatter_rows(part, tile.owned, tile.vertices, out);
+  }
+  return out;
+}
+
+}  // namespace focal
