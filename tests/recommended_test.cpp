@@ -36,11 +36,12 @@ AnalyticSurface suite_case(SurfaceKind kind, Triangulation t, Noise noise, int v
   return s;
 }
 
-/// Relative RMS error of H over the interior; every interior vertex must have an estimate (the
-/// suite's surfaces are smooth and clean of bad geometry), which relative_H alone would not show.
-double rel_h(const AnalyticSurface& s, const CurvatureResult& r) {
+/// Relative RMS error of H over the interior. Unless `may_be_undefined` (an estimator on corrupted
+/// normals), every interior vertex must have an estimate (the suite's surfaces are smooth and
+/// free of bad geometry), which relative_H alone would not show.
+double rel_h(const AnalyticSurface& s, const CurvatureResult& r, bool may_be_undefined = false) {
   const ErrorMetrics e = evaluate(s, r).interior;
-  EXPECT_EQ(e.undefined, 0);
+  if (!may_be_undefined) EXPECT_EQ(e.undefined, 0);
   return e.relative_H;
 }
 
@@ -269,7 +270,8 @@ TEST(Recommended, IsolatedBadFileNormalsAreReplaced) {
     EXPECT_GT((r.N.row(i) - bad.N.row(i).normalized()).norm(), 0.5) << "vertex " << i;
   }
   const double clean = recommended_file(s), with_bad = rel_h(s, r.curvature);
-  const double paper_bad = rel_h(s, estimate_curvature(bad.V, bad.F, bad.N));
+  // The paper's fit leaves out the flipped normals' rays: some vertices are left without two.
+  const double paper_bad = rel_h(s, estimate_curvature(bad.V, bad.F, bad.N), true);
   EXPECT_LT(with_bad, 1.1 * clean);
   EXPECT_GT(paper_bad, 10.0 * with_bad);
 }
