@@ -259,6 +259,10 @@ TEST_P(Accuracy, ErrorBoundedAndConverging) {
   RecordProperty("rms_coarse", text(coarse.rms));
   RecordProperty("rms_fine", text(fine.rms));
   RecordProperty("median_d1_angle_fine", text(fine.median_angle));
+  // The error as a fraction of the largest curvature (docs/ESTIMATOR.md quotes it for estimated
+  // normals on irregular meshes).
+  RecordProperty("rms_over_kappa_coarse", text(coarse.rms / coarse.kappa));
+  RecordProperty("rms_over_kappa_fine", text(fine.rms / fine.kappa));
   if (coarse.rms < 1e-12) {  // exact up to rounding (cylinder): nothing to converge
     EXPECT_LE(fine.rms, 1e-12);
   } else if (c.estimated_normals && c.triangulation == Triangulation::irregular) {
