@@ -41,7 +41,9 @@ AnalyticSurface suite_case(SurfaceKind kind, Triangulation t, Noise noise, int v
 /// free of bad geometry), which relative_H alone would not show.
 double rel_h(const AnalyticSurface& s, const CurvatureResult& r, bool may_be_undefined = false) {
   const ErrorMetrics e = evaluate(s, r).interior;
-  if (!may_be_undefined) EXPECT_EQ(e.undefined, 0);
+  if (!may_be_undefined) {
+    EXPECT_EQ(e.undefined, 0);
+  }
   return e.relative_H;
 }
 
