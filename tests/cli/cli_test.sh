@@ -730,6 +730,13 @@ run curvature polygon3000.obj -o polygon3000-2.csv --paper --rings 2
 check "--paper --rings 2 on it: every vertex undefined, said so" \
   bash -c '[[ $1 -eq 0 && $(grep -c ",undefined$" polygon3000-2.csv) -eq 3000 ]] &&
     grep -q "^Warning: polygon3000.obj: 3000 vertices .*left undefined" "$2"' _ "$rc" "$ERR"
+awk 'BEGIN { n = 2000; print "v 0 0 0"; print "v 1 0 0"
+  for (i = 0; i < n; i++) { t = 6.283185307179586 * i / n; printf "v 0.5 %.17g %.17g\n", cos(t), sin(t) }
+  for (i = 0; i < n; i++) printf "f 1 2 %d\n", i + 3 }' >fin2000.obj
+run curvature fin2000.obj -o fin2000.csv
+check "an edge shared by 2000 faces: exit 0, all 2002 vertices crowded, warned by name" \
+  bash -c '[[ $1 -eq 0 && $(awk "END { print NR - 1 }" fin2000.csv) -eq 2002 ]] &&
+    grep -q "^Warning: fin2000.obj: 2002 vertices have more than 1024 vertices within 2 rings" "$2"' _ "$rc" "$ERR"
 printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >octahedron.obj
 run -v curvature octahedron.obj -o octahedron.csv
 check "an octahedron (every vertex undefined): a warning, and -v says the empty H range in words" \
