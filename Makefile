@@ -3,6 +3,9 @@
 PRESET ?= release
 BUILD_DIR := build/$(PRESET)
 JOBS ?= $(shell nproc)
+# WERROR=ON: compiler warnings are errors (CI); the same build folder, so `make demo` after
+# `make test` with the same WERROR rebuilds nothing.
+WERROR ?= OFF
 # The Python environment of the bindings' build and tests (python/): nanobind, NumPy and pytest
 # from PyPI in a venv, so that the extension is built in the same CMake build as the library (one
 # library build) and the `python` ctest runs pytest on it. Users install with `pip install .`.
@@ -28,7 +31,8 @@ $(VENV)/.ready: python/requirements-test.txt | deps
 	@touch $@
 
 configure: deps venv
-	@cmake --preset $(PRESET) -DFOCAL_BUILD_PYTHON=ON -DPython_EXECUTABLE=$(CURDIR)/$(PYTHON) >/dev/null
+	@cmake --preset $(PRESET) -DFOCAL_BUILD_PYTHON=ON -DPython_EXECUTABLE=$(CURDIR)/$(PYTHON) \
+	  -DFOCAL_WERROR=$(WERROR) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)

@@ -14,32 +14,34 @@ namespace focal::cli {
 namespace {
 
 /// The warnings about what the normals stage fixed or suspects.
-void report_normals(const NormalsReport& r, const Log& log) {
+void report_normals(const NormalsReport& r, const std::string& mesh_name, const Log& log) {
   if (r.reoriented_component_count > 0) {
-    log.warning(std::to_string(r.reoriented_component_count) +
+    log.warning(mesh_name + ": " + std::to_string(r.reoriented_component_count) +
                 " closed component(s) are oriented inward; their faces "
                 "were reversed so that normals point outward");
   }
   if (r.filled_normal_count > 0) {
-    log.warning(std::to_string(r.filled_normal_count) +
+    log.warning(mesh_name + ": " + std::to_string(r.filled_normal_count) +
                 " vertices have no usable normal in the file; estimated them from the faces");
   }
   if (r.rescaled_normal_count > 0) {
-    log.warning(std::to_string(r.rescaled_normal_count) +
+    log.warning(mesh_name + ": " + std::to_string(r.rescaled_normal_count) +
                 " normals were not of unit length; normalised");
   }
   if (r.normals_against_faces) {
-    log.warning(
-        "most file normals point against the face orientation (inward?); curvature signs "
-        "follow the normals");
+    log.warning(mesh_name +
+                ": most file normals point against the face orientation (inward?); curvature "
+                "signs follow the normals");
   }
 }
 
+/// "[lo, hi]" of the finite values, or words when there are none.
 std::string range_of(const Eigen::VectorXd& v) {
   double lo = INFINITY, hi = -INFINITY;
   for (double x : v) {
     if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
   }
+  if (lo > hi) return "none (no finite value)";
   std::ostringstream s;
   s << "[" << lo << ", " << hi << "]";
   return s.str();
@@ -70,9 +72,10 @@ std::string normals_used(const Estimate& e) {
 
 /// The recommended estimator's decisions: a warning when it ignored the file's normals, and with
 /// -v its plan.
-void report_recommended(const Input& input, const Estimate& e, const Log& log) {
+void report_recommended(const Input& input, const std::string& mesh_name, const Estimate& e,
+                        const Log& log) {
   if (input.prepared->has_normals() && !e.file_normals_used) {
-    log.warning("the file's normals disagree with the positions (median angle " +
+    log.warning(mesh_name + ": the file's normals disagree with the positions (median angle " +
                 std::to_string(e.file_disagreement) +
                 " rad to jet normals): using normals estimated from the positions on the "
                 "file normals' side");
@@ -82,6 +85,65 @@ void report_recommended(const Input& input, const Estimate& e, const Log& log) {
        << " x edge length, " << e.plan.rings << "-ring "
        << (e.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
   log.info(plan.str());
+}
+
+/// The widest neighbourhood, in rings, that the run gathered; 1 when it used 1-rings only
+/// (never capped: kMaxNeighbourhoodSize).
+int widest_rings(const EstimateOptions& o, const Estimate& e) {
+  if (o.estimator == Estimator::paper) return o.paper.method == Method::vertex ? o.paper.rings : 1;
+  // The recommended estimator's first jets take 2 rings (recommended.h).
+  return e.plan.rings > 1 ? std::max(e.plan.rings, e.plan.jet_rings) : 2;
+}
+
+/// Whether some vertex may have more than kMaxNeighbourhoodSize vertices within `rings` rings: an
+/// O(#F) bound from the largest valence D (at most twice a vertex's faces), D (D - 1)^(j - 1)
+/// vertices at ring j, which keeps ordinary meshes from paying for a search of their rings.
+bool may_be_crowded(const PreparedMesh& mesh, int rings) {
+  if (mesh.vertex_count() == 0) return false;
+  std::vector<int> faces(static_cast<std::size_t>(mesh.vertex_count()), 0);
+  const FacesRef F = mesh.F();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) ++faces[static_cast<std::size_t>(F(f, c))];
+  }
+  const double valence = 2.0 * *std::max_element(faces.begin(), faces.end());
+  double ring = valence, total = 0.0;
+  for (int j = 1; j <= rings; ++j, ring *= valence - 1.0) total += ring;
+  return total > kMaxNeighbourhoodSize;
+}
+
+/// Warnings about vertices without an estimate: those whose neighbourhood was over the cap, and
+/// a mesh where no vertex has one.
+void report_undefined(const PreparedMesh& mesh, const std::string& mesh_name,
+                      const EstimateOptions& o, const Estimate& e, const Log& log) {
+  const auto& classes = e.curvature.point_class;
+  const auto undefined =
+      std::count(classes.begin(), classes.end(), static_cast<std::uint8_t>(PointClass::undefined));
+  const int rings = widest_rings(o, e);
+  // Crowded vertices lose their jets: without a 2-ring fit they are undefined (or, on the
+  // recommended estimator's 1-ring path, fitted on Max's normals), so a run without undefined
+  // vertices has none to report.
+  const bool lost_jets = o.estimator == Estimator::recommended && e.plan.rings == 1;
+  std::size_t crowded = 0;
+  if (rings > 1 && (undefined > 0 || lost_jets) && may_be_crowded(mesh, rings)) {
+    crowded = crowded_vertices(
+                  vertex_adjacency(static_cast<int>(mesh.vertex_count()), mesh.F(), mesh.threads()),
+                  rings, mesh.threads())
+                  .size();
+  }
+  if (crowded > 0) {
+    log.warning(mesh_name + ": " + std::to_string(crowded) + " vertices have more than " +
+                std::to_string(kMaxNeighbourhoodSize) + " vertices within " +
+                std::to_string(rings) +
+                " rings (a polygon of thousands of corners, or an edge of thousands of faces?): " +
+                (lost_jets ? "their fit uses their 1-ring and Max's normals only, no jets"
+                           : "left undefined"));
+  }
+  if (undefined > 0 && undefined == classes.size()) {
+    log.warning(mesh_name + ": every vertex is undefined (" + std::to_string(undefined) + ")" +
+                (crowded > 0 ? ""
+                             : ": no vertex has two neighbour rays to fit (a mesh this coarse, "
+                               "with neighbouring normals 90 degrees or more apart, has none)"));
+  }
 }
 
 }  // namespace
@@ -200,14 +262,15 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
       throw InvalidInput("--normals file: " + mesh_name + " has no vertex normals");
     }
     normals = prepare_normals(mesh, options);
-    report_normals(normals.report, log);
+    report_normals(normals.report, mesh_name, log);
   }
   Estimate e;
   {
     Stage stage(log, "curvature");
     e = estimate(mesh, std::move(normals), options);
   }
-  if (options.estimator == Estimator::recommended) report_recommended(input, e, log);
+  if (options.estimator == Estimator::recommended) report_recommended(input, mesh_name, e, log);
+  report_undefined(mesh, mesh_name, options, e, log);
   print_summary(e.curvature, log);
   return e;
 }

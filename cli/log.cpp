@@ -4,8 +4,26 @@
 
 namespace focal::cli {
 
+std::string one_line(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (byte < 0x20 || byte == 0x7f) {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", byte);
+      out += hex;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 void Log::warning(const std::string& message) const {
-  std::fprintf(stderr, "Warning: %s\n", message.c_str());
+  std::fprintf(stderr, "Warning: %s\n", one_line(message).c_str());
 }
 
 void Log::info(const std::string& message) const {

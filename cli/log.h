@@ -10,6 +10,10 @@
 
 namespace focal::cli {
 
+/// `text` with control characters escaped (a newline as \n, others as \xNN), so that a file name
+/// holding them cannot split an `Error:` or `Warning:` line.
+[[nodiscard]] std::string one_line(const std::string& text);
+
 class Log {
  public:
   void set_verbose(bool v) { verbose_ = v; }

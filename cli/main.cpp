@@ -60,7 +60,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr,
                  "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|eval|render|devices ... "
                  "(see focal -h)\n",
-                 e.what());
+                 focal::cli::one_line(e.what()).c_str());
     return kUsageError;
   }
   return 0;
@@ -72,10 +72,10 @@ int main(int argc, char** argv) {
   try {
     return run(argc, argv);
   } catch (const focal::Error& e) {
-    std::fprintf(stderr, "Error: %s\n", e.what());
+    std::fprintf(stderr, "Error: %s\n", focal::cli::one_line(e.what()).c_str());
     return kInputError;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "Error: internal: %s\n", e.what());
+    std::fprintf(stderr, "Error: internal: %s\n", focal::cli::one_line(e.what()).c_str());
     return kInternalError;
   }
 }

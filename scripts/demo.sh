@@ -15,7 +15,8 @@ fi
 echo "== focal info (the scanned Stanford bunny, from $archive)"
 "$focal" info "$out/bunny.off"
 echo
-echo "== focal curvature: per-vertex two-slit fit, closed form, 1-ring, Max (1999) normals"
+echo "== focal curvature: the recommended estimator (docs/ESTIMATOR.md): two-slit fit, closed form,"
+echo "   on jet or Max normals from the positions, rings from the measured noise (its plan below)"
 "$focal" -v curvature "$out/bunny.off" -o "$out/bunny-curvature.ply"
 "$focal" curvature "$out/bunny.off" -o "$out/bunny-curvature.csv"
 echo

@@ -404,7 +404,7 @@ std::string rich_ply(const std::string& encoding) {
                   "property list uchar uint vertex_indices\n"
                   "property list int float texcoord\n"
                   "end_header\n";
-  // int64 is not a PLY type: that header must be rejected; the valid one uses int.
+  // int64 (meshio's) is read too (PlyHeaderErrors); the file here keeps Turk's int.
   h.replace(h.find("int64"), 5, "int");
   const double xyz[4][3] = {{0.5, 1.25, -2}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   const float n[4][3] = {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, -1}};
@@ -590,15 +590,13 @@ TEST_F(MeshIo, PlyHeaderErrors) {
                   {"line 2", "unknown format"});
   expect_io_error(write("type.ply",
                         "ply\nformat ascii 1.0\nelement vertex 1\n"
-                        "property int64 x\nend_header\n"),
-                  {"line 4", "unknown property type 'int64'"});
-  expect_io_error(write("rich64.ply",
-                        [] {
-                          std::string s = rich_ply("ascii");
-                          s.replace(s.find("uchar int ignored"), 9, "uchar int64");
-                          return s;
-                        }()),
-                  {"line 9", "int64"});
+                        "property long x\nend_header\n"),
+                  {"line 4", "unknown property type 'long'"});
+  // A list of int64 (meshio writes them) is skipped like any other list.
+  std::string rich64 = rich_ply("ascii");
+  rich64.replace(rich64.find("uchar int ignored"), 9, "uchar int64");
+  expect_same_mesh(focal::read_mesh(write("rich.ply", rich_ply("ascii"))),
+                   focal::read_mesh(write("rich64.ply", rich64)));
   expect_io_error(write("nox.ply",
                         "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n"
                         "end_header\n0\n"),
@@ -1637,3 +1635,120 @@ TEST_F(MeshIo, DISABLED_SpeedBinaryPly1MVertices2MFaces) {
 }
 
 }  // namespace
+
+// Issue 13 item 7: MeshLab's NCOFF (vcglib's exporter: colour, then normal), Geomview's CNOFF
+// (normal, then colour), with texture coordinates too; other prefixes are refused by name.
+TEST_F(MeshIo, OffColourAndNormalInMeshLabAndGeomviewOrder) {
+  const std::string faces = "3 0 1 2\n";
+  const Mesh meshlab = focal::read_mesh(write("nc.off",
+                                              "NCOFF\n3 1 0\n"
+                                              "0 0 0 255 0 0 255 0 0.6 0.8 \n"
+                                              "1 0 0 9 9 9 255 1 0 0\n"
+                                              "0 1 0 9 9 9 255 0 1 0\n" +
+                                                  faces));
+  ASSERT_TRUE(meshlab.has_normals());
+  expect_same(meshlab.N, rows({{0, 0.6, 0.8}, {1, 0, 0}, {0, 1, 0}}));
+  const Mesh geomview = focal::read_mesh(write("cn.off",
+                                               "CNOFF\n3 1 0\n"
+                                               "0 0 0 0 0.6 0.8 0.5 0.5 0.5 1\n"
+                                               "1 0 0 1 0 0 0.5 0.5 0.5 1\n"
+                                               "0 1 0 0 1 0 0.5 0.5 0.5 1\n" +
+                                                   faces));
+  expect_same(geomview.N, meshlab.N);
+  const Mesh textured = focal::read_mesh(write("ncst.off",
+                                               "NCSTOFF\n3 1 0\n"
+                                               "0 0 0 1 2 3 0 0.6 0.8 0.25 0.75\n"
+                                               "1 0 0 1 2 3 1 0 0 0.25 0.75\n"
+                                               "0 1 0 1 2 3 0 1 0 0.25 0.75\n" +
+                                                   faces));
+  expect_same(textured.N, meshlab.N);
+  expect_io_error(write("bad.off", "CXOFF\n3 1 0\n"),
+                  {"line 1", "unsupported OFF variant 'CXOFF'"});
+  expect_io_error(write("long.off", "NCOFF\n1 0 0\n0 0 0 1 2 3 4 5 0 0 1\n"),
+                  {"line 3", "vertex 0: expected 6 to 10 numbers"});
+}
+
+// Issue 13 item 7: meshio writes int64 / uint64 properties; indices are range-checked.
+TEST_F(MeshIo, Ply64BitIntegersAreReadWithRangeChecks) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty int64 x\nproperty uint64 y\n"
+      "property double z\nelement face 1\nproperty list uint8 int64 vertex_indices\nend_header\n";
+  const Mesh m = focal::read_mesh(write("i64.ply", header + "0 0 0\n1 0 0\n-2 5 0\n3 0 1 2\n"));
+  expect_same(m.V, rows({{0, 0, 0}, {1, 0, 0}, {-2, 5, 0}}));
+  expect_faces(m, {{0, 1, 2}}, {0});
+  expect_io_error(write("far.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 4294967296\n"),
+                  {"face 0 refers to vertex 4294967296 but there are 3 vertices"});
+
+  // Binary: an index of 2^64 - 1 stays out of range (saturated), never wraps to a valid one.
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uint64 uint64 vertex_indices\nend_header\n";
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  bin.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  const std::uint64_t face[4] = {3, 0, 1, ~std::uint64_t{0}};
+  bin.append(reinterpret_cast<const char*>(face), sizeof face);
+  expect_io_error(write("u64.ply", bin), {"face 0 refers to vertex 9223372036854775807"});
+  // A 64-bit list length the file cannot hold is a truncation, not an allocation.
+  std::string huge = bin.substr(0, bin.size() - sizeof face);
+  const std::uint64_t length = std::uint64_t{1} << 62;
+  huge.append(reinterpret_cast<const char*>(&length), sizeof length);
+  expect_io_error(write("huge.ply", huge), {"file ends inside face 0 of 1"});
+}
+
+// Issue 13 item 7: triangle strips, -1 restarting a strip, every other triangle reversed so
+// that all keep the first one's orientation, joining (repeated-corner) triangles left out.
+TEST_F(MeshIo, PlyTristripsBecomeTriangles) {
+  const std::string vertices = "0 0 0\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n";
+  const Mesh m = focal::read_mesh(
+      write("strip.ply",
+            "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+            "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
+            "end_header\n" +
+                vertices + "9 3 0 4 1 1 -1 4 1 5\n"));
+  expect_faces(m, {{3, 0, 4}, {4, 0, 1}, {4, 1, 5}}, {0, 0, 0});
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {  // all counter-clockwise seen from +z
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    const Eigen::Vector3d u = b - a, v = c - a;
+    EXPECT_GT(u.x() * v.y() - u.y() * v.x(), 0.0) << "triangle " << f;
+  }
+  expect_io_error(
+      write("bad_strip.ply",
+            "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
+            "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
+            "end_header\n" +
+                vertices + "4 0 1 2 -2\n"),
+      {"line 16", "tristrips 0 refers to vertex -2 but there are 6 vertices"});
+}
+
+// Issue 13 item 8: a binary PLY whose header names the other byte order says so.
+TEST_F(MeshIo, PlyIndicesInTheOtherByteOrderHintAtIt) {
+  std::string bin =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  bin.append(36, '\0');                                                    // nine big-endian zeros
+  const unsigned char face[13] = {3, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0};  // little endian
+  bin.append(reinterpret_cast<const char*>(face), sizeof face);
+  expect_io_error(write("order.ply", bin), {"face 0 refers to vertex 16777216",
+                                            "wrong byte order? the header says "
+                                            "binary_big_endian"});
+}
+
+// Issue 13 item 8: numbers below the smallest double underflow as in C; old MSVC's "1.#QNAN"
+// is an error naming line and token, not a number cut short by a comment; trailing blanks on
+// PLY header lines are fine.
+TEST_F(MeshIo, UnderflowMsvcNanAndTrailingBlanks) {
+  const Mesh m = focal::read_mesh(write("tiny.obj", "v 1e-400 -1e-320 0 # comment\n"));
+  EXPECT_EQ(m.V(0, 0), 0.0);
+  EXPECT_EQ(m.V(0, 1), -1e-320);  // a subnormal, kept
+  expect_io_error(write("msvc.obj", "v 0 0 0\nv 0 0 1.#QNAN\n"),
+                  {"line 2", "'1.#QNAN' is not a number"});
+  expect_io_error(write("msvc.off", "OFF\n1 0 0\n0 0 1.#INF\n"), {"line 3", "'1.#INF'"});
+  expect_io_error(write("huge.obj", "v 0 0 1e400\n"), {"line 1", "'1e400' is not a number"});
+  const Mesh p = focal::read_mesh(
+      write("blank.ply",
+            "ply \nformat ascii 1.0 \nelement vertex 1  \nproperty float x\t\nproperty float y\n"
+            "property float z\nend_header  \n1 2 3\n"));
+  expect_same(p.V, rows({{1, 2, 3}}));
+}

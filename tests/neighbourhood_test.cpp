@@ -124,7 +124,7 @@ TEST(VertexAdjacency, StripRingsInOrder) {
 TEST(VertexAdjacency, GridRingsByHand) {
   const TestMesh m = grid(5, 5);
   const Neighbourhoods one = vertex_adjacency(25, m.F);
-  const Neighbourhoods two = k_ring(one, 2);
+  const focal::Neighbourhoods two = focal::k_ring(one, 2);
   const Neighbourhoods three = k_ring(one, 3);
   // Centre (2, 2).
   const std::vector<int> c1{6, 7, 11, 13, 17, 18};
@@ -396,3 +396,29 @@ TEST(MeshStatistics, EmptyMeshAndErrors) {
 
 }  // namespace
 }  // namespace focal
+
+// Issue 13 item 3: one polygon of n corners, fan-triangulated as the readers do: the hub
+// neighbours every corner, so every 2-ring holds all n - 1 other vertices. Above the cap the
+// k-ring is empty and crowded_vertices() names every vertex; 1-rings are never capped.
+TEST(KRing, NeighbourhoodsAboveTheCapAreEmptyAndNamed) {
+  const int n = 3 * focal::kMaxNeighbourhoodSize;
+  focal::RowMatrixX3i F(n - 2, 3);
+  for (int k = 0; k < n - 2; ++k) F.row(k) << 0, k + 1, k + 2;
+  const focal::Neighbourhoods one = focal::vertex_adjacency(n, F);
+  EXPECT_EQ(one.size(0), n - 1);  // the hub's 1-ring, kept whole
+  const focal::Neighbourhoods two = focal::k_ring(one, 2);
+  for (int v = 0; v < n; ++v) EXPECT_EQ(two.size(v), 0) << "vertex " << v;
+  const std::vector<int> crowded = focal::crowded_vertices(one, 2);
+  ASSERT_EQ(crowded.size(), static_cast<std::size_t>(n));
+  EXPECT_EQ(crowded.front(), 0);
+  EXPECT_EQ(crowded.back(), n - 1);
+  EXPECT_TRUE(focal::crowded_vertices(one, 1).empty());
+
+  // Just below the cap nothing changes: the 2-ring of a corner is every other vertex.
+  const int m = focal::kMaxNeighbourhoodSize + 1;
+  focal::RowMatrixX3i G(m - 2, 3);
+  for (int k = 0; k < m - 2; ++k) G.row(k) << 0, k + 1, k + 2;
+  const focal::Neighbourhoods small = focal::k_ring(focal::vertex_adjacency(m, G), 2);
+  for (int v = 0; v < m; ++v) EXPECT_EQ(small.size(v), m - 1) << "vertex " << v;
+  EXPECT_TRUE(focal::crowded_vertices(focal::vertex_adjacency(m, G), 2).empty());
+}

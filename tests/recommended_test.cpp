@@ -11,8 +11,9 @@
 #include <cstdio>
 #include <limits>
 
-#include "focal/curvature/baselines.h"
 #include "focal/core/error.h"
+#include "focal/curvature/baselines.h"
+#include "focal/curvature/estimate.h"
 #include "focal/evaluation/evaluation.h"
 #include "focal/mesh/normals.h"
 #include "focal/surfaces/surfaces.h"
@@ -35,8 +36,15 @@ AnalyticSurface suite_case(SurfaceKind kind, Triangulation t, Noise noise, int v
   return s;
 }
 
-double rel_h(const AnalyticSurface& s, const CurvatureResult& r) {
-  return evaluate(s, r).interior.relative_H;
+/// Relative RMS error of H over the interior. Unless `may_be_undefined` (an estimator on corrupted
+/// normals), every interior vertex must have an estimate (the suite's surfaces are smooth and
+/// free of bad geometry), which relative_H alone would not show.
+double rel_h(const AnalyticSurface& s, const CurvatureResult& r, bool may_be_undefined = false) {
+  const ErrorMetrics e = evaluate(s, r).interior;
+  if (!may_be_undefined) {
+    EXPECT_EQ(e.undefined, 0);
+  }
+  return e.relative_H;
 }
 
 double paper_file(const AnalyticSurface& s) {
@@ -63,14 +71,16 @@ TEST(Recommended, ExactOnSpheresWithAndWithoutNormals) {
   }
 }
 
-// Noisy file normals: measured relative RMS error of H at about 4000 vertices, recommended vs
-// paper: torus 0.01375 vs 0.1475, ellipsoid 0.00885 vs 0.204, saddle 0.0274 vs 3.99.
+// Noisy file normals: measured relative RMS error of H at about 4000 vertices (seed 1), recommended
+// vs paper: torus 0.00866 vs 0.148, ellipsoid 0.00617 vs 0.204, saddle 0.0155 vs 3.99. Bounds:
+// measured x 1.25 (seeds 2 and 3 stay below them).
 TEST(Recommended, NoisyFileNormalsAreReplaced) {
   const struct {
     SurfaceKind kind;
     double bound;
-  } cases[] = {
-      {SurfaceKind::torus, 0.02}, {SurfaceKind::ellipsoid, 0.013}, {SurfaceKind::saddle, 0.04}};
+  } cases[] = {{SurfaceKind::torus, 0.0108},
+               {SurfaceKind::ellipsoid, 0.0077},
+               {SurfaceKind::saddle, 0.0194}};
   for (const auto& c : cases) {
     const AnalyticSurface s = suite_case(c.kind, irregular, Noise::normals);
     const double rec = recommended_file(s), paper = paper_file(s);
@@ -79,14 +89,16 @@ TEST(Recommended, NoisyFileNormalsAreReplaced) {
   }
 }
 
-// No normals on irregular meshes: jets instead of first-order Max normals. Measured: torus
-// 0.01375 vs 0.0346 (paper with Max normals), helix tube 0.0205 vs 0.0351, saddle 0.0274 vs 0.257.
+// No normals on irregular meshes: jets instead of first-order Max normals. Measured (seed 1):
+// torus 0.00866 vs 0.0346 (paper with Max normals), helix tube 0.0164 vs 0.0351, saddle 0.0155 vs
+// 0.257. Bounds: measured x 1.25.
 TEST(Recommended, IrregularMeshesWithoutNormals) {
   const struct {
     SurfaceKind kind;
     double bound;
-  } cases[] = {
-      {SurfaceKind::torus, 0.02}, {SurfaceKind::helix_tube, 0.03}, {SurfaceKind::saddle, 0.04}};
+  } cases[] = {{SurfaceKind::torus, 0.0108},
+               {SurfaceKind::helix_tube, 0.0205},
+               {SurfaceKind::saddle, 0.0194}};
   for (const auto& c : cases) {
     const AnalyticSurface s = suite_case(c.kind, irregular, Noise::clean);
     const double rec = recommended_none(s);
@@ -96,14 +108,17 @@ TEST(Recommended, IrregularMeshesWithoutNormals) {
 }
 
 // Vertex noise with exact file normals: the normals are kept and the fit widens to 3 rings.
-// Measured: torus 0.0212 vs 0.0426 (paper), saddle 0.0512 vs 0.216. Without normals: wide jets,
-// torus 0.0327 vs 0.358 (paper with Max normals), saddle 0.287 vs 9.25.
+// Measured (seed 1): torus 0.0212 vs 0.0426 (paper), saddle 0.0512 vs 0.216; bounds measured
+// x 1.25. Without normals: wide jets, torus 0.0327 vs 0.358 (paper with Max normals), saddle
+// 0.287 vs 9.25.
 TEST(Recommended, NoisyPositions) {
   for (SurfaceKind kind : {SurfaceKind::torus, SurfaceKind::saddle}) {
     const AnalyticSurface s = suite_case(kind, irregular, Noise::positions);
     const double rec = recommended_file(s), rec_none = recommended_none(s);
-    EXPECT_LT(2.0 * rec, paper_file(s)) << surface_name(kind);
-    EXPECT_LT(rec, kind == SurfaceKind::torus ? 0.03 : 0.07) << surface_name(kind);
+    // The paper's error over ours: measured 2.0 (torus, seeds 1 to 3: 2.006, 1.997, 1.998) and
+    // 4.2 (saddle); asserted with a 1.25 margin on the torus's.
+    EXPECT_LT(1.6 * rec, paper_file(s)) << surface_name(kind);
+    EXPECT_LT(rec, kind == SurfaceKind::torus ? 0.0265 : 0.064) << surface_name(kind);
     EXPECT_LT(5.0 * rec_none, paper_max(s)) << surface_name(kind);
   }
 }
@@ -182,13 +197,20 @@ TEST(Recommended, UndefinedCasesAndMissingNormals) {
   EXPECT_NEAR(r.H[0], 1.0, 0.02);
   const CurvatureResult none = estimate_curvature_recommended(m.V, m.F, std::nullopt).curvature;
   EXPECT_EQ(none.class_of(static_cast<int>(n)), PointClass::undefined);
-  // A lone triangle: too few rays for a fit anywhere, NaN rather than zeros.
+  // A lone triangle: its estimated normals are all the face's, so no vertex has rays to fit:
+  // undefined with NaN, not flat with zeros.
   RowMatrixX3d V(3, 3);
   V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
   RowMatrixX3i F(1, 3);
   F << 0, 1, 2;
-  const CurvatureResult tri = estimate_curvature_recommended(V, F, std::nullopt).curvature;
-  for (int i = 0; i < 3; ++i) EXPECT_FALSE(tri.H[i] == 0.0 && tri.class_of(i) != PointClass::flat);
+  // Through focal::estimate (what the command line and Python run): estimate_curvature_recommended
+  // alone still gives flat zeros here (estimate.cpp undefines isolated triangles).
+  const CurvatureResult tri =
+      estimate(PreparedMesh(V, F, std::nullopt), EstimateOptions{}).curvature;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(tri.class_of(i), PointClass::undefined) << "vertex " << i;
+    EXPECT_TRUE(std::isnan(tri.H[i]) && std::isnan(tri.k1[i])) << "vertex " << i;
+  }
 }
 
 // 5% normal noise: the file's normals are ignored as a whole (their median angle to the jet
@@ -250,7 +272,8 @@ TEST(Recommended, IsolatedBadFileNormalsAreReplaced) {
     EXPECT_GT((r.N.row(i) - bad.N.row(i).normalized()).norm(), 0.5) << "vertex " << i;
   }
   const double clean = recommended_file(s), with_bad = rel_h(s, r.curvature);
-  const double paper_bad = rel_h(s, estimate_curvature(bad.V, bad.F, bad.N));
+  // The paper's fit leaves out the flipped normals' rays: some vertices are left without two.
+  const double paper_bad = rel_h(s, estimate_curvature(bad.V, bad.F, bad.N), true);
   EXPECT_LT(with_bad, 1.1 * clean);
   EXPECT_GT(paper_bad, 10.0 * with_bad);
 }

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <system_error>
@@ -121,13 +122,28 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) 
   }
 }
 
+std::string_view strip_comment(std::string_view line) {
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    if (line[i] == '#' && (i == 0 || is_blank(line[i - 1]))) return line.substr(0, i);
+  }
+  return line;
+}
+
 bool parse_double(std::string_view token, double& value) {
   // from_chars rejects '+' but writers emit it ("+1.5e+00").
   if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
   const char* end = token.data() + token.size();
   const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  // Out-of-range values (1e999) come back as errc::result_out_of_range: not a number we can keep.
-  return ec == std::errc() && ptr == end && !token.empty();
+  if (ptr != end || token.empty()) return false;
+  if (ec == std::errc()) return true;
+  // errc::result_out_of_range for 1e999 and for 1e-400 alike; strtod tells them apart (the token
+  // is already known to be a well-formed number) and rounds an underflow as C does.
+  if (ec != std::errc::result_out_of_range) return false;
+  const std::string copy(token);
+  const double rounded = std::strtod(copy.c_str(), nullptr);
+  if (std::isinf(rounded)) return false;
+  value = rounded;
+  return true;
 }
 
 bool parse_int(std::string_view token, std::int64_t& value) {
@@ -148,6 +164,26 @@ void TriangleCollector::add_polygon(const std::int32_t* corners, std::size_t cou
     corners_.push_back(corners[0]);
     corners_.push_back(corners[k]);
     corners_.push_back(corners[k + 1]);
+    source_.push_back(polygon);
+  }
+}
+
+void TriangleCollector::add_strip(const std::int32_t* corners, std::size_t count,
+                                  std::int32_t polygon) {
+  std::size_t start = 0;  // first corner of the current strip
+  for (std::size_t k = 0; k < count; ++k) {
+    if (corners[k] < 0) {
+      start = k + 1;
+      continue;
+    }
+    if (k < start + 2) continue;
+    // Triangle k - start - 2 of the strip (counted from 0): the odd ones are reversed.
+    const bool odd = (k - start) % 2 == 1;
+    const std::int32_t a = corners[k - 2], b = corners[k - 1], c = corners[k];
+    if (a == b || b == c || a == c) continue;
+    corners_.push_back(odd ? b : a);
+    corners_.push_back(odd ? a : b);
+    corners_.push_back(c);
     source_.push_back(polygon);
   }
 }

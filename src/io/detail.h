@@ -66,7 +66,13 @@ class LineCursor {
 /// Splits `line` at blanks (space, tab, CR, VT, FF) into `tokens` (cleared first).
 void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 
+/// `line` up to its comment: a '#' at the start of the line or after a blank. A '#' inside a
+/// token is not a comment, so that old MSVC's "1.#QNAN" or "1.#INF" is an error, not "1.".
+[[nodiscard]] std::string_view strip_comment(std::string_view line);
+
 /// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
+/// A value below the smallest double (1e-400) underflows to a subnormal or zero, as in C; one
+/// above the largest (1e400) is not a number.
 [[nodiscard]] bool parse_double(std::string_view token, double& value);
 /// Parses a whole token as a decimal integer (a leading '+' accepted).
 [[nodiscard]] bool parse_int(std::string_view token, std::int64_t& value);
@@ -77,6 +83,11 @@ class TriangleCollector {
  public:
   void reserve(std::size_t polygons);
   void add_polygon(const std::int32_t* corners, std::size_t count, std::int32_t polygon);
+  /// A triangle strip (PLY `tristrips`): -1 ends a strip and starts the next; triangle i of a
+  /// strip is (c[i], c[i+1], c[i+2]) with every other one reversed, (c[i+1], c[i], c[i+2]), so
+  /// that all keep the first one's orientation. Triangles with a repeated corner are left out:
+  /// strips use them to join, they are not faces of the surface.
+  void add_strip(const std::int32_t* corners, std::size_t count, std::int32_t polygon);
   /// Moves the collected triangles into mesh.F and mesh.face_source.
   void move_into(Mesh& mesh);
 

@@ -33,7 +33,7 @@ class ObjReader {
     std::vector<std::string_view> tokens;
     while (cursor.next(line)) {
       line_ = cursor.line_number();
-      io_detail::split_tokens(strip_comment(line), tokens);
+      io_detail::split_tokens(io_detail::strip_comment(line), tokens);
       if (tokens.empty()) continue;
       if (tokens[0] == "v") {
         read_triple(tokens, "coordinates", positions_);
@@ -49,11 +49,6 @@ class ObjReader {
   }
 
  private:
-  static std::string_view strip_comment(std::string_view line) {
-    const std::size_t hash = line.find('#');
-    return hash == std::string_view::npos ? line : line.substr(0, hash);
-  }
-
   /// `v x y z [w] [r g b]` and `vn x y z`: the first three numbers are kept.
   void read_triple(const std::vector<std::string_view>& tokens, const char* what,
                    std::vector<double>& out) {

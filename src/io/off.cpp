@@ -1,7 +1,10 @@
-// OFF reading and writing (Geomview's Object File Format, ascii). The keyword may carry the
-// prefixes ST (texture coordinates), C (colours) and N (normals), in that order: [ST][C][N]OFF.
-// Vertex lines are `x y z [nx ny nz] [colour] [s t]`, face lines `n i0 .. in-1 [colour]`;
-// colours and texture coordinates are skipped. `#` starts a comment.
+// OFF reading and writing (Geomview's Object File Format, ascii). The keyword's prefixes say
+// what follows the coordinates of a vertex: ST (texture coordinates), C (a colour), N (a
+// normal). Geomview writes them in the order [ST][C][N]OFF and a vertex as
+// `x y z [nx ny nz] [colour] [s t]`; MeshLab (vcglib's exporter, so pymeshlab too) writes
+// [N][C][ST]OFF and, with both N and C, the colour first: `NCOFF` is `x y z r g b a nx ny nz`.
+// The keyword's order tells the two apart; the colour (0 to 4 numbers) and texture coordinates
+// are skipped. Face lines are `n i0 .. in-1 [colour]`. `#` starts a comment.
 
 #include <cmath>
 
@@ -23,7 +26,7 @@ class OffReader {
 
   Mesh read() {
     if (!next_line()) fail(path_, "empty file, expected an OFF header");
-    const bool normals = parse_keyword(tokens_[0]);
+    const VertexLayout layout = parse_keyword(tokens_[0]);
     tokens_.erase(tokens_.begin());
     // Counts usually follow on the next line, but "OFF 8 6 12" on one line is common too.
     if (tokens_.empty() && !next_line()) fail(path_, "file ends before the element counts");
@@ -38,7 +41,7 @@ class OffReader {
     io_detail::check_count_fits(path_, where, face_count, 2, rest, "faces");
 
     Mesh mesh;
-    read_vertices(static_cast<Eigen::Index>(vertex_count), normals, mesh);
+    read_vertices(static_cast<Eigen::Index>(vertex_count), layout, mesh);
     read_faces(static_cast<std::int64_t>(face_count), static_cast<std::int64_t>(vertex_count),
                mesh);
     return mesh;
@@ -49,16 +52,43 @@ class OffReader {
   bool next_line() {
     std::string_view line;
     while (cursor_.next(line)) {
-      const std::size_t hash = line.find('#');
-      if (hash != std::string_view::npos) line = line.substr(0, hash);
-      io_detail::split_tokens(line, tokens_);
+      io_detail::split_tokens(io_detail::strip_comment(line), tokens_);
       if (!tokens_.empty()) return true;
     }
     return false;
   }
 
-  /// True for a keyword with the N prefix (vertex normals follow the coordinates).
-  bool parse_keyword(std::string_view keyword) const {
+  /// What a vertex line holds after its coordinates, from the keyword's prefixes.
+  struct VertexLayout {
+    bool normals = false;
+    bool colour_before_normal = false;  ///< MeshLab's NCOFF
+    bool texture = false;
+  };
+
+  /// Removes `prefix` from the front of k if it is there.
+  static bool take(std::string_view& k, std::string_view prefix) {
+    const bool found = k.starts_with(prefix);
+    if (found) k.remove_prefix(prefix.size());
+    return found;
+  }
+
+  /// Prefixes in Geomview's order [ST][C][N]: a normal follows the coordinates.
+  static bool parse_geomview(std::string_view k, VertexLayout& layout) {
+    layout.texture = take(k, "ST");
+    take(k, "C");
+    layout.normals = take(k, "N");
+    return k.empty();
+  }
+
+  /// Prefixes in MeshLab's order [N][C][ST]: with a colour, the colour comes before the normal.
+  static bool parse_meshlab(std::string_view k, VertexLayout& layout) {
+    layout.normals = take(k, "N");
+    layout.colour_before_normal = take(k, "C") && layout.normals;
+    layout.texture = take(k, "ST");
+    return k.empty();
+  }
+
+  VertexLayout parse_keyword(std::string_view keyword) const {
     std::string_view k = keyword;
     if (k.size() < 3 || k.substr(k.size() - 3) != "OFF") {
       fail_at_line(path_, cursor_.line_number(),
@@ -66,19 +96,17 @@ class OffReader {
                        std::string(keyword) + "')");
     }
     k.remove_suffix(3);
-    if (k.starts_with("ST")) k.remove_prefix(2);
-    if (k.starts_with("C")) k.remove_prefix(1);
-    const bool normals = k.starts_with("N");
-    if (normals) k.remove_prefix(1);
-    if (!k.empty()) {
+    VertexLayout layout;
+    if (!parse_geomview(k, layout) && !parse_meshlab(k, layout)) {
       fail_at_line(path_, cursor_.line_number(),
                    "unsupported OFF variant '" + std::string(keyword) +
-                       "' (4OFF and nOFF are not 3-d meshes)");
+                       "' (expected [ST][C][N]OFF or MeshLab's [N][C][ST]OFF; 4OFF and nOFF are "
+                       "not 3-d meshes)");
     }
     if (tokens_.size() > 1 && tokens_[1] == "BINARY") {
       fail_at_line(path_, cursor_.line_number(), "binary OFF is not supported");
     }
-    return normals;
+    return layout;
   }
 
   std::pair<std::uint64_t, std::uint64_t> parse_counts() const {
@@ -103,7 +131,8 @@ class OffReader {
     return value;
   }
 
-  void read_vertices(Eigen::Index count, bool normals, Mesh& mesh) {
+  void read_vertices(Eigen::Index count, VertexLayout layout, Mesh& mesh) {
+    const bool normals = layout.normals;
     const std::size_t needed = normals ? 6 : 3;
     mesh.V.resize(count, 3);
     if (normals) mesh.N.resize(count, 3);
@@ -120,8 +149,25 @@ class OffReader {
                          ", got " + std::to_string(tokens_.size()));
       }
       for (int c = 0; c < 3; ++c) mesh.V(i, c) = number(static_cast<std::size_t>(c));
-      for (int c = 0; normals && c < 3; ++c) mesh.N(i, c) = number(static_cast<std::size_t>(3 + c));
+      if (!normals) continue;
+      const std::size_t first = layout.colour_before_normal ? normal_after_colour(i, layout) : 3;
+      for (int c = 0; c < 3; ++c) mesh.N(i, c) = number(first + static_cast<std::size_t>(c));
     }
+  }
+
+  /// Token of the normal's first component on a MeshLab NCOFF vertex line: after the colour,
+  /// whose 0 to 4 numbers are what the line holds beyond coordinates, normal and [s t].
+  std::size_t normal_after_colour(Eigen::Index i, VertexLayout layout) const {
+    const std::size_t fixed = 6 + (layout.texture ? 2 : 0);
+    if (tokens_.size() < fixed || tokens_.size() > fixed + 4) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "vertex " + std::to_string(i) + ": expected " + std::to_string(fixed) + " to " +
+                       std::to_string(fixed + 4) +
+                       " numbers (coordinates, a colour of 0 to 4, a normal" +
+                       (layout.texture ? ", texture coordinates" : "") + "), got " +
+                       std::to_string(tokens_.size()));
+    }
+    return tokens_.size() - 3 - (layout.texture ? 2 : 0);
   }
 
   void read_faces(std::int64_t count, std::int64_t vertex_count, Mesh& mesh) {

@@ -23,7 +23,18 @@ namespace focal::io_detail {
 namespace ply {
 
 /// The scalar types of PLY properties (and of list counts and items).
-enum class Scalar : std::uint8_t { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+enum class Scalar : std::uint8_t {
+  int8,
+  uint8,
+  int16,
+  uint16,
+  int32,
+  uint32,
+  int64,
+  uint64,
+  float32,
+  float64
+};
 
 /// Bytes of one binary value of type t.
 constexpr std::size_t scalar_size(Scalar t) {
@@ -38,6 +49,8 @@ constexpr std::size_t scalar_size(Scalar t) {
     case Scalar::uint32:
     case Scalar::float32:
       return 4;
+    case Scalar::int64:
+    case Scalar::uint64:
     case Scalar::float64:
       return 8;
   }
@@ -47,7 +60,7 @@ constexpr std::size_t scalar_size(Scalar t) {
 constexpr bool is_integer(Scalar t) { return t != Scalar::float32 && t != Scalar::float64; }
 
 /// Every type name a header may use: Turk's names first (the ones focal writes), then the sized
-/// aliases.
+/// aliases, then the 64-bit integers that meshio and numpy-based writers add.
 struct ScalarName {
   std::string_view name;
   Scalar type;
@@ -58,7 +71,7 @@ inline constexpr ScalarName kScalarNames[] = {
     {"float", Scalar::float32},   {"double", Scalar::float64}, {"int8", Scalar::int8},
     {"uint8", Scalar::uint8},     {"int16", Scalar::int16},    {"uint16", Scalar::uint16},
     {"int32", Scalar::int32},     {"uint32", Scalar::uint32},  {"float32", Scalar::float32},
-    {"float64", Scalar::float64},
+    {"float64", Scalar::float64}, {"int64", Scalar::int64},    {"uint64", Scalar::uint64},
 };
 
 /// The type a header names `name`; false for an unknown name.

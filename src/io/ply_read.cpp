@@ -90,7 +90,11 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view data)
   io_detail::LineCursor cursor(data);
   std::string_view line;
   std::vector<std::string_view> tokens;
-  if (!cursor.next(line) || line != "ply") fail(path, "not a PLY file (first line is not 'ply')");
+  // Trailing blanks are allowed here as on every header line ("ply \n" from some writers).
+  if (!cursor.next(line) || (io_detail::split_tokens(line, tokens), tokens.size() != 1) ||
+      tokens[0] != "ply" || line.substr(0, 3) != "ply") {
+    fail(path, "not a PLY file (first line is not 'ply')");
+  }
   PlyHeader header;
   bool have_format = false;
   while (cursor.next(line)) {
@@ -160,17 +164,58 @@ std::vector<int> vertex_roles(const std::filesystem::path& path, const PlyElemen
   return roles;
 }
 
-/// Index of the face element's vertex list property.
+/// Index of the vertex list property of a face or tristrips element.
 std::size_t face_list_property(const std::filesystem::path& path, const PlyElement& face) {
   for (std::size_t i = 0; i < face.properties.size(); ++i) {
     const auto& p = face.properties[i];
     if (p.name == "vertex_indices" || p.name == "vertex_index") {
-      if (!p.is_list) fail(path, "face property '" + p.name + "' is not a list");
-      if (!is_integer(p.type)) fail(path, "face property '" + p.name + "' has non-integer items");
+      if (!p.is_list) fail(path, face.name + " property '" + p.name + "' is not a list");
+      if (!is_integer(p.type)) {
+        fail(path, face.name + " property '" + p.name + "' has non-integer items");
+      }
       return i;
     }
   }
-  fail(path, "the face element has no list property 'vertex_indices' or 'vertex_index'");
+  fail(path,
+       "the " + face.name + " element has no list property 'vertex_indices' or 'vertex_index'");
+}
+
+/// How a face list is read: one polygon per element (`face`), or triangle strips
+/// (`tristrips`: each list a strip, -1 starting a new one).
+struct FaceLists {
+  bool strips = false;
+  std::int32_t first_source = 0;  ///< Mesh::face_source of the element's first list
+};
+
+/// Adds list `f` of a face list element, checked, to `triangles`.
+void add_face_list(const std::vector<std::int32_t>& corners, std::uint64_t f, FaceLists kind,
+                   io_detail::TriangleCollector& triangles) {
+  const auto source = kind.first_source + static_cast<std::int32_t>(f);
+  if (kind.strips) {
+    triangles.add_strip(corners.data(), corners.size(), source);
+  } else {
+    triangles.add_polygon(corners.data(), corners.size(), source);
+  }
+}
+
+/// Throws unless list `f` of element `e` has enough corners for a face (strips may be short).
+void check_list_length(const std::filesystem::path& path, const std::string& where, std::int64_t n,
+                       std::uint64_t f, FaceLists kind) {
+  if (!kind.strips && n < 3) {
+    throw IoError(path.string() + ": " + where + ": face " + std::to_string(f) + " has " +
+                  std::to_string(n) + " vertices; a face needs at least 3");
+  }
+}
+
+/// Whether v is a corner index: in [0, #V), or -1 (a restart) in a strip.
+bool valid_corner(std::int64_t v, std::int64_t vertex_count, FaceLists kind) {
+  return (v >= 0 && v < vertex_count) || (kind.strips && v == -1);
+}
+
+std::string bad_corner(const PlyElement& e, std::uint64_t f, std::int64_t v,
+                       std::int64_t vertex_count) {
+  return e.name + " " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
+         " but there are " + std::to_string(vertex_count) + " vertices";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -193,6 +238,13 @@ Out load_as(const unsigned char* p, Scalar t, bool swap) {
       return static_cast<Out>(load<std::int32_t>(p, swap));
     case Scalar::uint32:
       return static_cast<Out>(load<std::uint32_t>(p, swap));
+    case Scalar::int64:
+      return static_cast<Out>(load<std::int64_t>(p, swap));
+    case Scalar::uint64: {
+      // Saturated, so that an index or count beyond 2^63 stays out of range, not negative.
+      const std::uint64_t v = load<std::uint64_t>(p, swap);
+      return static_cast<Out>(std::min<std::uint64_t>(v, std::numeric_limits<std::int64_t>::max()));
+    }
     case Scalar::float32:
       if constexpr (std::is_floating_point_v<Out>) return static_cast<Out>(load<float>(p, swap));
       break;
@@ -336,7 +388,7 @@ class BinaryBody {
   }
 
   void read_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
-                  io_detail::TriangleCollector& triangles) {
+                  FaceLists kind, io_detail::TriangleCollector& triangles) {
     std::vector<std::int32_t> corners;
     for (std::uint64_t f = 0; f < e.count; ++f) {
       const unsigned char* start = p_;
@@ -352,25 +404,21 @@ class BinaryBody {
           continue;
         }
         const std::int64_t n = read_count(prop, e, f, start);
-        if (n < 3) {
-          fail_at_offset(path_, offset_of(start),
-                         "face " + std::to_string(f) + " has " + std::to_string(n) +
-                             " vertices; a face needs at least 3");
-        }
+        check_list_length(path_, "byte offset " + std::to_string(offset_of(start)), n, f, kind);
         const std::size_t item = scalar_size(prop.type);
         require(static_cast<std::size_t>(n) * item, e, f, start);
         corners.resize(static_cast<std::size_t>(n));
         for (std::int64_t c = 0; c < n; ++c) {
           const std::int64_t v = load_as<std::int64_t>(p_, prop.type, swap_);
-          if (v < 0 || v >= vertex_count) {
+          if (!valid_corner(v, vertex_count, kind)) {
             fail_at_offset(path_, offset_of(start),
-                           "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                               " but there are " + std::to_string(vertex_count) + " vertices");
+                           bad_corner(e, f, v, vertex_count) +
+                               byte_order_hint(p_, prop.type, vertex_count, kind));
           }
           corners[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(v);
           p_ += item;
         }
-        triangles.add_polygon(corners.data(), corners.size(), static_cast<std::int32_t>(f));
+        add_face_list(corners, f, kind, triangles);
       }
     }
   }
@@ -449,6 +497,19 @@ class BinaryBody {
     p_ += e.count * stride;
   }
 
+  /// " (wrong byte order ...?)" when the index at p, out of range, would be in range read in the
+  /// other byte order; else "".
+  [[nodiscard]] std::string byte_order_hint(const unsigned char* p, Scalar t,
+                                            std::int64_t vertex_count, FaceLists kind) const {
+    if (scalar_size(t) == 1 ||
+        !valid_corner(load_as<std::int64_t>(p, t, !swap_), vertex_count, kind)) {
+      return "";
+    }
+    return " (wrong byte order? the header says binary_" +
+           std::string(swap_ == (std::endian::native == std::endian::little) ? "big" : "little") +
+           "_endian)";
+  }
+
   [[nodiscard]] std::uint64_t offset_of(const unsigned char* p) const {
     return static_cast<std::uint64_t>(p - begin_);
   }
@@ -472,6 +533,11 @@ class BinaryBody {
       fail_at_offset(
           path_, offset_of(start),
           e.name + " " + std::to_string(index) + ": negative list length " + std::to_string(n));
+    }
+    // Each item takes a byte at least: a longer list cannot be in the file (and n * item size
+    // could overflow for 64-bit counts).
+    if (static_cast<std::uint64_t>(n) > static_cast<std::uint64_t>(end_ - p_)) {
+      require(static_cast<std::size_t>(end_ - p_) + 1, e, index, start);
     }
     return n;
   }
@@ -537,7 +603,7 @@ class AsciiBody {
   }
 
   void read_faces(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
-                  io_detail::TriangleCollector& triangles) {
+                  FaceLists kind, io_detail::TriangleCollector& triangles) {
     std::vector<std::int32_t> corners;
     for (std::uint64_t f = 0; f < e.count; ++f) {
       next_element(e, f);
@@ -549,7 +615,7 @@ class AsciiBody {
           continue;
         }
         const std::size_t n = list_length(prop, e, f, t);
-        if (k == list_prop) read_polygon(t + 1, n, f, vertex_count, corners, triangles);
+        if (k == list_prop) read_polygon(e, t + 1, n, f, vertex_count, kind, corners, triangles);
         t += 1 + n;
       }
       finish_element(t, e, f);
@@ -628,30 +694,25 @@ class AsciiBody {
     return static_cast<std::size_t>(n);
   }
 
-  void read_polygon(std::size_t first, std::size_t n, std::uint64_t f, std::int64_t vertex_count,
-                    std::vector<std::int32_t>& corners, io_detail::TriangleCollector& triangles) {
+  void read_polygon(const PlyElement& e, std::size_t first, std::size_t n, std::uint64_t f,
+                    std::int64_t vertex_count, FaceLists kind, std::vector<std::int32_t>& corners,
+                    io_detail::TriangleCollector& triangles) {
     const std::size_t line = cursor_.line_number();
-    if (n < 3) {
-      fail_at_line(path_, line,
-                   "face " + std::to_string(f) + " has " + std::to_string(n) +
-                       " vertices; a face needs at least 3");
-    }
+    check_list_length(path_, "line " + std::to_string(line), static_cast<std::int64_t>(n), f, kind);
     corners.resize(n);
     for (std::size_t c = 0; c < n; ++c) {
       std::int64_t v = 0;
       if (!io_detail::parse_int(tokens_[first + c], v)) {
         fail_at_line(path_, line,
-                     "face " + std::to_string(f) + ": '" + std::string(tokens_[first + c]) +
+                     e.name + " " + std::to_string(f) + ": '" + std::string(tokens_[first + c]) +
                          "' is not a vertex index");
       }
-      if (v < 0 || v >= vertex_count) {
-        fail_at_line(path_, line,
-                     "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                         " but there are " + std::to_string(vertex_count) + " vertices");
+      if (!valid_corner(v, vertex_count, kind)) {
+        fail_at_line(path_, line, bad_corner(e, f, v, vertex_count));
       }
       corners[c] = static_cast<std::int32_t>(v);
     }
-    triangles.add_polygon(corners.data(), n, static_cast<std::int32_t>(f));
+    add_face_list(corners, f, kind, triangles);
   }
 
   const std::filesystem::path& path_;
@@ -670,10 +731,21 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body&
   const std::vector<int> roles = vertex_roles(path, *vertex_it, has_normals);
   const auto vertex_count = static_cast<std::int64_t>(vertex_it->count);
 
+  const auto element_named = [&](std::string_view name) {
+    return std::find_if(header.elements.begin(), header.elements.end(),
+                        [name](const PlyElement& e) { return e.name == name; });
+  };
+  const auto face_it = element_named("face");
+  const bool has_strips = element_named("tristrips") != header.elements.end();
+  // Strip triangles are numbered after the faces in Mesh::face_source.
+  const auto faces_before_strips =
+      static_cast<std::int32_t>(face_it == header.elements.end() ? 0 : face_it->count);
+
   Mesh mesh;
   io_detail::TriangleCollector triangles;
   bool vertices_done = false;
   bool faces_done = false;
+  bool strips_done = false;
   bool faces_direct = false;  // read_triangle_faces() filled mesh.F and mesh.face_source
   for (const PlyElement& e : header.elements) {
     body.check_fits(e);
@@ -689,13 +761,17 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body&
     } else if (e.name == "face" && !faces_done) {
       const std::size_t list_prop = face_list_property(path, e);
       if constexpr (std::is_same_v<Body, BinaryBody>) {
-        faces_direct = body.read_triangle_faces(e, list_prop, vertex_count, mesh);
+        if (!has_strips) faces_direct = body.read_triangle_faces(e, list_prop, vertex_count, mesh);
       }
       if (!faces_direct) {
         triangles.reserve(static_cast<std::size_t>(e.count));
-        body.read_faces(e, list_prop, vertex_count, triangles);
+        body.read_faces(e, list_prop, vertex_count, FaceLists{}, triangles);
       }
       faces_done = true;
+    } else if (e.name == "tristrips" && !strips_done) {
+      body.read_faces(e, face_list_property(path, e), vertex_count,
+                      FaceLists{.strips = true, .first_source = faces_before_strips}, triangles);
+      strips_done = true;
     } else {
       body.skip_element(e);
     }

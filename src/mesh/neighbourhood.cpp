@@ -114,7 +114,9 @@ struct BfsScratch {
   }
 };
 
-// Appends the k-ring of v to `out`, ring by ring, each ring sorted; returns its size.
+// Appends the k-ring of v to `out`, ring by ring, each ring sorted; returns its size, or -1
+// (appending nothing) as soon as it holds more than kMaxNeighbourhoodSize vertices: the search
+// stops there, so a vertex next to a hub of 100k neighbours costs O(cap), not O(100k).
 int append_k_ring(const Neighbourhoods& one_ring, int k, int v, BfsScratch& s,
                   std::vector<int>& out) {
   // Raw pointers: through the containers the compiler would reload every base pointer per
@@ -134,6 +136,7 @@ int append_k_ring(const Neighbourhoods& one_ring, int k, int v, BfsScratch& s,
       for (int e = offsets[queue[q]]; e < offsets[queue[q] + 1]; ++e) {
         const int w = indices[e];
         if (mark[w] != stamp) {
+          if (size > kMaxNeighbourhoodSize) return -1;  // v itself is queue[0]
           mark[w] = stamp;
           queue[size++] = w;
         }
@@ -172,7 +175,7 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
     s.prepare(n);
     auto& out = block_rings[static_cast<std::size_t>(b)];
     for (int v = block_begin(b); v < block_begin(b + 1); ++v) {
-      counts[static_cast<std::size_t>(v)] = append_k_ring(one_ring, k, v, s, out);
+      counts[static_cast<std::size_t>(v)] = std::max(append_k_ring(one_ring, k, v, s, out), 0);
     }
   });
   Neighbourhoods result;
@@ -183,6 +186,29 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
     std::copy(ring.begin(), ring.end(), result.indices.data() + result.offsets[block_begin(b)]);
     std::vector<int>().swap(ring);  // frees memory early: the result is as large again
   });
+  return result;
+}
+
+std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k, int threads) {
+  if (k < 1) throw InvalidInput("crowded_vertices: k must be at least 1, got " + std::to_string(k));
+  check_csr(one_ring, "crowded_vertices");
+  const int n = one_ring.vertex_count();
+  if (k == 1) return {};
+  std::vector<std::uint8_t> crowded(static_cast<std::size_t>(n), 0);
+  detail::PerThread<BfsScratch> scratch(threads);
+  detail::PerThread<std::vector<int>> rings(threads);
+  detail::parallel_for(n, threads, [&](std::int64_t v) {
+    BfsScratch& s = scratch.local();
+    s.prepare(n);
+    std::vector<int>& ring = rings.local();
+    ring.clear();
+    crowded[static_cast<std::size_t>(v)] =
+        append_k_ring(one_ring, k, static_cast<int>(v), s, ring) < 0 ? 1 : 0;
+  });
+  std::vector<int> result;
+  for (int v = 0; v < n; ++v) {
+    if (crowded[static_cast<std::size_t>(v)] != 0) result.push_back(v);
+  }
   return result;
 }
 

@@ -108,18 +108,21 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
   };
   s.ring.assign(1, v);
   test_and_set(v);
+  // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
+  const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
   std::size_t begin = 0;
   for (int depth = 0; depth < rings && begin < s.ring.size(); ++depth) {
     const std::size_t end = s.ring.size();
-    for (std::size_t k = begin; k < end; ++k) {
+    for (std::size_t k = begin; k < end && s.ring.size() <= cap; ++k) {
       const int u = s.ring[k];
-      for (const int* w = one.begin(u); w != one.end(u); ++w) {
+      for (const int* w = one.begin(u); w != one.end(u) && s.ring.size() <= cap; ++w) {
         if (!test_and_set(*w)) s.ring.push_back(*w);
       }
     }
     begin = end;
   }
   for (const int w : s.ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
+  if (s.ring.size() > cap) s.ring.resize(1);
   detail::sort_small(s.ring.data(), s.ring.data() + s.ring.size(), std::less<>());
 }
 

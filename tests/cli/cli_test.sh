@@ -471,12 +471,14 @@ run curvature long.off -o long.csv
 check "non-unit normal: exit 0, counted, and every vertex flat" \
   bash -c '[[ $1 -eq 0 && $3 == "flat=3 " ]] && grep -q "^Warning: long.off: found 1 non-unit normal" "$2"' _ "$rc" "$ERR" "$(classes long.csv)"
 
-# A single triangle without normals: nothing to report, and no curvature to estimate (its three
-# estimated normals are the one face normal): three undefined rows, not flat ones (issue 13).
+# A single triangle without normals: no finding to report, and no curvature to estimate (its three
+# estimated normals are the one face normal): three undefined rows, not flat ones, and the
+# warning that every vertex is undefined as the only line (issue 13).
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >one.off
 run curvature one.off -o one.csv --strict
-check "single triangle: exit 0 with --strict, no warning, 3 undefined rows" \
-  bash -c '[[ $1 -eq 0 && ! -s $2 && $3 == "undefined=3 " ]]' _ "$rc" "$ERR" "$(classes one.csv)"
+check "single triangle: exit 0 with --strict, 3 undefined rows, only the all-undefined warning" \
+  bash -c '[[ $1 -eq 0 && $(wc -l <"$2") -eq 1 && $3 == "undefined=3 " ]] &&
+    grep -q "^Warning: one.off: every vertex is undefined (3)" "$2"' _ "$rc" "$ERR" "$(classes one.csv)"
 
 # What the normals stage takes from the check stage (cli/estimator_flags.cpp reuses its findings
 # instead of recomputing the orientation and the face normals): each warning still appears.
@@ -488,7 +490,7 @@ for estimator in default --paper; do
   run curvature ico.off -o ico-out.csv ${flag:+"$flag"}
   run curvature inward.off -o inward.csv ${flag:+"$flag"}
   check "inward icosahedron ($estimator): warns that it reversed the faces, output as outward" \
-    bash -c 'grep -q "^Warning: 1 closed component(s) are oriented inward; their faces were reversed" "$1" &&
+    bash -c 'grep -q "^Warning: inward.off: 1 closed component(s) are oriented inward; their faces were reversed" "$1" &&
              cmp -s "$2" ico-out.csv' _ "$ERR" inward.csv
 done
 # The sphere with its normals negated: counted against the faces, and the estimator warns.
@@ -499,7 +501,7 @@ for estimator in default --paper; do
   run curvature against.off -o against.csv ${flag:+"$flag"}
   check "normals against the faces ($estimator): counted, and the sign warning" \
     bash -c '[[ $1 -eq 0 ]] && grep -q "normals against their faces" "$2" &&
-             grep -q "^Warning: most file normals point against the face orientation" "$2"' _ "$rc" "$ERR"
+             grep -q "^Warning: against.off: most file normals point against the face orientation" "$2"' _ "$rc" "$ERR"
 done
 # A missing (NaN) normal row is filled from the faces; outward normals raise no sign warning.
 awk 'NR == 3 { print $1, $2, $3, "nan nan nan"; next } { print }' so.off >missing.off 2>/dev/null || true
@@ -727,6 +729,38 @@ check "an output that is a link is written through: the link stays, its file is 
   bash -c '[[ $1 -eq 0 && -L link.csv && $(head -1 target.csv) == k1,* ]]' _ "$rc"
 ln -s missing-target.csv dangling.csv
 expect_error "an output that is a link to nothing: exit 2" 2 "dangling.csv" missing-target.csv curvature s.ply -o dangling.csv
+
+# Issue 13 items 3 and 8: high valence, messages.
+awk 'BEGIN { n = 3000; for (i = 0; i < n; i++) { t = 6.283185307179586 * i / n
+  printf "v %.17g %.17g %.17g\n", cos(t), sin(t), 0.1 * sin(3 * t) }
+  printf "f"; for (i = 1; i <= n; i++) printf " %d", i; print "" }' >polygon3000.obj
+run curvature polygon3000.obj -o polygon3000.csv
+check "a 3000-corner polygon: exit 0, one row per vertex" \
+  bash -c '[[ $1 -eq 0 && $(awk "END { print NR - 1 }" polygon3000.csv) -eq 3000 ]]' _ "$rc"
+check "... and a warning naming the file and all 3000 crowded vertices" \
+  grep -q "^Warning: polygon3000.obj: 3000 vertices have more than 1024 vertices within 2 rings" "$ERR"
+run curvature polygon3000.obj -o polygon3000-2.csv --paper --rings 2
+check "--paper --rings 2 on it: every vertex undefined, said so" \
+  bash -c '[[ $1 -eq 0 && $(grep -c ",undefined$" polygon3000-2.csv) -eq 3000 ]] &&
+    grep -q "^Warning: polygon3000.obj: 3000 vertices .*left undefined" "$2"' _ "$rc" "$ERR"
+awk 'BEGIN { n = 2000; print "v 0 0 0"; print "v 1 0 0"
+  for (i = 0; i < n; i++) { t = 6.283185307179586 * i / n; printf "v 0.5 %.17g %.17g\n", cos(t), sin(t) }
+  for (i = 0; i < n; i++) printf "f 1 2 %d\n", i + 3 }' >fin2000.obj
+run curvature fin2000.obj -o fin2000.csv
+check "an edge shared by 2000 faces: exit 0, all 2002 vertices crowded, warned by name" \
+  bash -c '[[ $1 -eq 0 && $(awk "END { print NR - 1 }" fin2000.csv) -eq 2002 ]] &&
+    grep -q "^Warning: fin2000.obj: 2002 vertices have more than 1024 vertices within 2 rings" "$2"' _ "$rc" "$ERR"
+printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >octahedron.obj
+run -v curvature octahedron.obj -o octahedron.csv
+check "an octahedron (every vertex undefined): a warning, and -v says the empty H range in words" \
+  bash -c '[[ $1 -eq 0 ]] && grep -q "^Warning: octahedron.obj: every vertex is undefined (6)" "$2" &&
+    grep -q "H range: none" "$2" && ! grep -q "inf, -inf" "$2"' _ "$rc" "$ERR"
+# (no such file: the error names it)
+run info "$(printf 'new\nline.obj')"
+check "a newline in a file name does not split the Error: line" \
+  bash -c '[[ $1 -eq 2 && $(wc -l <"$2") -eq 1 ]] && grep -qF "Error: new\nline.obj: " "$2"' _ "$rc" "$ERR"
+printf 'v 0 0 0\nv 1 0 1e-400\nv 0 1 1.#QNAN\nf 1 2 3\n' >msvc.obj
+expect_error "OBJ 1.#QNAN: an error naming line and token" 2 "msvc.obj: line 3: '1.#QNAN' is not a number" msvc.csv curvature msvc.obj -o msvc.csv
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -33,12 +33,31 @@ struct Neighbourhoods {
 /// would not fit 32-bit offsets.
 [[nodiscard]] Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F, int threads = 0);
 
+/// The most vertices a neighbourhood of two or more rings may hold (the vertex itself not
+/// counted). A vertex with more within its rings, such as every corner of a polygon of thousands
+/// of corners (fan-triangulated on read: the fan's hub neighbours them all) or of the faces around
+/// an edge shared by thousands of faces, gets an empty neighbourhood from k_ring() and from the
+/// jets (jets.h), so the estimators leave it `undefined` rather than fit an arbitrary part of
+/// it; the search stops at the cap, so a run costs O(#V x cap) at worst instead of O(#V^2).
+/// Ordinary meshes stay far below it: a 4-ring (the widest the recommended estimator uses) holds
+/// 60 vertices on a regular valence-6 grid.
+/// 1-rings are never capped (together they hold twice the edges: linear already).
+inline constexpr int kMaxNeighbourhoodSize = 1024;
+
 /// k-ring: all vertices within k edges (k >= 1), excluding the vertex itself, each once, sorted
-/// by ring distance then by index. k = 1 returns a copy of `one_ring`.
+/// by ring distance then by index. k = 1 returns a copy of `one_ring`. For k >= 2 a vertex with
+/// more than kMaxNeighbourhoodSize vertices within k edges gets an empty list
+/// (crowded_vertices() names them).
 /// \throw InvalidInput when k < 1, `one_ring` is not a valid CSR (offsets not starting at 0,
 /// decreasing, not ending at indices.size(), or an index outside [0, #V)), or the result would
 /// not fit 32-bit offsets.
 [[nodiscard]] Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads = 0);
+
+/// The vertices (ascending) whose k-ring has more than kMaxNeighbourhoodSize vertices, those
+/// k_ring() leaves empty; none for k = 1. O(#V x kMaxNeighbourhoodSize) at most.
+/// \throw InvalidInput as k_ring().
+[[nodiscard]] std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k,
+                                                int threads = 0);
 
 /// #V flags: true for vertices on a boundary edge (an edge with exactly one incident face).
 /// Vertices only on non-manifold edges (3+ faces) are not boundary vertices.
