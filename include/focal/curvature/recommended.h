@@ -84,7 +84,7 @@ struct RecommendedOptions {
   /// The per-mesh choices, when given, instead of measuring them on this mesh: a tile takes
   /// recommended_mesh_wide() of the whole mesh (with PrepareOptions::mean_edge_length, the scale
   /// they are measured in).
-  std::optional<RecommendedMeshWide> mesh_wide;
+  std::optional<RecommendedMeshWide> mesh_wide{};
 };
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
