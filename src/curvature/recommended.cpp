@@ -115,14 +115,53 @@ double finite_median(const Eigen::VectorXd& x) {
   return *mid;
 }
 
-/// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
-JetNormals local_jets(const Context& c, int rings, int degree) {
+JetOptions jet_options(const Context& c, int rings, int degree) {
   JetOptions o;
   o.rings = rings;
   o.degree = degree;
   o.iterations = 1;
   o.threads = c.threads;
-  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o);
+  return o;
+}
+
+/// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
+JetNormals local_jets(const Context& c, int rings, int degree) {
+  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, jet_options(c, rings, degree));
+}
+
+/// Vertices sampled for the noise measurement: at most about kNoiseSamples, evenly by index.
+constexpr Eigen::Index kNoiseSamples = 4096;
+
+/// The position noise of recommended_plan (recommended.h): the 2-ring cubic jets' residuals
+/// `r2` with their truncation error taken out, by the 3-ring jets' residuals on a sample. A
+/// cubic's truncation error grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's:
+/// its squared residual grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are
+/// per degree of freedom). Median over the sample, over the mean edge length.
+double position_noise(const Context& c, const Eigen::VectorXd& r2) {
+  const Eigen::Index n = r2.size(), step = std::max<Eigen::Index>(1, n / kNoiseSamples);
+  std::vector<int> sample;
+  for (Eigen::Index i = 0; i < n; i += step) {
+    if (std::isfinite(r2[i])) sample.push_back(static_cast<int>(i));
+  }
+  const Eigen::VectorXd r3 =
+      detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(c, 3, 3), sample);
+  constexpr double kGrowth = 5.0625 - 1.0;  // (3/2)^4 - 1
+  Eigen::VectorXd noise(static_cast<Eigen::Index>(sample.size()));
+  for (Eigen::Index k = 0; k < noise.size(); ++k) {
+    const double a = r2[sample[static_cast<std::size_t>(k)]], b = r3[k];
+    const double truncation = std::max(0.0, b * b - a * a) / kGrowth;
+    noise[k] = std::isfinite(b) ? std::sqrt(std::max(0.0, a * a - truncation)) : NAN;
+  }
+  return finite_median(noise) / c.edge_length;
+}
+
+/// The plan for the mesh from its 2-ring cubic jets: rings from the position noise, `noise` the
+/// jets' plain residual (the file's normals are judged against the jets' error, truncation
+/// included).
+RecommendedPlan plan_of(const Context& c, const JetNormals& jets) {
+  RecommendedPlan plan = recommended_plan_for_noise(position_noise(c, jets.residual), c.options);
+  plan.noise = finite_median(jets.residual) / c.edge_length;
+  return plan;
 }
 
 /// Per vertex, the primary normal unless the secondary field is clearly smoother there: its
@@ -244,7 +283,7 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   const std::optional<NormalsRef> file = c.mesh.normals();
   const bool has_normals = file.has_value();
   const JetNormals jets = local_jets(c, 2, 3);
-  out.plan = recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, c.options);
+  out.plan = plan_of(c, jets);
   // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
   // normals from the positions take the side of the faces until turned.
   const double side = has_normals ? majority_side(*file, jets.N) : 1.0;
@@ -278,7 +317,7 @@ void choose_normals(const Context& c, RecommendedResult& out) {
 
 RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOptions& options) {
   RecommendedPlan plan;
-  plan.noise = noise;
+  plan.noise = plan.position_noise = noise;
   // Also NaN: no estimate, keep the 1-ring.
   if (!(noise > options.noise_for_two_rings)) return plan;
   plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
@@ -291,8 +330,7 @@ RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOption
 RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOptions& options) {
   validate_options(options, "recommended_plan");
   const Context c = make_context(mesh, options);
-  const JetNormals jets = local_jets(c, 2, 3);
-  return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, options);
+  return plan_of(c, local_jets(c, 2, 3));
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {

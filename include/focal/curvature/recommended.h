@@ -74,7 +74,10 @@ struct RecommendedOptions {
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
 struct RecommendedPlan {
-  double noise = NAN;     ///< median cubic-jet residual over the mean edge length; NaN: none
+  double noise = NAN;  ///< median cubic-jet residual over the mean edge length; NaN: none
+  /// The part of it that is position noise, the jets' truncation error taken out (see
+  /// recommended_plan): what decides the rings. Equals `noise` from recommended_plan_for_noise.
+  double position_noise = NAN;
   int rings = 1;          ///< rings of the two-slit fit
   bool gaussian = false;  ///< Gaussian ray weights (width = mean edge length x rings)
   int jet_rings = 2;      ///< rings of the jets whose normals are used without file normals
@@ -85,7 +88,12 @@ struct RecommendedPlan {
 [[nodiscard]] RecommendedPlan recommended_plan_for_noise(double noise,
                                                          const RecommendedOptions& options = {});
 
-/// The plan for a mesh: measures its noise (cubic jets over the 2-ring) and plans for it.
+/// The plan for a mesh: measures its noise (cubic jets over the 2-ring) and plans for its
+/// position noise. A jet's residual r mixes the position noise s with the truncation error t of
+/// a cubic, which grows as the 4th power of the neighbourhood's radius: on a sample of the
+/// vertices the 3-ring jet's residual r3 (radius about 3/2 times the 2-ring's) then gives
+/// t2^2 = (r3^2 - r2^2) / ((3/2)^8 - 1) and s^2 = r2^2 - t2^2 per vertex; position_noise is the
+/// median s over the mean edge length. On coarse meshes of curved surfaces t dominates r.
 /// \throw InvalidInput when an option is out of range.
 [[nodiscard]] RecommendedPlan recommended_plan(const PreparedMesh& mesh,
                                                const RecommendedOptions& options = {});
