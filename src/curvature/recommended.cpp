@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "core/parallel.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
+#include "curvature/robust_fit.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -43,7 +45,7 @@ struct Context {
   const RecommendedOptions& options;
   int threads;
   double edge_length;
-  std::shared_ptr<const Neighbourhoods> one_ring;
+  mutable std::shared_ptr<const Neighbourhoods> one_ring;  ///< dropped and rebuilt on demand
   RowMatrixX3d max;
 };
 
@@ -249,18 +251,6 @@ bool file_normals_agree(double median_angle, double noise, double agreement) {
 /// meet two slits exactly (spheres, cylinders, planes), and so does the fit.
 constexpr double kExactFitResidual = 1e-9;
 
-void copy_vertex(const CurvatureResult& from, Eigen::Index i, CurvatureResult& to) {
-  for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
-                     &CurvatureResult::K, &CurvatureResult::residual}) {
-    (to.*field)[i] = (from.*field)[i];
-  }
-  to.d1.row(i) = from.d1.row(i);
-  to.d2.row(i) = from.d2.row(i);
-  to.point_class[i] = from.point_class[i];
-  to.rays_used[i] = from.rays_used[i];
-  to.rays_excluded[i] = from.rays_excluded[i];
-}
-
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
@@ -273,8 +263,47 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureRes
   detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
     const bool exact_fit = fit.residual[i] <= kExactFitResidual;
     const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) copy_vertex(triangles, i, fit);
+    if (!exact_fit && triangles_defined) detail::copy_vertex(triangles, i, fit);
   });
+}
+
+/// The robust fit (curvature/robust_fit.h) of the listed vertices over `rings` rings, Gaussian
+/// weighted when `gaussian`, into their rows of `fit` (with `only_rejecting`, only where it
+/// rejected rays); no ray from a vertex flagged in `skip`.
+void robust_refit(const Context& c, const PreparedMesh& fitted, int rings, bool gaussian,
+                  const std::vector<char>& skip, const std::vector<int>& vertices,
+                  bool only_rejecting, CurvatureResult& fit) {
+  if (vertices.empty()) return;
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+  const Neighbourhoods wider = rings > 1 ? k_ring(*c.one_ring, rings, c.threads) : Neighbourhoods{};
+  const detail::VertexFitInput in{c.mesh.V(), unit.N, unit.ok, rings > 1 ? wider : *c.one_ring,
+                                  c.edge_length};
+  detail::robust_fit_vertices({in, skip, gaussian ? c.edge_length * rings : 0.0}, vertices,
+                              detail::class_tolerances(paper_options(c), c.edge_length),
+                              c.threads, only_rejecting, fit);
+}
+
+std::vector<int> all_vertices(const Context& c) {
+  std::vector<int> out(static_cast<std::size_t>(c.mesh.vertex_count()));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(i);
+  return out;
+}
+
+/// Never NaN where a fit is possible: vertices left undefined (too few rays in the hemisphere
+/// of their normal, an ill-posed fit) are fitted again, robustly, over one and then two more
+/// rings than the plan's: kMaxExtraRings bounds the estimator's reach (recommended_reach).
+void fill_undefined(const Context& c, const PreparedMesh& fitted, const RecommendedPlan& plan,
+                    const std::vector<char>& skip, CurvatureResult& fit) {
+  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+  for (int extra = 1; extra <= kMaxExtraRings; ++extra) {
+    std::vector<int> undefined;
+    for (int i = 0; i < fitted.vertex_count(); ++i) {
+      if (fit.class_of(i) == PointClass::undefined && unit.ok[static_cast<std::size_t>(i)])
+        undefined.push_back(i);
+    }
+    robust_refit(c, fitted, plan.rings + extra, true, skip, undefined, false, fit);
+  }
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -321,6 +350,8 @@ RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOption
   // Also NaN: no estimate, keep the 1-ring.
   if (!(noise > options.noise_for_two_rings)) return plan;
   plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
+  if (const char* e = std::getenv("EXP_T4"); e && noise > std::atof(e)) plan.rings = 4;
+  if (const char* e = std::getenv("EXP_T5"); e && noise > std::atof(e)) plan.rings = 5;
   plan.gaussian = true;
   plan.jet_rings = plan.rings + 1;
   plan.jet_degree = 2;
@@ -348,13 +379,20 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
   choose_normals(c, out);
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
-  out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+  const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
+    out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
     prefer_triangles(c, fitted, out.curvature);
+  } else {
+    // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
+    out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+    robust_refit(c, fitted, out.plan.rings, out.plan.gaussian, no_skip, all_vertices(c), true,
+                 out.curvature);
   }
+  fill_undefined(c, fitted, out.plan, no_skip, out.curvature);
   return out;
 }
 

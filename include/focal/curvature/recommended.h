@@ -49,6 +49,10 @@ inline constexpr double kNoiseForTwoRings = 0.015;
 /// ... and above which it uses 3 rings.
 inline constexpr double kNoiseForThreeRings = 0.035;
 
+/// Rings beyond the plan's that the recommended estimator reads where the plan's neighbourhood
+/// gives no fit (never NaN where a wider fit is possible).
+inline constexpr int kMaxExtraRings = 2;
+
 /// Options of the recommended estimator. The defaults are the measured choices of
 /// docs/ESTIMATOR.md; each field is a knob of one of the steps above.
 struct RecommendedOptions {
