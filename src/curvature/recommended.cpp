@@ -2,7 +2,6 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -291,19 +290,47 @@ std::vector<int> all_vertices(const Context& c) {
 }
 
 /// Never NaN where a fit is possible: vertices left undefined (too few rays in the hemisphere
-/// of their normal, an ill-posed fit) are fitted again, robustly, over one and then two more
-/// rings than the plan's: kMaxExtraRings bounds the estimator's reach (recommended_reach).
-void fill_undefined(const Context& c, const PreparedMesh& fitted, const RecommendedPlan& plan,
-                    const std::vector<char>& skip, CurvatureResult& fit) {
-  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+/// of their normal, an ill-posed fit) are fitted again, robustly, in the frame of the mean of
+/// their neighbours' normals (their own may be the wild one), over one and then two more rings
+/// than the plan's: kMaxExtraRings bounds the estimator's reach (recommended_reach). `N` is the
+/// normal field of the fit; the rows of the refitted vertices are replaced by that mean.
+void fill_undefined(const Context& c, const RecommendedPlan& plan, const std::vector<char>& skip,
+                    RowMatrixX3d& N, CurvatureResult& fit) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   for (int extra = 1; extra <= kMaxExtraRings; ++extra) {
     std::vector<int> undefined;
-    for (int i = 0; i < fitted.vertex_count(); ++i) {
-      if (fit.class_of(i) == PointClass::undefined && unit.ok[static_cast<std::size_t>(i)])
-        undefined.push_back(i);
+    for (int i = 0; i < c.mesh.vertex_count(); ++i) {
+      if (fit.class_of(i) != PointClass::undefined) continue;
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (const int* j = c.one_ring->begin(i); j != c.one_ring->end(i); ++j) {
+        if (N.row(*j).allFinite()) mean += N.row(*j).transpose();
+      }
+      if (!(mean.norm() > 0.0)) continue;  // no neighbour with a normal: no fit possible
+      N.row(i) = mean.normalized().transpose();
+      undefined.push_back(i);
     }
-    robust_refit(c, fitted, plan.rings + extra, true, skip, undefined, false, fit);
+    if (undefined.empty()) return;
+    robust_refit(c, c.mesh.with_normals(N), plan.rings + extra, true, skip, undefined, false, fit);
   }
+}
+
+/// `N` with each row that points against the sum of its 1-ring neighbours' turned round. Under
+/// strong noise a few jets fit in a frame tilted past 90 degrees (their first frame, Max's
+/// normal, comes from folded faces); such a normal leaves every neighbour's ray out of its fit.
+RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
+  std::vector<char> turn(static_cast<std::size_t>(N.rows()), 0);
+  detail::parallel_for(N.rows(), c.threads, [&](std::int64_t i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const int v = static_cast<int>(i);
+    for (const int* j = c.one_ring->begin(v); j != c.one_ring->end(v); ++j) {
+      if (N.row(*j).allFinite()) sum += N.row(*j).transpose();
+    }
+    turn[static_cast<std::size_t>(i)] = N.row(i).dot(sum) < 0.0 ? 1 : 0;
+  });
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    if (turn[static_cast<std::size_t>(i)]) N.row(i) = -N.row(i);
+  }
+  return N;
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -324,7 +351,9 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   Eigen::VectorXd roughness;
   if (!out.file_normals_used && out.plan.rings > 1) {
     // Noisy positions: normals from wider, lower-degree jets that average the noise.
-    out.N = local_jets(c, out.plan.jet_rings, out.plan.jet_degree).N;
+    JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
+    o.iterations = out.plan.jet_iterations;
+    out.N = turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
   } else {
     // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
     // first-order (rough) on irregular meshes.
@@ -332,6 +361,10 @@ void choose_normals(const Context& c, RecommendedResult& out) {
     const CurvatureResult with_jets = two_slit_fit(c, jets.N, 1, false);
     out.N = select_normals(jets.N, roughness_of(with_jets), c.max, roughness_of(with_max),
                            c.threads, roughness, [](std::int64_t) { return true; });
+  }
+  // Where the chosen jets have no fit (too few points, degenerate), Max's normal if any.
+  for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+    if (!out.N.row(i).allFinite()) out.N.row(i) = c.max.row(i);
   }
   if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
   if (out.file_normals_used) {
@@ -350,8 +383,9 @@ RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOption
   // Also NaN: no estimate, keep the 1-ring.
   if (!(noise > options.noise_for_two_rings)) return plan;
   plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
-  if (const char* e = std::getenv("EXP_T4"); e && noise > std::atof(e)) plan.rings = 4;
-  if (const char* e = std::getenv("EXP_T5"); e && noise > std::atof(e)) plan.rings = 5;
+  // Strong noise tilts the faces, so Max's normals (the jets' first frame) are far off: a second
+  // fit in the frame of the first.
+  plan.jet_iterations = noise > kNoiseForRefittedJets ? 2 : 1;
   plan.gaussian = true;
   plan.jet_rings = plan.rings + 1;
   plan.jet_degree = 2;
@@ -392,7 +426,7 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
     robust_refit(c, fitted, out.plan.rings, out.plan.gaussian, no_skip, all_vertices(c), true,
                  out.curvature);
   }
-  fill_undefined(c, fitted, out.plan, no_skip, out.curvature);
+  fill_undefined(c, out.plan, no_skip, out.N, out.curvature);
   return out;
 }
 

@@ -48,6 +48,12 @@ namespace focal {
 inline constexpr double kNoiseForTwoRings = 0.015;
 /// ... and above which it uses 3 rings.
 inline constexpr double kNoiseForThreeRings = 0.035;
+/// Position noise above which the jets of the positions' normals fit twice (the second time in
+/// the frame of the first): beyond the paper's 10% noise (0.058), at 30% and more (0.17), the
+/// faces tilt so much that Max's normals, the first frame, are far off (measured on the hard
+/// cases of focal eval: 50% vertex noise, sphere 3.4 -> 0.45 relative H error, torus
+/// 8.1 -> 0.39; at 10% a second fit changes the standard suite both ways by up to 7%).
+inline constexpr double kNoiseForRefittedJets = 0.1;
 
 /// Rings beyond the plan's that the recommended estimator reads where the plan's neighbourhood
 /// gives no fit (never NaN where a wider fit is possible).
@@ -86,6 +92,7 @@ struct RecommendedPlan {
   bool gaussian = false;  ///< Gaussian ray weights (width = mean edge length x rings)
   int jet_rings = 2;      ///< rings of the jets whose normals are used without file normals
   int jet_degree = 3;     ///< their degree
+  int jet_iterations = 1;  ///< their fits per vertex (2 above kNoiseForRefittedJets)
 };
 
 /// The plan for a given noise level (see the steps above); reads the noise thresholds.
