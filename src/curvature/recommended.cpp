@@ -33,6 +33,7 @@ void validate_options(const RecommendedOptions& o, const char* what) {
   non_negative(o.outlier_disagreement, "outlier_disagreement");
   non_negative(o.zero_tolerance, "zero_tolerance");
   non_negative(o.umbilic_tolerance, "umbilic_tolerance");
+  non_negative(o.crease_angle, "crease_angle");
   if (o.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
 }
 
@@ -279,8 +280,8 @@ void robust_refit(const Context& c, const PreparedMesh& fitted, int rings, bool 
   const detail::VertexFitInput in{c.mesh.V(), unit.N, unit.ok, rings > 1 ? wider : *c.one_ring,
                                   c.edge_length};
   detail::robust_fit_vertices({in, skip, gaussian ? c.edge_length * rings : 0.0}, vertices,
-                              detail::class_tolerances(paper_options(c), c.edge_length),
-                              c.threads, only_rejecting, fit);
+                              detail::class_tolerances(paper_options(c), c.edge_length), c.threads,
+                              only_rejecting, fit);
 }
 
 std::vector<int> all_vertices(const Context& c) {
@@ -333,6 +334,65 @@ RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
   return N;
 }
 
+/// Crease vertices (recommended.h, step 5): corners of an edge whose two faces' normals differ
+/// by more than RecommendedOptions::crease_angle. Per vertex, over pairs of its faces that
+/// share an edge at it.
+std::vector<char> crease_vertices(const Context& c) {
+  const PositionsRef& V = c.mesh.V();
+  const FacesRef& F = c.mesh.F();
+  const auto& incidence = *detail::incidence(c.mesh);
+  const double cos_limit = std::cos(c.options.crease_angle);
+  const auto normal_of = [&](int f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)).transpose(), b = V.row(F(f, 1)).transpose(),
+                          d = V.row(F(f, 2)).transpose();
+    return Eigen::Vector3d((b - a).cross(d - a).normalized());
+  };
+  const auto shares_edge_at = [&](int f, int g, int v) {
+    int shared = 0;
+    for (int x = 0; x < 3; ++x) {
+      for (int y = 0; y < 3; ++y) shared += F(f, x) == F(g, y) && F(f, x) != v;
+    }
+    return shared > 0;
+  };
+  std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+  detail::parallel_for(c.mesh.vertex_count(), c.threads, [&](std::int64_t i) {
+    const int v = static_cast<int>(i);
+    for (int a = incidence.begin(v); a < incidence.end(v) && !crease[i]; ++a) {
+      const int f = incidence.faces[static_cast<std::size_t>(a)];
+      for (int b = a + 1; b < incidence.end(v); ++b) {
+        const int g = incidence.faces[static_cast<std::size_t>(b)];
+        if (shares_edge_at(f, g, v) && normal_of(f).dot(normal_of(g)) < cos_limit) {
+          crease[static_cast<std::size_t>(i)] = 1;
+          break;
+        }
+      }
+    }
+  });
+  return crease;
+}
+
+/// Vertices within `rings` rings of a flagged one (not flagged themselves).
+std::vector<int> near_flagged(const Context& c, const std::vector<char>& flagged, int rings) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const Eigen::VectorXi distance =
+      rings_to_boundary(*c.one_ring, std::vector<bool>(flagged.begin(), flagged.end()), rings);
+  std::vector<int> out;
+  for (int i = 0; i < distance.size(); ++i) {
+    if (distance[i] >= 1 && distance[i] <= rings) out.push_back(i);
+  }
+  return out;
+}
+
+/// Vertices next to a crease vertex: the triangles there use the crease vertex's normal, which
+/// belongs to neither piece; the 1-ring fit without crease vertices replaces them.
+void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
+                          CurvatureResult& fit) {
+  if (crease.size() == 0 || crease.maxCoeff() == 0) return;
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const std::vector<char> skip(crease.begin(), crease.end());
+  robust_refit(c, fitted, 1, false, skip, near_flagged(c, skip, 1), false, fit);
+}
+
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
 /// normals (the mesh's, if any) are used, and the normals to fit, into `out`.
 void choose_normals(const Context& c, RecommendedResult& out) {
@@ -353,7 +413,8 @@ void choose_normals(const Context& c, RecommendedResult& out) {
     // Noisy positions: normals from wider, lower-degree jets that average the noise.
     JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
     o.iterations = out.plan.jet_iterations;
-    out.N = turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
+    out.N =
+        turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
   } else {
     // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
     // first-order (rough) on irregular meshes.
@@ -372,6 +433,22 @@ void choose_normals(const Context& c, RecommendedResult& out) {
     const CurvatureResult with_file = two_slit_fit(c, *file, 1, false);
     out.N = replace_outliers(*file, roughness_of(with_file), disagreement, out.N, roughness,
                              c.options.outlier_disagreement * out.plan.noise, c.threads);
+  }
+  if (out.plan.rings == 1 && c.options.crease_angle > 0.0) {
+    // Creases on clean positions: jets over the 2-ring mix the pieces' normals; each face lies
+    // on one piece, so Max's normals (of the faces) stay on their piece.
+    const std::vector<char> crease = crease_vertices(c);
+    out.crease = Eigen::Map<const Eigen::Matrix<char, Eigen::Dynamic, 1>>(
+                     crease.data(), static_cast<Eigen::Index>(crease.size()))
+                     .cast<std::uint8_t>();
+    // Used file normals are kept there where they agree with Max's normal within half the
+    // crease angle (the jets they were judged against mix the pieces); others take Max's.
+    const double agree = std::cos(0.5 * c.options.crease_angle);
+    for (const int v : near_flagged(c, crease, 2)) {
+      const Eigen::RowVector3d max = side * c.max.row(v);
+      const bool keep_file = out.file_normals_used && file->row(v).normalized().dot(max) > agree;
+      out.N.row(v) = keep_file ? Eigen::RowVector3d(file->row(v).normalized()) : max;
+    }
   }
 }
 
@@ -420,6 +497,7 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
     c.one_ring.reset();
     c.max.resize(0, 3);
     prefer_triangles(c, fitted, out.curvature);
+    refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);

@@ -73,6 +73,11 @@ struct RecommendedOptions {
   /// Step 3: among used file normals, one more than this many times the noise from its jet normal
   /// (and rougher than the positions' normal by half) is an outlier, replaced.
   double outlier_disagreement = 10.0;
+  /// Step 5: on clean positions, an edge whose two faces' normals differ by more than this
+  /// (radians; 0 turns crease handling off) is a crease; its corners are crease vertices.
+  /// 60 degrees: above the 46 degrees that faces of the coarsest suite meshes (spacing 0.8 /
+  /// max |curvature|) turn between neighbours on smooth surfaces.
+  double crease_angle = 1.0471975511965976;  // 60 degrees
   /// Classes, as CurvatureOptions: |k| x mean edge length <= zero_tolerance is zero ...
   double zero_tolerance = 1e-3;
   /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
@@ -88,10 +93,10 @@ struct RecommendedPlan {
   /// The part of it that is position noise, the jets' truncation error taken out (see
   /// recommended_plan): what decides the rings. Equals `noise` from recommended_plan_for_noise.
   double position_noise = NAN;
-  int rings = 1;          ///< rings of the two-slit fit
-  bool gaussian = false;  ///< Gaussian ray weights (width = mean edge length x rings)
-  int jet_rings = 2;      ///< rings of the jets whose normals are used without file normals
-  int jet_degree = 3;     ///< their degree
+  int rings = 1;           ///< rings of the two-slit fit
+  bool gaussian = false;   ///< Gaussian ray weights (width = mean edge length x rings)
+  int jet_rings = 2;       ///< rings of the jets whose normals are used without file normals
+  int jet_degree = 3;      ///< their degree
   int jet_iterations = 1;  ///< their fits per vertex (2 above kNoiseForRefittedJets)
 };
 
@@ -124,6 +129,9 @@ struct RecommendedResult {
   /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
   /// their side.
   bool file_normals_used = false;
+  /// #V flags, 1 at crease vertices (step 5; clean positions only, else all 0 or empty): the
+  /// curvature does not exist there, their values are not to be trusted.
+  VectorXu8 crease;
 };
 
 /// The recommended estimate of a mesh, with its normals as the file's when it has them (they may
