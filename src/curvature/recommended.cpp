@@ -469,6 +469,11 @@ RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOption
   return plan;
 }
 
+int recommended_reach(const RecommendedPlan& plan) {
+  const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
+  return plan.rings + kMaxExtraRings + normal_reach;
+}
+
 RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOptions& options) {
   validate_options(options, "recommended_plan");
   const Context c = make_context(mesh, options);

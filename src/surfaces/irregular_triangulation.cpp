@@ -182,7 +182,10 @@ std::vector<Vector2d> poisson_samples(const Parametrisation& s, const ParameterD
   // The grid maximum misses peaks between samples by O(h^2); 10% covers that.
   const double bound = 1.1 * stats.max_area_element;
   // Scaled by the count r gives: more than target where sample_spacing had to shrink r.
-  const std::int64_t candidates = kCandidatesPerVertex * std::max<std::int64_t>(target, expected);
+  // Graded: the dense end needs candidates in proportion to its density to be saturated.
+  const auto grading = static_cast<std::int64_t>(std::ceil(std::exp(radius.log_grading)));
+  const std::int64_t candidates =
+      kCandidatesPerVertex * grading * std::max<std::int64_t>(target, expected);
   for (std::int64_t k = 0; k < candidates;) {
     const Vector2d uv(uniform(rng, d.u_min, d.u_max), uniform(rng, d.v_min, d.v_max));
     const double accept = uniform01(rng);

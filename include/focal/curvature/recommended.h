@@ -118,6 +118,19 @@ struct RecommendedPlan {
 [[nodiscard]] RecommendedPlan recommended_plan(PositionsRef V, FacesRef F,
                                                const RecommendedOptions& options = {});
 
+/// How far the recommended estimate of one vertex reads the mesh, in rings, for a plan: an upper
+/// bound for partitioning a mesh into tiles whose halos give owned vertices the whole-mesh result
+/// (the plan and the verdict on the file's normals are global: decide them once and pass them).
+/// A vertex's normal reads at most max(4, jet_rings + 2) rings (2-ring jets from Max's normals,
+/// rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned with the 1-ring);
+/// the fit reads the normals of rings + kMaxExtraRings rings (the per-triangle pass, the crease
+/// steps and the neighbour mean of undefined vertices read fewer). 7 on clean positions,
+/// 11 at most (kRecommendedMaxReach).
+[[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
+
+/// recommended_reach of the widest plan (3 rings, 4-ring jets).
+inline constexpr int kRecommendedMaxReach = 11;
+
 /// The recommended estimate with what it decided and the normals it fitted.
 struct RecommendedResult {
   CurvatureResult curvature;
