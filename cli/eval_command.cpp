@@ -319,8 +319,11 @@ void write_csv_table(const std::string& path, const std::vector<Row>& rows) {
   write_csv(path, columns);
 }
 
-/// Whether `v` is at most `best` (errors both below 1e-12 are exact up to rounding and tie).
-bool at_most(double v, double best) { return v <= best || (v < 1e-12 && best < 1e-12); }
+/// Whether `v` is at most `best`: within 0.1% (the 4 digits the tables show; the same estimator
+/// on the same normals can differ in the last bits) or both below 1e-12 (exact up to rounding).
+bool at_most(double v, double best) {
+  return v <= best * (1.0 + 1e-3) || (v < 1e-12 && best < 1e-12);
+}
 
 /// How focal default fares in one case (rows [r, r + methods) of the table).
 struct CaseWins {
