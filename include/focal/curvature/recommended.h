@@ -13,8 +13,9 @@
 ///     noise = median residual / mean edge length (about 1e-4 on clean smooth meshes, 0.056 for
 ///     the paper's 10% vertex noise).
 ///  2. Neighbourhood (recommended_plan_for_noise): the 1-ring (the paper) on clean positions;
-///     Gaussian-weighted 2 or 3 rings when the noise is above RecommendedOptions::
-///     noise_for_two_rings or noise_for_three_rings.
+///     Gaussian-weighted 2 or 3 rings when the position noise (the jets' residual without their
+///     truncation error, recommended_plan) is above RecommendedOptions::noise_for_two_rings or
+///     noise_for_three_rings.
 ///  3. Normals. From the positions: per vertex the jets' normals, or Max's (exact on spheres)
 ///     where those are clearly smoother: the RMS misfit (residual) of their 1-ring two-slit fit
 ///     below half the jets'; on noisy positions instead those of wider quadratic jets (rings + 1
@@ -31,6 +32,19 @@
 ///     (Method::triangle; 1.3 to 1.8 times lower H error on irregular meshes), except where the
 ///     fit is exact (residual <= 1e-9: the rays meet two slits, as on spheres and cylinders) or
 ///     the triangles give no estimate.
+///  5. Creases (clean positions only): an edge whose faces' normals differ by more than
+///     RecommendedOptions::crease_angle (60 degrees) is sharp, its corners are crease vertices
+///     (RecommendedResult::crease). Within 2 rings of them the normals are Max's (each face lies
+///     on one piece) or the file's where those agree with Max's; vertices next to a crease vertex
+///     take the 1-ring fit without the crease vertices' rays.
+///  6. Robust refit (noisy positions): where a ray's misfit exceeds 5 robust scales (1.4826 x
+///     the median misfit), it is left out and the fit repeated (curvature/robust_fit.h); clean
+///     misfits never get there, so the least-squares fit stays where nothing is wild. Under
+///     position noise above kNoiseForRefittedJets the positions' jets fit twice, and normals
+///     pointing against the sum of their 1-ring's are turned.
+///  7. Never NaN where a fit is possible: undefined vertices are refitted robustly in the frame
+///     of their neighbours' mean normal over 1, then 2 more rings (kMaxExtraRings); the reach of
+///     the whole estimator is recommended_reach(plan).
 /// The paper's method as written remains estimate_curvature with default CurvatureOptions.
 ///
 /// Deterministic for any thread count. Vertices the fit cannot handle are `undefined` (NaN) as
