@@ -191,19 +191,19 @@ std::vector<Case> hard_cases() {
   // with thin pole fans on the sphere and the ellipsoid), and thin cells across curvature.
   add("anisotropic", cylinder, "strips 8:1 along the axis",
       surface_maker(cylinder, regular, 0, aspect(1.0 / 8)));
-  add("anisotropic", sphere, "lat-long 8:1, pole fans",
+  add("anisotropic", sphere, "lat-long 8:1 with pole fans",
       surface_maker(sphere, regular, 0, aspect(8)));
-  add("anisotropic", ellipsoid, "lat-long 1:5, pole fans",
+  add("anisotropic", ellipsoid, "lat-long 1:5 with pole fans",
       surface_maker(ellipsoid, regular, 0, aspect(1.0 / 5)));
   add("anisotropic", torus, "strips 8:1", surface_maker(torus, regular, 0, aspect(8)));
   add("anisotropic", saddle, "strips 20:1", surface_maker(saddle, regular, 0, aspect(20)));
   add("anisotropic", helix_tube, "strips 1:5", surface_maker(helix_tube, regular, 0, aspect(0.2)));
   const auto graded = [](SurfaceOptions& o) { o.grading = 10; };
   for (SurfaceKind k : {ellipsoid, torus, saddle, pear})
-    add("graded density", k, "irregular, density 10:1", surface_maker(k, irregular, 0, graded));
+    add("graded density", k, "irregular with density 10:1", surface_maker(k, irregular, 0, graded));
   for (SurfaceKind k : {torus, ellipsoid, pear, helix_tube, monkey_saddle})
-    add("coarse", k, "irregular, 850 vertices", surface_maker(k, irregular, 850));
-  add("coarse", ellipsoid, "regular, 850 vertices", surface_maker(ellipsoid, regular, 850));
+    add("coarse", k, "irregular with 850 vertices", surface_maker(k, irregular, 850));
+  add("coarse", ellipsoid, "regular with 850 vertices", surface_maker(ellipsoid, regular, 850));
   for (const auto& [k, a] : {std::pair{sphere, 0.5},
                              {torus, 0.3},
                              {torus, 0.5},
@@ -220,14 +220,15 @@ std::vector<Case> hard_cases() {
   add("outliers", helix_tube, "irregular", surface_maker(helix_tube, irregular),
       {.outlier_normals = 0.02, .spikes = 0.005});
   for (SurfaceKind k : {saddle, monkey_saddle, cylinder, helix_tube})
-    add("near boundaries", k, "irregular, rings 1-2", surface_maker(k, irregular), {}, true);
-  add("near boundaries", saddle, "irregular, rings 1-2", surface_maker(saddle, irregular),
+    add("near boundaries", k, "irregular scored at rings 1-2", surface_maker(k, irregular), {},
+        true);
+  add("near boundaries", saddle, "irregular scored at rings 1-2", surface_maker(saddle, irregular),
       {.vertex_noise = 0.1}, true);
   const auto capped = [](const EvalFlags& f) { return make_capped_cylinder(1.0, 2.0, f.vertices); };
   for (const Perturbation& p :
        {Perturbation{}, Perturbation{.vertex_noise = 0.1}, Perturbation{.normal_noise = 0.05}}) {
-    out.push_back({"creases", "capped-cylinder", "regular, rims not scored", noise_name(p), capped,
-                   p, false, slug_of("creases capped-cylinder " + noise_name(p))});
+    out.push_back({"creases", "capped-cylinder", "regular with rims not scored", noise_name(p),
+                   capped, p, false, slug_of("creases capped-cylinder " + noise_name(p))});
   }
   return out;
 }
