@@ -227,8 +227,10 @@ Where focal default loses on these cases (measured, docs/ESTIMATOR.md "Hard case
   pass (a little less accurate), and without file normals the jets of its 2-ring are pulled; the
   2-ring closed-form fit of Max's normals averages the spike over more rays. A spike test of its
   own (a vertex far off the jet of its neighbours) would be the fix; not built.
-- **Graded pear, coarse helix tube without normals, torus strips without normals**: within 1-20%
-  of the per-triangle pass on Max's normals, which the default chooses per vertex by roughness.
+- **Graded pear with file normals**: 1% behind the per-triangle pass on the same normals (not
+  analysed further).
+  **Coarse helix tube and torus strips without normals**: 19% and 43% behind the per-triangle
+  pass on Max's normals; the default's per-vertex roughness test keeps the jets' normals there.
 - **Creases under vertex noise**: crease detection runs on clean positions only (noise folds
   faces past any angle), so the noisy capped cylinder is fitted across its rims; its error is
   still the lowest of the table.
