@@ -81,9 +81,9 @@ void report_recommended(const Input& input, const std::string& mesh_name, const 
                 "file normals' side");
   }
   std::ostringstream plan;
-  plan << "  recommended estimator: " << normals_used(e) << ", position noise " << e.plan.noise
-       << " x edge length, " << e.plan.rings << "-ring "
-       << (e.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
+  plan << "  recommended estimator: " << normals_used(e) << ", jet residual " << e.plan.noise
+       << ", position noise " << e.plan.position_noise << " x edge length, " << e.plan.rings
+       << "-ring " << (e.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
   log.info(plan.str());
 }
 

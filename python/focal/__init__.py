@@ -200,7 +200,8 @@ class Curvature:
     F: Optional[np.ndarray] = None
     #: What the normals step fixed (counts; see estimate.h NormalsReport).
     normals_report: dict = dataclasses.field(default_factory=dict)
-    #: The recommended estimator's plan: noise, rings, gaussian, jet_rings, jet_degree.
+    #: The recommended estimator's plan: noise, position_noise, rings, gaussian, jet_rings,
+    #: jet_degree, jet_iterations.
     plan: dict = dataclasses.field(default_factory=dict)
     #: Median angle (radians) of the given normals to the jet normals (NaN without N).
     file_disagreement: float = float("nan")

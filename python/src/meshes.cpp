@@ -154,10 +154,12 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   d["normals_report"] = report;
   nb::dict plan;
   plan["noise"] = e.plan.noise;
+  plan["position_noise"] = e.plan.position_noise;
   plan["rings"] = e.plan.rings;
   plan["gaussian"] = e.plan.gaussian;
   plan["jet_rings"] = e.plan.jet_rings;
   plan["jet_degree"] = e.plan.jet_degree;
+  plan["jet_iterations"] = e.plan.jet_iterations;
   d["plan"] = plan;
   d["file_disagreement"] = e.file_disagreement;
   d["file_normals_used"] = e.file_normals_used;

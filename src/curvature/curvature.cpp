@@ -271,7 +271,8 @@ template <class L>
   if (slots.size() < static_cast<std::size_t>(g.slots)) slots.resize(g.slots);
   SlotSums<L> sums;
   for (int k = 0; k < g.slots; ++k) make_slot(c, g, k, slots[k], sums);
-  const kernels::SlitSolution<L> w = kernels::solve_slits(sums.equations, detail::kMinRelativeDeterminant);
+  const kernels::SlitSolution<L> w =
+      kernels::solve_slits(sums.equations, detail::kMinRelativeDeterminant);
   const auto used = -sums.used;
   const auto valid = g.ok & (-sums.positive >= 2) & w.valid;
   // Both divisions by one reciprocal, for the divider's sake as in make_slot.

@@ -26,8 +26,7 @@ inline TangentFrame frame_of(const Eigen::Vector3d& n) {
 /// ray rather than poisoning the fit), and `ray` is then unspecified. The slopes are divided
 /// exactly (kernels::Quotient), as this path always has.
 inline bool ray_of(const TangentFrame& frame, const Eigen::Vector3d& origin,
-                   const Eigen::Vector3d& position, const Eigen::Vector3d& normal,
-                   NormalRay& ray) {
+                   const Eigen::Vector3d& position, const Eigen::Vector3d& normal, NormalRay& ray) {
   const kernels::Frame<double> f{vec3_of(frame.x), vec3_of(frame.y), vec3_of(frame.n)};
   const kernels::Vec3<double> m = vec3_of(normal);
   return kernels::normal_ray<kernels::Quotient::exact>(f, vec3_of(position - origin), m, m, ray);

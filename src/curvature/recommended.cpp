@@ -12,6 +12,7 @@
 #include "core/parallel.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
+#include "curvature/robust_fit.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -33,6 +34,7 @@ void validate_options(const RecommendedOptions& o, const char* what) {
   non_negative(o.outlier_disagreement, "outlier_disagreement");
   non_negative(o.zero_tolerance, "zero_tolerance");
   non_negative(o.umbilic_tolerance, "umbilic_tolerance");
+  non_negative(o.crease_angle, "crease_angle");
   if (o.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
 }
 
@@ -44,7 +46,7 @@ struct Context {
   const RecommendedOptions& options;
   int threads;
   double edge_length;
-  std::shared_ptr<const Neighbourhoods> one_ring;
+  mutable std::shared_ptr<const Neighbourhoods> one_ring;  ///< dropped and rebuilt on demand
   RowMatrixX3d max;
 };
 
@@ -116,14 +118,53 @@ double finite_median(const Eigen::VectorXd& x) {
   return *mid;
 }
 
-/// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
-JetNormals local_jets(const Context& c, int rings, int degree) {
+JetOptions jet_options(const Context& c, int rings, int degree) {
   JetOptions o;
   o.rings = rings;
   o.degree = degree;
   o.iterations = 1;
   o.threads = c.threads;
-  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o);
+  return o;
+}
+
+/// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
+JetNormals local_jets(const Context& c, int rings, int degree) {
+  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, jet_options(c, rings, degree));
+}
+
+/// Vertices sampled for the noise measurement: at most about kNoiseSamples, evenly by index.
+constexpr Eigen::Index kNoiseSamples = 4096;
+
+/// The position noise of recommended_plan (recommended.h): the 2-ring cubic jets' residuals
+/// `r2` with their truncation error taken out, by the 3-ring jets' residuals on a sample. A
+/// cubic's truncation error grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's:
+/// its squared residual grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are
+/// per degree of freedom). Median over the sample, over the mean edge length.
+double position_noise(const Context& c, const Eigen::VectorXd& r2) {
+  const Eigen::Index n = r2.size(), step = std::max<Eigen::Index>(1, n / kNoiseSamples);
+  std::vector<int> sample;
+  for (Eigen::Index i = 0; i < n; i += step) {
+    if (std::isfinite(r2[i])) sample.push_back(static_cast<int>(i));
+  }
+  const Eigen::VectorXd r3 =
+      detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(c, 3, 3), sample);
+  constexpr double kGrowth = 5.0625 - 1.0;  // (3/2)^4 - 1
+  Eigen::VectorXd noise(static_cast<Eigen::Index>(sample.size()));
+  for (Eigen::Index k = 0; k < noise.size(); ++k) {
+    const double a = r2[sample[static_cast<std::size_t>(k)]], b = r3[k];
+    const double truncation = std::max(0.0, b * b - a * a) / kGrowth;
+    noise[k] = std::isfinite(b) ? std::sqrt(std::max(0.0, a * a - truncation)) : NAN;
+  }
+  return finite_median(noise) / c.edge_length;
+}
+
+/// The plan for the mesh from its measured (or given) per-mesh choices: rings from the position
+/// noise, `noise` the 2-ring cubic jets' plain residual (the file's normals are judged against
+/// the jets' error, truncation included).
+RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions& options) {
+  RecommendedPlan plan = recommended_plan_for_noise(m.position_noise, options);
+  plan.noise = m.noise;
+  return plan;
 }
 
 /// Per vertex, the primary normal unless the secondary field is clearly smoother there: its
@@ -248,8 +289,138 @@ FileComparison compare_file_normals(const Context& c, const JetNormals& jets) {
 /// The per-mesh choices measured on the context's mesh: medians over all its vertices.
 RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
                                       const FileComparison& file) {
-  return {finite_median(jets.residual) / c.edge_length,
-          c.mesh.has_normals() ? finite_median(file.disagreement) : NAN, file.side};
+  RecommendedMeshWide m;
+  m.noise = finite_median(jets.residual) / c.edge_length;
+  m.position_noise = position_noise(c, jets.residual);
+  m.file_disagreement = c.mesh.has_normals() ? finite_median(file.disagreement) : NAN;
+  m.side = file.side;
+  return m;
+}
+
+/// The robust fit (curvature/robust_fit.h) of the listed vertices over `rings` rings, Gaussian
+/// weighted when `gaussian`, into their rows of `fit` (with `only_rejecting`, only where it
+/// rejected rays); no ray from a vertex flagged in `skip`.
+void robust_refit(const Context& c, const PreparedMesh& fitted, int rings, bool gaussian,
+                  const std::vector<char>& skip, const std::vector<int>& vertices,
+                  bool only_rejecting, CurvatureResult& fit) {
+  if (vertices.empty()) return;
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+  const Neighbourhoods wider = rings > 1 ? k_ring(*c.one_ring, rings, c.threads) : Neighbourhoods{};
+  const detail::VertexFitInput in{c.mesh.V(), unit.N, unit.ok, rings > 1 ? wider : *c.one_ring,
+                                  c.edge_length};
+  detail::robust_fit_vertices({in, skip, gaussian ? c.edge_length * rings : 0.0}, vertices,
+                              detail::class_tolerances(paper_options(c), c.edge_length), c.threads,
+                              only_rejecting, fit);
+}
+
+std::vector<int> all_vertices(const Context& c) {
+  std::vector<int> out(static_cast<std::size_t>(c.mesh.vertex_count()));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(i);
+  return out;
+}
+
+/// Never NaN where a fit is possible: vertices left undefined (too few rays in the hemisphere
+/// of their normal, an ill-posed fit) are fitted again, robustly, in the frame of the mean of
+/// their neighbours' normals (their own may be the wild one), over one and then two more rings
+/// than the plan's: kMaxExtraRings bounds the estimator's reach (recommended_reach). `N` is the
+/// normal field of the fit; the rows of the refitted vertices are replaced by that mean.
+void fill_undefined(const Context& c, const RecommendedPlan& plan, const std::vector<char>& skip,
+                    RowMatrixX3d& N, CurvatureResult& fit) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  for (int extra = 1; extra <= kMaxExtraRings; ++extra) {
+    std::vector<int> undefined;
+    for (int i = 0; i < c.mesh.vertex_count(); ++i) {
+      if (fit.class_of(i) != PointClass::undefined) continue;
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (const int* j = c.one_ring->begin(i); j != c.one_ring->end(i); ++j) {
+        if (N.row(*j).allFinite()) mean += N.row(*j).transpose();
+      }
+      if (!(mean.norm() > 0.0)) continue;  // no neighbour with a normal: no fit possible
+      N.row(i) = mean.normalized().transpose();
+      undefined.push_back(i);
+    }
+    if (undefined.empty()) return;
+    robust_refit(c, c.mesh.with_normals(N), plan.rings + extra, true, skip, undefined, false, fit);
+  }
+}
+
+/// `N` with each row that points against the sum of its 1-ring neighbours' turned round. Under
+/// strong noise a few jets fit in a frame tilted past 90 degrees (their first frame, Max's
+/// normal, comes from folded faces); such a normal leaves every neighbour's ray out of its fit.
+RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
+  std::vector<char> turn(static_cast<std::size_t>(N.rows()), 0);
+  detail::parallel_for(N.rows(), c.threads, [&](std::int64_t i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const int v = static_cast<int>(i);
+    for (const int* j = c.one_ring->begin(v); j != c.one_ring->end(v); ++j) {
+      if (N.row(*j).allFinite()) sum += N.row(*j).transpose();
+    }
+    turn[static_cast<std::size_t>(i)] = N.row(i).dot(sum) < 0.0 ? 1 : 0;
+  });
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    if (turn[static_cast<std::size_t>(i)]) N.row(i) = -N.row(i);
+  }
+  return N;
+}
+
+/// Crease vertices (recommended.h, step 5): corners of an edge whose two faces' normals differ
+/// by more than RecommendedOptions::crease_angle. Per vertex, over pairs of its faces that
+/// share an edge at it.
+std::vector<char> crease_vertices(const Context& c) {
+  const PositionsRef& V = c.mesh.V();
+  const FacesRef& F = c.mesh.F();
+  const auto& incidence = *detail::incidence(c.mesh);
+  const double cos_limit = std::cos(c.options.crease_angle);
+  const auto normal_of = [&](int f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)).transpose(), b = V.row(F(f, 1)).transpose(),
+                          d = V.row(F(f, 2)).transpose();
+    return Eigen::Vector3d((b - a).cross(d - a).normalized());
+  };
+  const auto shares_edge_at = [&](int f, int g, int v) {
+    int shared = 0;
+    for (int x = 0; x < 3; ++x) {
+      for (int y = 0; y < 3; ++y) shared += F(f, x) == F(g, y) && F(f, x) != v;
+    }
+    return shared > 0;
+  };
+  std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+  detail::parallel_for(c.mesh.vertex_count(), c.threads, [&](std::int64_t i) {
+    const int v = static_cast<int>(i);
+    for (int a = incidence.begin(v); a < incidence.end(v) && !crease[i]; ++a) {
+      const int f = incidence.faces[static_cast<std::size_t>(a)];
+      for (int b = a + 1; b < incidence.end(v); ++b) {
+        const int g = incidence.faces[static_cast<std::size_t>(b)];
+        if (shares_edge_at(f, g, v) && normal_of(f).dot(normal_of(g)) < cos_limit) {
+          crease[static_cast<std::size_t>(i)] = 1;
+          break;
+        }
+      }
+    }
+  });
+  return crease;
+}
+
+/// Vertices within `rings` rings of a flagged one (not flagged themselves).
+std::vector<int> near_flagged(const Context& c, const std::vector<char>& flagged, int rings) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const Eigen::VectorXi distance =
+      rings_to_boundary(*c.one_ring, std::vector<bool>(flagged.begin(), flagged.end()), rings);
+  std::vector<int> out;
+  for (int i = 0; i < distance.size(); ++i) {
+    if (distance[i] >= 1 && distance[i] <= rings) out.push_back(i);
+  }
+  return out;
+}
+
+/// Vertices next to a crease vertex: the triangles there use the crease vertex's normal, which
+/// belongs to neither piece; the 1-ring fit without crease vertices replaces them.
+void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
+                          CurvatureResult& fit) {
+  if (crease.size() == 0 || crease.maxCoeff() == 0) return;
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const std::vector<char> skip(crease.begin(), crease.end());
+  robust_refit(c, fitted, 1, false, skip, near_flagged(c, skip, 1), false, fit);
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -261,7 +432,7 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   const FileComparison compared = compare_file_normals(c, jets);
   const RecommendedMeshWide mesh_wide =
       c.options.mesh_wide ? *c.options.mesh_wide : measure_mesh_wide(c, jets, compared);
-  out.plan = recommended_plan_for_noise(mesh_wide.noise, c.options);
+  out.plan = plan_for(mesh_wide, c.options);
   const double side = compared.side;
   const Eigen::VectorXd& disagreement = compared.disagreement;
   out.file_disagreement = mesh_wide.file_disagreement;
@@ -270,7 +441,10 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   Eigen::VectorXd roughness;
   if (!out.file_normals_used && out.plan.rings > 1) {
     // Noisy positions: normals from wider, lower-degree jets that average the noise.
-    out.N = local_jets(c, out.plan.jet_rings, out.plan.jet_degree).N;
+    JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
+    o.iterations = out.plan.jet_iterations;
+    out.N =
+        turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
   } else {
     // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
     // first-order (rough) on irregular meshes.
@@ -279,6 +453,10 @@ void choose_normals(const Context& c, RecommendedResult& out) {
     out.N = select_normals(jets.N, roughness_of(with_jets), c.max, roughness_of(with_max),
                            c.threads, roughness, [](std::int64_t) { return true; });
   }
+  // Where the chosen jets have no fit (too few points, degenerate), Max's normal if any.
+  for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+    if (!out.N.row(i).allFinite()) out.N.row(i) = c.max.row(i);
+  }
   if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
   if (out.file_normals_used) {
     // The file's normals, except outliers where the positions' choice is clearly smoother.
@@ -286,16 +464,35 @@ void choose_normals(const Context& c, RecommendedResult& out) {
     out.N = replace_outliers(*file, roughness_of(with_file), disagreement, out.N, roughness,
                              c.options.outlier_disagreement * out.plan.noise, c.threads);
   }
+  if (out.plan.rings == 1 && c.options.crease_angle > 0.0) {
+    // Creases on clean positions: jets over the 2-ring mix the pieces' normals; each face lies
+    // on one piece, so Max's normals (of the faces) stay on their piece.
+    const std::vector<char> crease = crease_vertices(c);
+    out.crease = Eigen::Map<const Eigen::Matrix<char, Eigen::Dynamic, 1>>(
+                     crease.data(), static_cast<Eigen::Index>(crease.size()))
+                     .cast<std::uint8_t>();
+    // Used file normals are kept there where they agree with Max's normal within half the
+    // crease angle (the jets they were judged against mix the pieces); others take Max's.
+    const double agree = std::cos(0.5 * c.options.crease_angle);
+    for (const int v : near_flagged(c, crease, 2)) {
+      const Eigen::RowVector3d max = side * c.max.row(v);
+      const bool keep_file = out.file_normals_used && file->row(v).normalized().dot(max) > agree;
+      out.N.row(v) = keep_file ? Eigen::RowVector3d(file->row(v).normalized()) : max;
+    }
+  }
 }
 
 }  // namespace
 
 RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOptions& options) {
   RecommendedPlan plan;
-  plan.noise = noise;
+  plan.noise = plan.position_noise = noise;
   // Also NaN: no estimate, keep the 1-ring.
   if (!(noise > options.noise_for_two_rings)) return plan;
   plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
+  // Strong noise tilts the faces, so Max's normals (the jets' first frame) are far off: a second
+  // fit in the frame of the first.
+  plan.jet_iterations = noise > kNoiseForRefittedJets ? 2 : 1;
   plan.gaussian = true;
   plan.jet_rings = plan.rings + 1;
   plan.jet_degree = 2;
@@ -304,9 +501,10 @@ RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOption
 
 RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOptions& options) {
   validate_options(options, "recommended_plan");
+  if (options.mesh_wide) return plan_for(*options.mesh_wide, options);
   const Context c = make_context(mesh, options);
   const JetNormals jets = local_jets(c, 2, 3);
-  return recommended_plan_for_noise(finite_median(jets.residual) / c.edge_length, options);
+  return plan_for(measure_mesh_wide(c, jets, compare_file_normals(c, jets)), options);
 }
 
 RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
@@ -323,19 +521,17 @@ int recommended_reach(const RecommendedPlan& plan) {
   // What the estimate at a vertex v reads, in rings from v (a vertex's Max normal reads its
   // incident faces, whose corners are one ring further; jets read their k-ring's positions and
   // Max's normal at their centre only):
-  //  - the final fit: the fitted normals within plan.rings; on the 1-ring also the per-triangle
-  //    pass, the fitted normals at the corners of v's faces (1 ring);
-  //  - a fitted normal at u is either (noisy positions, file normals ignored) the jet of u over
-  //    plan.jet_rings rings, or chosen between candidates by their 1-ring fits' residuals at u:
-  //    candidates (jets over 2 rings, Max's, the file's) on u's 1-ring, so a jet over 2 rings
-  //    around a vertex one ring from u: 1 + 2 rings from u;
-  //  - a jet over k rings around w needs w's whole k-ring, so every face within k rings of w,
-  //    i.e. vertices up to k rings from w with all their faces: k rings suffice for positions,
-  //    as the k-ring is made of the 1-rings of the (k-1)-ring;
-  //  - Max's normal at w reads w's incident faces: their corners are 1 ring from w.
-  const int chosen = 1 + 2;  // a candidate's 1-ring fit, of jets over 2 rings
-  const int noisy = plan.jet_rings;
-  return std::max(plan.rings, 1) + std::max(chosen, noisy);
+  //  - a fitted normal at u, on clean positions, is chosen between candidates (jets over 2
+  //    rings, Max's, the file's) by their 1-ring fits' residuals at u, and the crease steps read
+  //    the faces of vertices within 2 rings of u: 1 + 2 + 1 = 4 rings from u; on noisy
+  //    positions it is the jet of u over plan.jet_rings rings from Max's normals, turned with
+  //    its 1-ring's normals: jet_rings + 2 (with a margin of one);
+  //  - the fit of v reads the fitted normals within plan.rings, the per-triangle pass those at
+  //    the corners of v's faces (1 ring), and where v stays undefined the refits over up to
+  //    kMaxExtraRings more rings; those read the normals that the previous refit replaced by
+  //    their neighbours' mean, one ring further.
+  const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
+  return std::max(plan.rings, 1) + kMaxExtraRings + 1 + normal_reach;
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
@@ -353,13 +549,21 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
   choose_normals(c, out);
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
-  out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+  const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
+    out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
     prefer_triangles(c, fitted, out.curvature);
+    refit_beside_creases(c, fitted, out.crease, out.curvature);
+  } else {
+    // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
+    out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+    robust_refit(c, fitted, out.plan.rings, out.plan.gaussian, no_skip, all_vertices(c), true,
+                 out.curvature);
   }
+  fill_undefined(c, out.plan, no_skip, out.N, out.curvature);
   return out;
 }
 

@@ -73,19 +73,66 @@ ErrorMetrics measure(const AnalyticSurface& t, const CurvatureResult& e, const s
   return m;
 }
 
+bool on_crease(const AnalyticSurface& truth, int i) {
+  return truth.crease.size() > 0 && truth.crease[i] != 0;
+}
+
+/// The umbilic gap of the direction error: 0.2 max |k| over the surface.
+double umbilic_gap(const AnalyticSurface& truth) {
+  double kappa = 0;
+  for (Eigen::Index i = 0; i < truth.k1.size(); ++i)
+    kappa = std::max({kappa, std::abs(truth.k1[i]), std::abs(truth.k2[i])});
+  return 0.2 * kappa;
+}
+
+void check_sizes(const AnalyticSurface& truth, const CurvatureResult& estimate, const char* what) {
+  const Eigen::Index n = truth.mesh.V.rows();
+  if (estimate.k1.size() != n || estimate.k2.size() != n || estimate.H.size() != n ||
+      estimate.K.size() != n || estimate.d1.rows() != n || estimate.point_class.size() != n)
+    throw InvalidInput(std::string(what) + ": the estimate has not one row per vertex");
+  if (truth.crease.size() != 0 && truth.crease.size() != n)
+    throw InvalidInput(std::string(what) + ": the crease flags have not one entry per vertex");
+}
+
 }  // namespace
 
 Evaluation evaluate(const AnalyticSurface& truth, const CurvatureResult& estimate,
                     int boundary_rings) {
+  check_sizes(truth, estimate, "evaluate");
   const int n = static_cast<int>(truth.mesh.V.rows());
   const VectorXu8 mask = interior_mask(n, truth.mesh.F, boundary_rings);
   std::vector<int> interior, near;
-  for (int i = 0; i < n; ++i) (mask[i] ? interior : near).push_back(i);
-  double kappa = 0;
-  for (int i = 0; i < n; ++i)
-    kappa = std::max({kappa, std::abs(truth.k1[i]), std::abs(truth.k2[i])});
-  return {measure(truth, estimate, interior, 0.2 * kappa),
-          measure(truth, estimate, near, 0.2 * kappa)};
+  for (int i = 0; i < n; ++i) {
+    if (!on_crease(truth, i)) (mask[i] ? interior : near).push_back(i);
+  }
+  const double gap = umbilic_gap(truth);
+  return {measure(truth, estimate, interior, gap), measure(truth, estimate, near, gap)};
+}
+
+ErrorMetrics evaluate_at(const AnalyticSurface& truth, const CurvatureResult& estimate,
+                         const VectorXu8& scored) {
+  check_sizes(truth, estimate, "evaluate_at");
+  const int n = static_cast<int>(truth.mesh.V.rows());
+  if (scored.size() != n) throw InvalidInput("evaluate_at: `scored` needs one flag per vertex");
+  std::vector<int> at;
+  for (int i = 0; i < n; ++i) {
+    if (scored[i] && !on_crease(truth, i)) at.push_back(i);
+  }
+  return measure(truth, estimate, at, umbilic_gap(truth));
+}
+
+VectorXu8 boundary_band_mask(int vertex_count, FacesRef F, int first_ring, int last_ring) {
+  if (first_ring < 0 || last_ring < first_ring || vertex_count < 0)
+    throw InvalidInput("boundary_band_mask: need 0 <= first_ring <= last_ring");
+  const RowMatrixX3d no_normals(0, 3);
+  validate_mesh_arrays(RowMatrixX3d::Zero(vertex_count, 3), F, no_normals, "boundary_band_mask");
+  const Neighbourhoods one_ring = vertex_adjacency(vertex_count, F);
+  const Eigen::VectorXi distance =
+      rings_to_boundary(one_ring, boundary_vertices(vertex_count, F), last_ring);
+  VectorXu8 mask(vertex_count);
+  for (int i = 0; i < vertex_count; ++i)
+    mask[i] = distance[i] >= first_ring && distance[i] <= last_ring ? 1 : 0;
+  return mask;
 }
 
 VectorXu8 interior_mask(int vertex_count, FacesRef F, int boundary_rings) {
@@ -109,12 +156,23 @@ const std::vector<std::string>& truth_field_names() {
 
 void export_case(const std::filesystem::path& mesh_path, const std::filesystem::path& truth_path,
                  const AnalyticSurface& surface, int boundary_rings) {
+  export_case(
+      mesh_path, truth_path, surface,
+      interior_mask(static_cast<int>(surface.mesh.V.rows()), surface.mesh.F, boundary_rings));
+}
+
+void export_case(const std::filesystem::path& mesh_path, const std::filesystem::path& truth_path,
+                 const AnalyticSurface& surface, const VectorXu8& scored) {
   const Mesh& m = surface.mesh;
   const int n = static_cast<int>(m.V.rows());
   if (surface.k1.size() != n || surface.k2.size() != n || surface.d1.rows() != n ||
-      surface.d2.rows() != n)
-    throw InvalidInput("export_case: the truth has not one row per vertex");
-  const VectorXu8 mask = interior_mask(n, m.F, boundary_rings);
+      surface.d2.rows() != n || scored.size() != n ||
+      (surface.crease.size() != 0 && surface.crease.size() != n))
+    throw InvalidInput("export_case: the truth or the flags have not one row per vertex");
+  VectorXu8 mask = scored;
+  for (int i = 0; i < n; ++i) {
+    if (on_crease(surface, i)) mask[i] = 0;
+  }
   const Eigen::VectorXd H = 0.5 * (surface.k1 + surface.k2);
   const Eigen::VectorXd K = surface.k1.cwiseProduct(surface.k2);
   const std::vector<std::string>& names = truth_field_names();

@@ -516,6 +516,25 @@ JetNormals detail::jet_normals_from(PositionsRef V, const Neighbourhoods& one_ri
   return collect_normals(V, one_ring, start, options);
 }
 
+Eigen::VectorXd detail::jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring,
+                                         NormalsRef start, const JetOptions& options,
+                                         const std::vector<int>& vertices) {
+  validate_options(options);
+  Eigen::VectorXd out(static_cast<Eigen::Index>(vertices.size()));
+  detail::PerThread<JetScratch> scratch(options.threads);
+  detail::parallel_for_blocks(
+      out.size(), 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
+        JetScratch& s = scratch.local();
+        for (auto k = begin; k < end; ++k) {
+          const int v = vertices[static_cast<std::size_t>(k)];
+          const Eigen::Vector3d n0 = start.row(v).transpose();
+          out[k] = n0.allFinite() ? fit_vertex(V, one_ring, v, n0, options, s).residual
+                                  : std::numeric_limits<double>::quiet_NaN();
+        }
+      });
+  return out;
+}
+
 CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   validate_options(options);

@@ -1,6 +1,8 @@
 #pragma once
 // Internal: the jets of jets.cpp with their inputs at hand, for the recommended estimator.
 
+#include <vector>
+
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/jets.h"
@@ -13,5 +15,10 @@ namespace focal::detail {
 /// \throw InvalidInput when an option is out of range or one_ring does not have #V vertices.
 JetNormals jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
                             const JetOptions& options);
+
+/// The residuals (JetNormals::residual) of the jets of the listed vertices only, as
+/// jet_normals_from computes them: for measurements on a sample of the vertices.
+Eigen::VectorXd jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
+                                 const JetOptions& options, const std::vector<int>& vertices);
 
 }  // namespace focal::detail

@@ -1,11 +1,12 @@
 // Geometry images of the analytic surfaces: the exact surface sampled on a parameter grid.
+#include "focal/surfaces/geometry_image.h"
+
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "focal/core/error.h"
-#include "focal/surfaces/geometry_image.h"
 #include "core/parallel.h"
+#include "focal/core/error.h"
 
 namespace focal {
 namespace {

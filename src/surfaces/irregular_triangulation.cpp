@@ -12,13 +12,14 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-/// Point sets with a minimum distance r in space: a hash grid of cells of size 2r, so that the
-/// ball of radius r around a point meets only 2 x 2 x 2 cells.
+/// Point sets with a minimum distance of at most r in space: a hash grid of cells of size 2r, so
+/// that the ball of radius r around a point meets only 2 x 2 x 2 cells.
 class PoissonGrid {
  public:
   PoissonGrid(double r, std::size_t expected_points) : r_(r) { cells_.reserve(expected_points); }
 
-  [[nodiscard]] bool far_from_all(const Vector3d& x) const {
+  /// Whether x is at least `distance` (<= r) from every point.
+  [[nodiscard]] bool far_from_all(const Vector3d& x, double distance) const {
     const Vector3d scaled = x / (2.0 * r_);
     std::array<std::array<std::int64_t, 2>, 3> range{};
     for (int axis = 0; axis < 3; ++axis) {
@@ -32,7 +33,7 @@ class PoissonGrid {
           const auto it = cells_.find(key(cx, cy, cz));
           if (it == cells_.end()) continue;
           for (const Vector3d& y : it->second) {
-            if ((x - y).squaredNorm() < r_ * r_) return false;
+            if ((x - y).squaredNorm() < distance * distance) return false;
           }
         }
       }
@@ -152,12 +153,28 @@ double sample_spacing(const Parametrisation& s, const ParameterDomain& d, const 
   return loop > 0.0 ? std::min(r, loop / kLoopSamples) : r;
 }
 
+/// The exclusion radius at u of a sampling graded by `grading` (density ratio u_max : u_min):
+/// density exp(t ln g) at t = (u - u_min) / (u_max - u_min), so radius r0 g^(-t/2), with r0 such
+/// that the count matches uniform spacing r (sum of 1/radius^2 over t as over a uniform area).
+struct GradedRadius {
+  double r0 = 0.0, log_grading = 0.0, u_min = 0.0, u_span = 1.0;
+  GradedRadius(const ParameterDomain& d, double r, double grading)
+      : r0(r), log_grading(std::log(grading)), u_min(d.u_min), u_span(d.u_max - d.u_min) {
+    if (log_grading > 0.0) r0 = r * std::sqrt((grading - 1.0) / log_grading);
+  }
+  [[nodiscard]] double at(double u) const {
+    return r0 * std::exp(-0.5 * log_grading * (u - u_min) / u_span);
+  }
+  [[nodiscard]] double smallest() const { return at(u_min + u_span); }
+};
+
 /// Fixed points, then random points of uniform density in area, each kept only when at least
-/// r (in space) from all points kept so far.
+/// radius.at(u) (in space) from all points kept so far.
 std::vector<Vector2d> poisson_samples(const Parametrisation& s, const ParameterDomain& d,
-                                      const DomainStats& stats, double r, int target,
-                                      std::uint64_t seed) {
-  std::vector<Vector2d> samples = fixed_points(s, d, r);
+                                      const DomainStats& stats, const GradedRadius& radius,
+                                      int target, std::uint64_t seed) {
+  const double r = radius.r0;
+  std::vector<Vector2d> samples = fixed_points(s, d, radius.smallest());
   const auto expected = static_cast<std::int64_t>(std::ceil(kPacking * stats.area / (r * r)));
   PoissonGrid grid(r, static_cast<std::size_t>(expected));
   for (const Vector2d& uv : samples) grid.add(evaluate(s, d, uv).position);
@@ -165,7 +182,10 @@ std::vector<Vector2d> poisson_samples(const Parametrisation& s, const ParameterD
   // The grid maximum misses peaks between samples by O(h^2); 10% covers that.
   const double bound = 1.1 * stats.max_area_element;
   // Scaled by the count r gives: more than target where sample_spacing had to shrink r.
-  const std::int64_t candidates = kCandidatesPerVertex * std::max<std::int64_t>(target, expected);
+  // Graded: the dense end needs candidates in proportion to its density to be saturated.
+  const auto grading = static_cast<std::int64_t>(std::ceil(std::exp(radius.log_grading)));
+  const std::int64_t candidates =
+      kCandidatesPerVertex * grading * std::max<std::int64_t>(target, expected);
   for (std::int64_t k = 0; k < candidates;) {
     const Vector2d uv(uniform(rng, d.u_min, d.u_max), uniform(rng, d.v_min, d.v_max));
     const double accept = uniform01(rng);
@@ -173,7 +193,7 @@ std::vector<Vector2d> poisson_samples(const Parametrisation& s, const ParameterD
     const Derivatives x = s.derivatives(uv.x(), uv.y());
     if (accept * bound >= x.xu.cross(x.xv).norm()) continue;
     ++k;
-    if (!grid.far_from_all(x.x)) continue;
+    if (!grid.far_from_all(x.x, radius.at(uv.x()))) continue;
     grid.add(x.x);
     samples.push_back(uv);
   }
@@ -309,10 +329,12 @@ void flip_to_max_min_angle(const std::vector<Vector3d>& x, const std::vector<Vec
 }  // namespace
 
 Triangulated irregular_triangulation(const Parametrisation& s, const ParameterDomain& d,
-                                     const DomainStats& stats, int target, std::uint64_t seed) {
+                                     const DomainStats& stats, int target, std::uint64_t seed,
+                                     double grading) {
   Triangulated t;
-  const double r = sample_spacing(s, d, stats, target);
-  t.uv = poisson_samples(s, d, stats, r, target, seed);
+  const GradedRadius radius(d, sample_spacing(s, d, stats, target), grading);
+  const double r = radius.r0;  // the largest spacing
+  t.uv = poisson_samples(s, d, stats, radius, target, seed);
   if (d.poles) {
     t.faces = triangulate_polar(s, t.uv);
   } else if (d.periodic_u || d.periodic_v) {

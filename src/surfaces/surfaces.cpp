@@ -1,11 +1,13 @@
 #include "focal/surfaces/surfaces.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "focal/core/error.h"
 #include "surfaces/triangulation.h"
@@ -97,18 +99,29 @@ AnalyticSurface make_surface(const SurfaceOptions& options) {
                        std::to_string(detail::kMaxTarget) + "], got " +
                        std::to_string(options.target_vertices));
   }
+  if (!(options.aspect > 0.0) || !std::isfinite(options.aspect)) {
+    throw InvalidInput("make_surface: aspect must be finite and > 0, got " +
+                       std::to_string(options.aspect));
+  }
+  if (!(options.grading >= 1.0) || !std::isfinite(options.grading)) {
+    throw InvalidInput("make_surface: grading must be finite and >= 1, got " +
+                       std::to_string(options.grading));
+  }
   const auto surface = detail::make_parametrisation(options);
   const ParameterDomain d = surface->domain();
   const DomainStats stats = detail::domain_stats(*surface, d);
   const int target = detail::effective_target(stats, options.target_vertices);
   switch (options.triangulation) {
     case Triangulation::regular:
-      return assemble(*surface, d,
-                      d.disc ? detail::regular_disc(d.u_max, target)
-                             : detail::regular_grid(d, target, stats.log_aspect));
+      // Cells `aspect` times longer along u than along v: that many fewer u intervals.
+      return assemble(
+          *surface, d,
+          d.disc ? detail::regular_disc(d.u_max, target)
+                 : detail::regular_grid(d, target, stats.log_aspect - std::log(options.aspect)));
     case Triangulation::irregular:
       return assemble(*surface, d,
-                      detail::irregular_triangulation(*surface, d, stats, target, options.seed));
+                      detail::irregular_triangulation(*surface, d, stats, target, options.seed,
+                                                      options.grading));
   }
   throw InvalidInput("make_surface: unknown Triangulation " +
                      std::to_string(static_cast<int>(options.triangulation)));
@@ -155,6 +168,57 @@ void add_normal_noise(Mesh& mesh, double amplitude, std::uint64_t seed) {
       noisy = mesh.N.row(i).transpose() + u;
     } while (noisy.squaredNorm() == 0.0);
     mesh.N.row(i) = noisy.normalized().transpose();
+  }
+}
+
+namespace {
+
+/// round(fraction * n) distinct vertices in random order (a partial Fisher-Yates shuffle).
+std::vector<Eigen::Index> random_vertices(Eigen::Index n, double fraction, std::mt19937_64& rng) {
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) order[static_cast<std::size_t>(i)] = i;
+  const auto count = static_cast<std::size_t>(std::llround(fraction * static_cast<double>(n)));
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto pick = k + static_cast<std::size_t>(detail::uniform01(rng) *
+                                                   static_cast<double>(order.size() - k));
+    std::swap(order[k], order[std::min(pick, order.size() - 1)]);
+  }
+  order.resize(count);
+  return order;
+}
+
+void check_fraction(double fraction, const char* what) {
+  if (!(fraction >= 0.0 && fraction <= 1.0)) {
+    throw InvalidInput(std::string(what) + ": fraction must be in [0, 1], got " +
+                       std::to_string(fraction));
+  }
+}
+
+}  // namespace
+
+void add_outlier_normals(Mesh& mesh, double fraction, std::uint64_t seed) {
+  check_fraction(fraction, "add_outlier_normals");
+  if (!mesh.has_normals()) throw InvalidInput("add_outlier_normals: the mesh has no normals");
+  std::mt19937_64 rng(seed);
+  for (const Eigen::Index i : random_vertices(mesh.N.rows(), fraction, rng)) {
+    // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
+    const double z = detail::uniform(rng, -1.0, 1.0),
+                 phi = detail::uniform(rng, 0.0, 2.0 * detail::kPi);
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    mesh.N.row(i) = Vector3d(rho * std::cos(phi), rho * std::sin(phi), z).transpose();
+  }
+}
+
+void add_spikes(Mesh& mesh, double fraction, double height, std::uint64_t seed) {
+  check_fraction(fraction, "add_spikes");
+  check_amplitude(height, "add_spikes");
+  if (!mesh.has_normals()) throw InvalidInput("add_spikes: the mesh has no normals");
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, "add_spikes");
+  const double length = height * mean_edge_length(mesh.V, mesh.F);
+  std::mt19937_64 rng(seed);
+  for (const Eigen::Index i : random_vertices(mesh.V.rows(), fraction, rng)) {
+    const double side = detail::uniform01(rng) < 0.5 ? -1.0 : 1.0;
+    mesh.V.row(i) += side * length * mesh.N.row(i).normalized();
   }
 }
 

@@ -49,8 +49,9 @@ Triangulated regular_grid(const ParameterDomain& d, int target, double log_aspec
 Triangulated regular_disc(double radius, int target);
 
 /// Poisson-disk samples of about `target` vertices, triangulated in a planar chart and improved
-/// by edge flips in space.
+/// by edge flips in space; `grading` (>= 1) is the ratio of the density at u_max to u_min.
 Triangulated irregular_triangulation(const Parametrisation& s, const ParameterDomain& d,
-                                     const DomainStats& stats, int target, std::uint64_t seed);
+                                     const DomainStats& stats, int target, std::uint64_t seed,
+                                     double grading = 1.0);
 
 }  // namespace focal::detail

@@ -571,7 +571,7 @@ run -v generate sphere -o gv.ply
 check "-v generate: a generate timing" stages_ok "$ERR" generate
 
 # eval: every estimator on every analytic case (8 surfaces x 2 triangulations x 3 noise models)
-run eval --vertices 300 --csv ev.csv --markdown ev.md --export evx
+run eval --suite standard --vertices 300 --csv ev.csv --markdown ev.md --export evx
 check "eval: exit 0" test "$rc" -eq 0
 check "eval: 48 cases x 16 estimators in the CSV" test "$(data_rows ev.csv)" -eq 768
 check "eval: focal default with and without normals in every case" \
@@ -590,6 +590,20 @@ check "eval --export: the open saddle has vertices near its boundary" \
   awk -F, 'NR > 1 && $11 == 0 { found = 1 } END { exit !found }' evx/saddle-irregular-clean.truth.csv
 run eval --markdown ev.txt
 check "eval: a wrong report extension is a usage error" test "$rc" -eq 1
+run eval --suite nonsense
+check "eval: an unknown suite is a usage error" test "$rc" -eq 1
+
+# eval --suite hard: the hard cases of issue 16 by category
+run eval --suite hard --vertices 300 --csv evh.csv --markdown evh.md
+check "eval --suite hard: exit 0" test "$rc" -eq 0
+check "eval --suite hard: 41 cases x 12 estimators in the CSV" test "$(data_rows evh.csv)" -eq 492
+check "eval --suite hard: every category in the CSV" test "$(cut -d, -f20 evh.csv | sort -u | \
+  grep -c -x -e anisotropic -e 'graded density' -e coarse -e 'strong vertex noise' \
+  -e 'strong normal noise' -e outliers -e 'near boundaries' -e creases)" -eq 8
+check "eval --suite hard: a summary row per category and one for all" \
+  test "$(grep -c '^| [a-z ]* | [0-9]* | [0-9]* | [0-9]* |' evh.md)" -eq 9
+check "eval --suite hard: no undefined vertex of focal default on the creases" \
+  awk -F, '$20 == "creases" && $4 ~ /^focal default/ { found = 1; if ($6 != 0) exit 1 } END { exit !found }' evh.csv
 
 # eval --scan: smoothness of H on meshes without truth (paper Fig. 7)
 run eval --scan s.ply --csv sc.csv --markdown sc.md --export scx

@@ -13,8 +13,9 @@
 ///     noise = median residual / mean edge length (about 1e-4 on clean smooth meshes, 0.056 for
 ///     the paper's 10% vertex noise).
 ///  2. Neighbourhood (recommended_plan_for_noise): the 1-ring (the paper) on clean positions;
-///     Gaussian-weighted 2 or 3 rings when the noise is above RecommendedOptions::
-///     noise_for_two_rings or noise_for_three_rings.
+///     Gaussian-weighted 2 or 3 rings when the position noise (the jets' residual without their
+///     truncation error, recommended_plan) is above RecommendedOptions::noise_for_two_rings or
+///     noise_for_three_rings.
 ///  3. Normals. From the positions: per vertex the jets' normals, or Max's (exact on spheres)
 ///     where those are clearly smoother: the RMS misfit (residual) of their 1-ring two-slit fit
 ///     below half the jets'; on noisy positions instead those of wider quadratic jets (rings + 1
@@ -31,6 +32,19 @@
 ///     (Method::triangle; 1.3 to 1.8 times lower H error on irregular meshes), except where the
 ///     fit is exact (residual <= 1e-9: the rays meet two slits, as on spheres and cylinders) or
 ///     the triangles give no estimate.
+///  5. Creases (clean positions only): an edge whose faces' normals differ by more than
+///     RecommendedOptions::crease_angle (60 degrees) is sharp, its corners are crease vertices
+///     (RecommendedResult::crease). Within 2 rings of them the normals are Max's (each face lies
+///     on one piece) or the file's where those agree with Max's; vertices next to a crease vertex
+///     take the 1-ring fit without the crease vertices' rays.
+///  6. Robust refit (noisy positions): where a ray's misfit exceeds 5 robust scales (1.4826 x
+///     the median misfit), it is left out and the fit repeated (curvature/robust_fit.h); clean
+///     misfits never get there, so the least-squares fit stays where nothing is wild. Under
+///     position noise above kNoiseForRefittedJets the positions' jets fit twice, and normals
+///     pointing against the sum of their 1-ring's are turned.
+///  7. Never NaN where a fit is possible: undefined vertices are refitted robustly in the frame
+///     of their neighbours' mean normal over 1, then 2 more rings (kMaxExtraRings); the reach of
+///     the whole estimator is recommended_reach(plan).
 /// The paper's method as written remains estimate_curvature with default CurvatureOptions.
 ///
 /// Deterministic for any thread count. Vertices the fit cannot handle are `undefined` (NaN) as
@@ -48,12 +62,25 @@ namespace focal {
 inline constexpr double kNoiseForTwoRings = 0.015;
 /// ... and above which it uses 3 rings.
 inline constexpr double kNoiseForThreeRings = 0.035;
+/// Position noise above which the jets of the positions' normals fit twice (the second time in
+/// the frame of the first): beyond the paper's 10% noise (0.058), at 30% and more (0.17), the
+/// faces tilt so much that Max's normals, the first frame, are far off (measured on the hard
+/// cases of focal eval: 50% vertex noise, sphere 3.4 -> 0.45 relative H error, torus
+/// 8.1 -> 0.39; at 10% a second fit changes the standard suite both ways by up to 7%).
+inline constexpr double kNoiseForRefittedJets = 0.1;
+
+/// Rings beyond the plan's that the recommended estimator reads where the plan's neighbourhood
+/// gives no fit (never NaN where a wider fit is possible).
+inline constexpr int kMaxExtraRings = 2;
 
 /// The choices of steps 1 to 3 that are made once per mesh, from all its vertices (medians and
 /// a majority): given in RecommendedOptions::mesh_wide instead of measured, they let a part of a
 /// mesh (a tile with its halo, focal/tiles/tiles.h) be estimated exactly as in the whole mesh.
 struct RecommendedMeshWide {
-  double noise = NAN;              ///< RecommendedPlan::noise: decides the plan
+  double noise = NAN;           ///< RecommendedPlan::noise: judges the file's normals
+  /// RecommendedPlan::position_noise: decides the plan (measured on a sample of the vertices
+  /// chosen by index, so a tile could not measure it alone).
+  double position_noise = NAN;
   double file_disagreement = NAN;  ///< RecommendedResult::file_disagreement (NaN: no normals)
   /// +1, or -1 when most file normals point against the jet normals (the positions' normals are
   /// then turned to the file's side).
@@ -74,6 +101,11 @@ struct RecommendedOptions {
   /// Step 3: among used file normals, one more than this many times the noise from its jet normal
   /// (and rougher than the positions' normal by half) is an outlier, replaced.
   double outlier_disagreement = 10.0;
+  /// Step 5: on clean positions, an edge whose two faces' normals differ by more than this
+  /// (radians; 0 turns crease handling off) is a crease; its corners are crease vertices.
+  /// 60 degrees: above the 46 degrees that faces of the coarsest suite meshes (spacing 0.8 /
+  /// max |curvature|) turn between neighbours on smooth surfaces.
+  double crease_angle = 1.0471975511965976;  // 60 degrees
   /// Classes, as CurvatureOptions: |k| x mean edge length <= zero_tolerance is zero ...
   double zero_tolerance = 1e-3;
   /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
@@ -89,18 +121,27 @@ struct RecommendedOptions {
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
 struct RecommendedPlan {
-  double noise = NAN;     ///< median cubic-jet residual over the mean edge length; NaN: none
-  int rings = 1;          ///< rings of the two-slit fit
-  bool gaussian = false;  ///< Gaussian ray weights (width = mean edge length x rings)
-  int jet_rings = 2;      ///< rings of the jets whose normals are used without file normals
-  int jet_degree = 3;     ///< their degree
+  double noise = NAN;  ///< median cubic-jet residual over the mean edge length; NaN: none
+  /// The part of it that is position noise, the jets' truncation error taken out (see
+  /// recommended_plan): what decides the rings. Equals `noise` from recommended_plan_for_noise.
+  double position_noise = NAN;
+  int rings = 1;           ///< rings of the two-slit fit
+  bool gaussian = false;   ///< Gaussian ray weights (width = mean edge length x rings)
+  int jet_rings = 2;       ///< rings of the jets whose normals are used without file normals
+  int jet_degree = 3;      ///< their degree
+  int jet_iterations = 1;  ///< their fits per vertex (2 above kNoiseForRefittedJets)
 };
 
 /// The plan for a given noise level (see the steps above); reads the noise thresholds.
 [[nodiscard]] RecommendedPlan recommended_plan_for_noise(double noise,
                                                          const RecommendedOptions& options = {});
 
-/// The plan for a mesh: measures its noise (cubic jets over the 2-ring) and plans for it.
+/// The plan for a mesh: measures its noise (cubic jets over the 2-ring) and plans for its
+/// position noise. A jet's residual r mixes the position noise s with the truncation error t of
+/// a cubic, which grows as the 4th power of the neighbourhood's radius: on a sample of the
+/// vertices the 3-ring jet's residual r3 (radius about 3/2 times the 2-ring's) then gives
+/// t2^2 = (r3^2 - r2^2) / ((3/2)^8 - 1) and s^2 = r2^2 - t2^2 per vertex; position_noise is the
+/// median s over the mean edge length. On coarse meshes of curved surfaces t dominates r.
 /// \throw InvalidInput when an option is out of range.
 [[nodiscard]] RecommendedPlan recommended_plan(const PreparedMesh& mesh,
                                                const RecommendedOptions& options = {});
@@ -115,10 +156,18 @@ struct RecommendedPlan {
 [[nodiscard]] RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
                                                         const RecommendedOptions& options = {});
 
-/// The rings around a vertex whose positions, faces and normals its recommended estimate reads,
-/// for a plan: a tile needs a halo this wide (focal/tiles/tiles.h). Derived in recommended.cpp
-/// from the steps above.
+/// How far the recommended estimate of one vertex reads the mesh, in rings, for a plan: a tile
+/// needs a halo this wide (focal/tiles/tiles.h) for its owned vertices to get the whole-mesh
+/// result (the plan and the verdict on the file's normals are global: RecommendedMeshWide, decided
+/// once and passed). A vertex's normal reads at most max(4, jet_rings + 2) rings (2-ring jets
+/// from Max's normals, rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned
+/// with the 1-ring); the fit reads the normals of rings + kMaxExtraRings rings, and the normals
+/// that the refit of undefined vertices replaced by their neighbours' mean one ring further. 8 on
+/// clean positions, 12 at most (kRecommendedMaxReach). Derived in recommended.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
+
+/// recommended_reach of the widest plan (3 rings, 4-ring jets).
+inline constexpr int kRecommendedMaxReach = 12;
 
 /// The recommended estimate with what it decided and the normals it fitted.
 struct RecommendedResult {
@@ -131,6 +180,9 @@ struct RecommendedResult {
   /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
   /// their side.
   bool file_normals_used = false;
+  /// #V flags, 1 at crease vertices (step 5; clean positions only, else all 0 or empty): the
+  /// curvature does not exist there, their values are not to be trusted.
+  VectorXu8 crease;
 };
 
 /// The recommended estimate of a mesh, with its normals as the file's when it has them (they may

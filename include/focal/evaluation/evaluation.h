@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "focal/curvature/curvature.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/curvature.h"
 #include "focal/surfaces/surfaces.h"
 
 namespace focal {
@@ -32,9 +32,22 @@ struct Evaluation {
 };
 
 /// Compares an estimate with the truth of an analytic surface. A vertex counts as umbilic for the
-/// direction error when k1 - k2 <= 0.2 max |k| over the surface.
+/// direction error when k1 - k2 <= 0.2 max |k| over the surface. Crease vertices
+/// (AnalyticSurface::crease) are in neither set: their curvature does not exist.
 [[nodiscard]] Evaluation evaluate(const AnalyticSurface& truth, const CurvatureResult& estimate,
                                   int boundary_rings = 2);
+
+/// The errors over the vertices flagged 1 in `scored` (#V flags), crease vertices left out.
+/// \throw InvalidInput when `scored` or the estimate has not #V entries.
+[[nodiscard]] ErrorMetrics evaluate_at(const AnalyticSurface& truth,
+                                       const CurvatureResult& estimate, const VectorXu8& scored);
+
+/// #V flags, 1 for the vertices whose ring distance to the nearest boundary vertex lies in
+/// [first_ring, last_ring] (0 is the boundary itself); all 0 on closed meshes.
+/// \throw InvalidInput when F indexes outside [0, vertex_count) or the rings are not
+/// 0 <= first_ring <= last_ring.
+[[nodiscard]] VectorXu8 boundary_band_mask(int vertex_count, FacesRef F, int first_ring,
+                                           int last_ring);
 
 /// #V flags, 1 for the vertices evaluate() counts as interior (more than `boundary_rings` rings
 /// from a boundary vertex), 0 for the others.
@@ -52,6 +65,11 @@ struct Evaluation {
 /// \throw InvalidInput for inconsistent arrays; IoError naming the path on write failure.
 void export_case(const std::filesystem::path& mesh_path, const std::filesystem::path& truth_path,
                  const AnalyticSurface& surface, int boundary_rings = 2);
+
+/// export_case with the vertices to measure given as #V flags (written to the `interior` column;
+/// crease vertices are written 0), for cases scored elsewhere than the interior.
+void export_case(const std::filesystem::path& mesh_path, const std::filesystem::path& truth_path,
+                 const AnalyticSurface& surface, const VectorXu8& scored);
 
 /// How smooth a scalar field (mean curvature) is on a mesh without truth: the paper's Fig. 7
 /// compares range and variance of H on scanned meshes. Values are made scale-free by multiplying

@@ -84,6 +84,14 @@ struct SurfaceOptions {
   /// monkey saddle a=1; helix tube a=1, b=0.25, c=0.3; pear a=1, b=0.3, c=0.3). Parameters a
   /// surface does not use are ignored. See the parametrisations above for their meaning.
   double a = 0, b = 0, c = 0;
+  /// Regular grids only (not the monkey saddle's disc): the cells' aspect in space, their length
+  /// along u over their length along v, > 0. 1 gives cells close to square; 8 or 1/8 the long
+  /// thin strips of CAD exports (on the cylinder 1/8 runs them along the axis; on the sphere,
+  /// ellipsoid and pear, lat-long rows whose pole fans get thin).
+  double aspect = 1.0;
+  /// Irregular samplings only: the ratio, >= 1, of the vertex density at u = u_max to that at
+  /// u = u_min (graded exponentially in u; 1 is uniform). The count stays close to the target.
+  double grading = 1.0;
 };
 
 /// A triangulated analytic surface with its exact truth per vertex.
@@ -107,6 +115,9 @@ struct AnalyticSurface {
   RowMatrixX3d d2;
   /// #V x 2 parameters (u, v) of each vertex (a pole has its u and v = 0).
   Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> uv;
+  /// #V flags, 1 at vertices on a sharp crease (piecewise-smooth surfaces: the curvature and the
+  /// normal do not exist there; evaluate() does not score them). Empty for smooth surfaces.
+  VectorXu8 crease;
 };
 
 /// \throw InvalidInput when target_vertices is outside [16, 1e8] or a shape parameter is invalid
@@ -153,5 +164,29 @@ void add_position_noise(Mesh& mesh, double amplitude, std::uint64_t seed);
 /// (default 0.05). Positions are left as they are. Random numbers as add_position_noise.
 /// \throw InvalidInput for a negative or non-finite amplitude or a mesh without normals.
 void add_normal_noise(Mesh& mesh, double amplitude, std::uint64_t seed);
+
+/// A piecewise-smooth surface: the cylinder of radius `radius` and height `height` around the z
+/// axis closed by two flat discs, with sharp 90-degree creases on the two rims. Regular: the side
+/// is a grid of 6m columns, each cap m concentric rings of 6k vertices (regular_disc), welded at
+/// the rims; m is chosen for about target_vertices. Truth per smooth piece: side k1 = 1/radius,
+/// k2 = 0, d1 around; caps flat (0, 0). Rim vertices are flagged in `crease`; their normal is the
+/// normalised mean of the two pieces' (what a mesh exporter writes) and their curvature is
+/// given as the side's (it is not scored).
+/// \throw InvalidInput for a non-positive or non-finite radius or height, or target_vertices
+/// outside [16, 1e8].
+[[nodiscard]] AnalyticSurface make_capped_cylinder(double radius, double height,
+                                                   int target_vertices);
+
+/// Outlier normals: a `fraction` in [0, 1] of the vertices, chosen at random, get a normal drawn
+/// uniformly from the unit sphere (so about half point against the surface). Random numbers as
+/// add_position_noise. \throw InvalidInput for a fraction outside [0, 1] or a mesh without
+/// normals.
+void add_outlier_normals(Mesh& mesh, double fraction, std::uint64_t seed);
+
+/// Spikes: a `fraction` in [0, 1] of the vertices, chosen at random, move along their normal by
+/// `height` times the mean edge length, outwards or inwards at random (scanner outliers).
+/// Normals are left as they are. \throw InvalidInput for a fraction outside [0, 1], a
+/// non-finite height or a mesh without normals.
+void add_spikes(Mesh& mesh, double fraction, double height, std::uint64_t seed);
 
 }  // namespace focal

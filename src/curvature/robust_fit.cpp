@@ -1,0 +1,128 @@
+#include "curvature/robust_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/fields_detail.h"
+#include "core/parallel.h"
+#include "curvature/normal_rays_detail.h"
+#include "curvature/two_slit_detail.h"
+
+namespace focal::detail {
+namespace {
+
+struct Rays {
+  std::vector<NormalRay> rays;
+  std::vector<double> base;     ///< Gaussian (or 1) weight of each ray
+  std::vector<double> weights;  ///< base x robust weight
+  std::vector<double> misfit;   ///< |W x - g| at the current solution
+  std::vector<double> sorted;
+};
+
+/// The rays of i's neighbours (not skipped, normal in i's hemisphere) in i's frame.
+void gather(const RobustFitInput& in, int i, const TangentFrame& frame, Rays& s) {
+  const VertexFitInput& f = in.fit;
+  const Eigen::Vector3d p = f.V.row(i).transpose();
+  const double inverse = in.gaussian_width > 0 ? 0.5 / (in.gaussian_width * in.gaussian_width) : 0;
+  s.rays.clear();
+  s.base.clear();
+  for (const int* j = f.rings.begin(i); j != f.rings.end(i); ++j) {
+    if (!f.normal_ok[static_cast<std::size_t>(*j)]) continue;
+    if (!in.skip.empty() && in.skip[static_cast<std::size_t>(*j)]) continue;
+    const Eigen::Vector3d q = f.V.row(*j).transpose();
+    NormalRay ray;
+    if (!ray_of(frame, p, q, f.unit_normals.row(*j).transpose(), ray)) continue;
+    s.rays.push_back(ray);
+    s.base.push_back(std::exp(-(q - p).squaredNorm() * inverse));
+  }
+}
+
+double median_of(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// Weights: the base weight of rays within kRejectionScales robust scales of the fit, 0 beyond.
+/// Returns how many rays are rejected (0 also when the scale is zero: the rays fit exactly).
+int reject(Rays& s) {
+  s.sorted = s.misfit;
+  const double cut = kRejectionScales * 1.4826 * median_of(s.sorted);
+  int rejected = 0;
+  for (std::size_t k = 0; k < s.rays.size(); ++k) {
+    const bool keep = !(s.misfit[k] > cut) || !(cut > 0.0);
+    s.weights[k] = keep ? s.base[k] : 0.0;
+    rejected += keep ? 0 : 1;
+  }
+  return rejected;
+}
+
+void measure_misfit(const kernels::SlitSolution<double>& w, Rays& s) {
+  s.misfit.resize(s.rays.size());
+  for (std::size_t k = 0; k < s.rays.size(); ++k) {
+    const NormalRay& r = s.rays[k];
+    s.misfit[k] = std::sqrt(kernels::slit_misfit(w, r.u, r.v, r.sigma, r.tau));
+  }
+}
+
+}  // namespace
+
+bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& tolerances,
+                       CurvatureResult& r) {
+  thread_local Rays s;
+  const VertexFitInput& f = in.fit;
+  if (!f.normal_ok[static_cast<std::size_t>(i)]) {
+    store_undefined(r, i);
+    return false;
+  }
+  const TangentFrame frame = frame_of(f.unit_normals.row(i).transpose());
+  gather(in, i, frame, s);
+  s.weights = s.base;
+  kernels::SlitSolution<double> w;
+  if (!solve_well_conditioned(accumulate(s.rays, s.weights), w)) {
+    store_undefined(r, i);
+    return false;
+  }
+  bool rejected = false;
+  for (int round = 0; round < kRejectionRounds && !s.rays.empty(); ++round) {
+    measure_misfit(w, s);
+    if (reject(s) == 0) break;
+    kernels::SlitSolution<double> next;
+    // Too few rays left (a vertex whose neighbours mostly disagree): keep the last fit.
+    if (!solve_well_conditioned(accumulate(s.rays, s.weights), next)) break;
+    w = next;
+    rejected = true;
+  }
+  if (!rejected) s.weights = s.base;
+  double weight_sum = 0.0;
+  int used = 0;
+  for (double x : s.weights) {
+    weight_sum += x;
+    used += x > 0.0 ? 1 : 0;
+  }
+  r.rays_used[i] = used;
+  r.rays_excluded[i] = f.rings.size(i) - used;
+  store_vertex(r, i, frame, principal_from_symmetric(w.a, w.b, w.c),
+               std::sqrt(energy_of(s.rays, s.weights, w) / weight_sum), tolerances);
+  return rejected;
+}
+
+void robust_fit_vertices(const RobustFitInput& in, const std::vector<int>& vertices,
+                         const ClassTolerances& tolerances, int threads, bool only_rejecting,
+                         CurvatureResult& r) {
+  if (!only_rejecting) {
+    parallel_for(static_cast<std::int64_t>(vertices.size()), threads, [&](std::int64_t k) {
+      robust_fit_vertex(in, vertices[static_cast<std::size_t>(k)], tolerances, r);
+    });
+    return;
+  }
+  // Fitted into a scratch result; rows copied where rays were rejected.
+  CurvatureResult scratch = unwritten_result(r.k1.size());
+  parallel_for(static_cast<std::int64_t>(vertices.size()), threads, [&](std::int64_t k) {
+    const int i = vertices[static_cast<std::size_t>(k)];
+    if (!robust_fit_vertex(in, i, tolerances, scratch)) return;
+    copy_vertex(scratch, i, r);
+  });
+}
+
+}  // namespace focal::detail
