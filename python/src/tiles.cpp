@@ -33,6 +33,7 @@ nb::dict choices_dict(const focal::MeshWideChoices& c) {
   d["mean_edge_length"] = c.mean_edge_length;
   if (c.recommended) {
     d["noise"] = c.recommended->noise;
+    d["position_noise"] = c.recommended->position_noise;
     d["file_disagreement"] = c.recommended->file_disagreement;
     d["side"] = c.recommended->side;
   }
@@ -43,9 +44,11 @@ focal::MeshWideChoices choices_from(const nb::dict& d) {
   focal::MeshWideChoices c;
   c.mean_edge_length = nb::cast<double>(d["mean_edge_length"]);
   if (d.contains("noise")) {
-    c.recommended = focal::RecommendedMeshWide{nb::cast<double>(d["noise"]),
-                                               nb::cast<double>(d["file_disagreement"]),
-                                               nb::cast<double>(d["side"])};
+    c.recommended = focal::RecommendedMeshWide{
+        .noise = nb::cast<double>(d["noise"]),
+        .position_noise = nb::cast<double>(d["position_noise"]),
+        .file_disagreement = nb::cast<double>(d["file_disagreement"]),
+        .side = nb::cast<double>(d["side"])};
   }
   return c;
 }

@@ -59,17 +59,4 @@ inline void store_vertex(CurvatureResult& r, Eigen::Index i, const TangentFrame&
   r.point_class[i] = static_cast<std::uint8_t>(classify(p.k1, p.k2, tol.zero, tol.umbilic));
 }
 
-/// Copies row i of every per-vertex field of `from` into `to`.
-inline void copy_vertex(const CurvatureResult& from, Eigen::Index i, CurvatureResult& to) {
-  for (auto field : {&CurvatureResult::k1, &CurvatureResult::k2, &CurvatureResult::H,
-                     &CurvatureResult::K, &CurvatureResult::residual}) {
-    (to.*field)[i] = (from.*field)[i];
-  }
-  to.d1.row(i) = from.d1.row(i);
-  to.d2.row(i) = from.d2.row(i);
-  to.point_class[i] = from.point_class[i];
-  to.rays_used[i] = from.rays_used[i];
-  to.rays_excluded[i] = from.rays_excluded[i];
-}
-
 }  // namespace focal::detail

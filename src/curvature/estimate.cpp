@@ -192,8 +192,9 @@ Estimate estimate(const PreparedMesh& mesh, const EstimateOptions& options) {
 int estimate_reach(const EstimateOptions& options) {
   if (options.estimator == Estimator::recommended) {
     // Without the mesh's choices, the widest plan (3 rings) bounds every plan's reach.
-    const double noise = options.recommended.mesh_wide ? options.recommended.mesh_wide->noise
-                                                       : std::numeric_limits<double>::infinity();
+    const double noise = options.recommended.mesh_wide
+                             ? options.recommended.mesh_wide->position_noise
+                             : std::numeric_limits<double>::infinity();
     return recommended_reach(recommended_plan_for_noise(noise, options.recommended));
   }
   // The corners of a vertex's faces, whose normals read their own faces.

@@ -121,7 +121,7 @@ void robust_fit_vertices(const RobustFitInput& in, const std::vector<int>& verti
   parallel_for(static_cast<std::int64_t>(vertices.size()), threads, [&](std::int64_t k) {
     const int i = vertices[static_cast<std::size_t>(k)];
     if (!robust_fit_vertex(in, i, tolerances, scratch)) return;
-    copy_vertex(scratch, i, r);
+    copy_row(scratch, i, r, i);
   });
 }
 

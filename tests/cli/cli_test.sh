@@ -596,7 +596,7 @@ check "eval: an unknown suite is a usage error" test "$rc" -eq 1
 # eval --suite hard: the hard cases of issue 16 by category
 run eval --suite hard --vertices 300 --csv evh.csv --markdown evh.md
 check "eval --suite hard: exit 0" test "$rc" -eq 0
-check "eval --suite hard: 41 cases x 12 estimators in the CSV" test "$(data_rows evh.csv)" -eq 492
+check "eval --suite hard: 41 cases x 16 estimators in the CSV" test "$(data_rows evh.csv)" -eq 656
 check "eval --suite hard: every category in the CSV" test "$(cut -d, -f20 evh.csv | sort -u | \
   grep -c -x -e anisotropic -e 'graded density' -e coarse -e 'strong vertex noise' \
   -e 'strong normal noise' -e outliers -e 'near boundaries' -e creases)" -eq 8
