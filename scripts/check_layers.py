@@ -10,7 +10,7 @@ import re
 import sys
 
 # Lowest first: a folder may include itself and the folders before it.
-LAYERS = ["core", "kernels", "io", "mesh", "normals", "curvature", "cuda", "image_space",
+LAYERS = ["core", "kernels", "io", "mesh", "points", "normals", "curvature", "cuda", "image_space",
           "surfaces", "evaluation", "render"]
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()

@@ -12,11 +12,12 @@ set -euo pipefail
 # libegl-dev, libopengl-dev and Mesa (libegl-mesa0, libgl1-mesa-dri): headless OpenGL for
 # rasterised G-buffers and `focal render`; libpng-dev writes its pictures.
 packages=(cmake ninja-build g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libgmock-dev
-          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libpng-dev python3-venv python3-dev)
+          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libpng-dev python3-venv python3-dev
+          libnanoflann-dev)
 if [[ "${1:-}" == "demo" ]]; then
   packages+=(libcgal-demo)
 elif [[ "${1:-}" == "bench" ]]; then
-  packages+=(libbenchmark-dev time libcgal-demo)
+  packages+=(libbenchmark-dev time libcgal-demo libcgal-dev libpcl-dev)
 elif [[ "${1:-}" == "fuzz" ]]; then
   # libFuzzer and the sanitizer runtimes of clang are in libclang-rt-14-dev, which clang only
   # recommends; libomp-dev is clang's OpenMP (the library links it).

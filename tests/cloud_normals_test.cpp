@@ -1,0 +1,5 @@
+#include "focal/points/neighbours.h"
+
+#include <gtest/gtest.h>
+
+TEST(Neighbours, Placeholder) {}
