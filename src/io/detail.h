@@ -113,6 +113,8 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+/// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
+[[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
 
 // The same readers on the contents of a file already in memory (read_X(path) is
