@@ -17,6 +17,10 @@
 namespace focal {
 namespace {
 
+/// (squared distance, row): ordered by distance, then index, so that ties do not depend on the
+/// tree's traversal.
+using Candidate = std::pair<double, int>;
+
 /// The finite rows of V, as nanoflann's dataset adaptor reads them.
 struct FinitePoints {
   PositionsRef V;
@@ -50,14 +54,22 @@ class PointTree {
   [[nodiscard]] int row(std::uint32_t index) const { return points_.rows[index]; }
   [[nodiscard]] std::size_t size() const { return points_.rows.size(); }
 
+  /// Every point at squared distance <= d2 from q (nanoflann's radius test is strict: d2 is
+  /// raised to the next double), appended to `out`.
+  void within(const double* q, double d2, std::vector<Candidate>& out) const {
+    std::vector<std::pair<std::uint32_t, double>> matches;
+    nanoflann::SearchParams params;
+    params.sorted = false;
+    tree_->radiusSearch(q, std::nextafter(d2, INFINITY), matches, params);
+    for (const auto& [index, distance] : matches) {
+      if (distance <= d2) out.emplace_back(distance, row(index));
+    }
+  }
+
  private:
   FinitePoints points_;
   std::unique_ptr<Tree> tree_;
 };
-
-/// (squared distance, row): ordered by distance, then index, so that ties do not depend on the
-/// tree's traversal.
-using Candidate = std::pair<double, int>;
 
 /// One point's list (candidates sorted, the point itself removed, at most `limit`) appended.
 void keep_sorted(std::vector<Candidate>& candidates, int self, std::size_t limit,
@@ -114,8 +126,9 @@ Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
   if (k < 1) throw InvalidInput("neighbours: k must be >= 1, got " + std::to_string(k));
   check_threads(threads);
   const PointTree tree(V);
-  // k + 1 for the point itself, and one more so that a tie at the k-th distance is seen and
-  // broken by index rather than by the traversal order.
+  // k + 1 for the point itself, and one more to see whether the k-th distance is tied with a
+  // farther point: then every point at that distance is gathered and the tie broken by index
+  // rather than by the traversal order (rare on measured data, common on grids).
   const std::size_t wanted = std::min<std::size_t>(static_cast<std::size_t>(k) + 2, tree.size());
   return gather(V.rows(), threads, [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
     if (!V.row(i).allFinite() || wanted == 0) return;
@@ -132,7 +145,11 @@ Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
     const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
     const std::size_t found = tree.tree().knnSearch(q, wanted, idx, dist);
     c.clear();
-    for (std::size_t j = 0; j < found; ++j) c.emplace_back(dist[j], tree.row(idx[j]));
+    if (found == wanted && wanted >= 2 && dist[wanted - 1] == dist[wanted - 2]) {
+      tree.within(q, dist[wanted - 1], c);
+    } else {
+      for (std::size_t j = 0; j < found; ++j) c.emplace_back(dist[j], tree.row(idx[j]));
+    }
     keep_sorted(c, i, static_cast<std::size_t>(k) + out.size(), out);
   });
 }
@@ -148,13 +165,9 @@ Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, i
       max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
   return gather(V.rows(), threads, [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
     if (!V.row(i).allFinite()) return;
-    std::vector<std::pair<std::uint32_t, double>> matches;
     const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
-    nanoflann::SearchParams params;
-    params.sorted = false;
-    tree.tree().radiusSearch(q, radius * radius, matches, params);
     c.clear();
-    for (const auto& [index, distance] : matches) c.emplace_back(distance, tree.row(index));
+    tree.within(q, radius * radius, c);
     keep_sorted(c, i, limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
                 out);
   });

@@ -47,7 +47,7 @@ struct CloudNormalOptions {
   CloudNormalMethod method = CloudNormalMethod::jet;
   int jet_degree = 2;  ///< 1 to 4: degree of the height polynomial of the jet normals
   /// Orientation: towards this point when given, else by the minimum spanning tree.
-  std::optional<Eigen::Vector3d> viewpoint;
+  std::optional<Eigen::Vector3d> viewpoint{};
   int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
 };
 
