@@ -54,7 +54,7 @@ check "sphere cloud with exact normals: k2 = 1 to 1e-9" below "$(max_dev sphere.
 # Without normals (estimated, MST-oriented), and the same points as PLY and OBJ without faces.
 cut -d' ' -f1-3 sphere.xyz >bare.xyz
 run curvature bare.xyz -o bare.csv
-# Jet normals over 16 neighbours at 2000 points: measured max |H - 1| 0.0011; bound 0.01.
+# Jet normals over 16 neighbours at 2000 points: measured max |H - 1| 0.00026; bound 0.01.
 check "no normals: H = 1 within 0.01 (normals estimated and oriented outward)" \
   below "$(max_dev bare.csv 3 1)" 0.01
 run curvature bare.xyz -o bare.ply --k 24
