@@ -467,3 +467,7 @@ def generate_surface(
     d = _ext.generate_surface(str(kind), str(triangulation), int(n), int(seed), float(a),
                               float(b), float(c))
     return Surface(**d)
+
+from ._clouds import cloud_curvature, cloud_normals  # noqa: E402  (point clouds, docs/POINTS.md)
+
+__all__ += ["cloud_curvature", "cloud_normals"]

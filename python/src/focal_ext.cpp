@@ -358,6 +358,8 @@ nb::dict generate_surface(const std::string& kind, const std::string& triangulat
 
 }  // namespace
 
+void bind_clouds(nb::module_& m);  // clouds.cpp
+
 NB_MODULE(_focal_ext, m) {
   m.doc() = "focal's C++ library (the focal package wraps it; use that).";
 
@@ -396,4 +398,5 @@ NB_MODULE(_focal_ext, m) {
         "N"_a.none().noconvert());
   m.def("generate_surface", &generate_surface, "kind"_a, "triangulation"_a, "target_vertices"_a,
         "seed"_a, "a"_a, "b"_a, "c"_a);
+  bind_clouds(m);
 }
