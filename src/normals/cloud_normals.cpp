@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/normals/jets.h"
+#include "normals/cloud_normals_detail.h"
 #include "normals/jets_detail.h"
 
 namespace focal {
@@ -127,8 +128,8 @@ void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, 
   }
 }
 
-RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
-                           const CloudNormalOptions& options) {
+JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                              const CloudNormalOptions& options) {
   check_sizes(V, neighbours, "cloud_normals");
   if (options.jet_degree < 1 || options.jet_degree > 4) {
     throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
@@ -141,12 +142,17 @@ RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
   } else {
     orient_normals_mst(V, neighbours, N);
   }
-  if (options.method == CloudNormalMethod::pca) return N;
+  if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
   const JetOptions jet{.rings = 1, .degree = options.jet_degree, .iterations = 2,
                        .threads = options.threads};
-  return detail::jet_normals_from(V, neighbours, N, jet).N;
+  return detail::jet_normals_from(V, neighbours, N, jet);
+}
+
+RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
+                           const CloudNormalOptions& options) {
+  return detail::cloud_jets(V, neighbours, options).N;
 }
 
 }  // namespace focal

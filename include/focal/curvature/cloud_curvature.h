@@ -8,13 +8,23 @@
 /// d1, d2, H, K, the residual and the class, exactly as for a mesh vertex's ring: the same fit
 /// code runs on both.
 ///
-/// Normals: the cloud's own (made unit; zero or non-finite rows make their point `undefined`),
-/// else cloud_normals (normals/cloud_normals.h: PCA, oriented by a minimum spanning tree or
-/// towards a viewpoint, then jets over the same neighbours).
+/// The default (k = 0, radius = 0) adapts to the cloud, as the recommended estimator does on
+/// meshes (docs/POINTS.md, where the thresholds were measured):
+///  1. jet normals (cloud_normals: PCA, oriented by a minimum spanning tree or towards a
+///     viewpoint, then cubic jets) over the 16 nearest neighbours, and the position noise:
+///     the median jet residual over the mean spacing;
+///  2. noisy positions (noise > 0.03; clean analytic clouds measured <= 0.0094, 10% noise
+///     0.075-0.080): the fit and quadratic jet normals over 4 x 16 = 64 neighbours instead;
+///  3. the cloud's own normals are used when their median angle to the jet normals is at most
+///     2.5 times the noise (clean: ratio <= 1.72 measured, 0.23-0.28 with position noise;
+///     normal noise 0.05: >= 4.0), else the jet normals turned to their side.
+/// With k or radius given: the fit over those neighbours, of the cloud's own normals (made unit;
+/// zero or non-finite rows make their point `undefined`), else of cloud_normals over them.
 ///
 /// Conventions as curvature.h: outward normals, a sphere of radius r has k1 = k2 = +1/r; the
 /// classes' zero tolerance is relative to the cloud's mean spacing (mean_spacing) as it is to
 /// the mean edge length of a mesh. Deterministic for any thread count.
+#include <cmath>
 #include <optional>
 
 #include "focal/core/fields.h"
@@ -29,7 +39,8 @@ namespace focal {
 inline constexpr int default_cloud_neighbours = 16;
 
 struct CloudOptions {
-  /// Neighbours per point (k nearest); 0 = default_cloud_neighbours. Ignored when radius > 0.
+  /// Neighbours per point (k nearest); 0 (with radius 0) = the adaptive default above.
+  /// Ignored when radius > 0.
   int k = 0;
   /// > 0: the neighbours within this distance instead of the k nearest (at most 1024, the
   /// nearest).
@@ -50,6 +61,11 @@ struct CloudCurvature {
   bool normals_estimated = false;  ///< true when N was estimated (the cloud had none)
   Neighbourhoods neighbours;       ///< the neighbourhoods of the fit (and of the normals)
   double spacing = 0.0;            ///< mean_spacing of the cloud
+  /// The default's plan: the median jet residual over the spacing (NaN when not measured), the
+  /// neighbours of the fit, and whether the cloud's own normals were used.
+  double noise = NAN;
+  int k = 0;
+  bool file_normals_used = false;
 };
 
 /// Curvature of the cloud V (#V x 3) with optional normals N (#V x 3, outward).
