@@ -4,15 +4,17 @@
 For every analytic surface and case (exact normals, no normals, position noise, normal noise)
 it writes a cloud with `focal generate --cloud` (Poisson-disk samples with exact truth) and
 measures the relative RMS error of H, sqrt(mean (H - H_true)^2) / max |k_true|, of
-  - focal: `focal curvature CLOUD.xyz --k K` (the cloud default),
+  - focal: `focal curvature CLOUD.xyz` (the cloud default: adaptive, 16 or 64 neighbours),
   - CGAL 5.5 Monge_via_jet_fitting over the K nearest (bench/points/cgal_peer.cpp; normals
     jet_estimate_normals + mst_orient_normals when the cloud has none),
+  - PCL 1.13 NormalEstimation + PrincipalCurvaturesEstimation over the K nearest
+    (bench/points/pcl_peer.cpp): unsigned pc1, pc2, compared as they are (H = (pc1 + pc2) / 2);
   - focal's mesh path: `focal curvature` (recommended estimator) on the irregular triangulation
     of the same points (the same vertices, noise and seeds).
 Prints a Markdown table and the fraction of cases where focal's cloud default has the lowest
 error. Points without an estimate (NaN) are counted apart, not in the RMS.
 
-Usage: compare.py FOCAL CGAL_PEER [POINTS=5000] [K=16] [SEED=1]
+Usage: compare.py FOCAL CGAL_PEER PCL_PEER [POINTS=5000] [K=16] [SEED=1]
 """
 
 import os
@@ -51,13 +53,13 @@ def run(*args):
 
 
 def main():
-    focal, cgal = sys.argv[1], sys.argv[2]
-    points = int(sys.argv[3]) if len(sys.argv) > 3 else 5000
-    k = int(sys.argv[4]) if len(sys.argv) > 4 else 16
-    seed = sys.argv[5] if len(sys.argv) > 5 else "1"
-    wins, cases = 0, 0
-    print(f"| surface | case | focal cloud (k={k}) | CGAL jet (k={k}) | focal mesh |")
-    print("|---|---|---|---|---|")
+    focal, cgal, pcl = sys.argv[1], sys.argv[2], sys.argv[3]
+    points = int(sys.argv[4]) if len(sys.argv) > 4 else 5000
+    k = int(sys.argv[5]) if len(sys.argv) > 5 else 16
+    seed = sys.argv[6] if len(sys.argv) > 6 else "1"
+    wins, peer_wins, cases = 0, 0, 0
+    print(f"| surface | case | focal cloud (default) | CGAL jet (k={k}) | PCL (k={k}) | focal mesh |")
+    print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for surface in SURFACES:
             for case, flags in CASES.items():
@@ -69,19 +71,23 @@ def main():
                 k1, k2 = read_column(truth, "k1"), read_column(truth, "k2")
                 out = os.path.join(tmp, "out.csv")
                 errors = []
-                run(focal, "curvature", cloud, "-o", out, "--k", k, "--force")
+                run(focal, "curvature", cloud, "-o", out, "--force")
                 errors.append(h_error(read_column(out, "H"), k1, k2))
                 run(cgal, cloud, k, out)
+                errors.append(h_error(read_column(out, "H"), k1, k2))
+                run(pcl, cloud, k, out)
                 errors.append(h_error(read_column(out, "H"), k1, k2))
                 run(focal, "curvature", mesh, "-o", out, "--force")
                 errors.append(h_error(read_column(out, "H"), k1, k2))
                 best = min(e for e, _ in errors)
                 cases += 1
                 wins += errors[0][0] == best
+                peer_wins += errors[0][0] <= min(e for e, _ in errors[1:3])
                 cells = [f"{e:.4f}" + (f" ({n} NaN)" if n else "") for e, n in errors]
                 cells = [f"**{c}**" if e == best else c for c, (e, _) in zip(cells, errors)]
                 print(f"| {surface} | {case} | " + " | ".join(cells) + " |", flush=True)
-    print(f"\nfocal's cloud default lowest in {wins} of {cases} cases")
+    print(f"\nfocal's cloud default lowest of all four in {wins} of {cases} cases, "
+          f"at most the peers' (CGAL, PCL) in {peer_wins} of {cases}")
 
 
 if __name__ == "__main__":
