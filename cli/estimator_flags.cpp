@@ -183,7 +183,8 @@ CloudOptions EstimatorFlags::cloud_options() const {
   CloudOptions o = cloud;
   o.solver = options.solver;
   o.threads = threads;
-  if (viewpoint.size() == 3) o.normals.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
+  if (viewpoint.size() == 3)
+    o.normals.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
   return o;
 }
 
@@ -260,8 +261,7 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
   return e;
 }
 
-CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags,
-                                  const Log& log) {
+CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags, const Log& log) {
   const CloudOptions options = flags.cloud_options();
   CloudCurvature c;
   {

@@ -95,7 +95,8 @@ void add_generate_command(CLI::App& app, const Log& log) {
   cmd->add_option("surface", f->surface, "one of: " + names)
       ->required()
       ->check(CLI::IsMember(known));
-  cmd->add_option("-o,--output", f->output, "output mesh (.ply .obj .off) or cloud (also .xyz), with exact normals")
+  cmd->add_option("-o,--output", f->output,
+                  "output mesh (.ply .obj .off) or cloud (also .xyz), with exact normals")
       ->required();
   cmd->add_option("--truth", f->truth, "also write the exact k1,k2,H,K,d1,d2 per vertex as CSV");
   const std::map<std::string, Triangulation> tri = {{"regular", Triangulation::regular},

@@ -20,11 +20,13 @@ struct InfoFlags {
 void print_cloud_info(const std::string& path, const Mesh& cloud) {
   const Neighbourhoods nearest = nearest_neighbours(cloud.V, 1);
   int non_finite = 0;
-  for (Eigen::Index i = 0; i < cloud.V.rows(); ++i) non_finite += cloud.V.row(i).allFinite() ? 0 : 1;
+  for (Eigen::Index i = 0; i < cloud.V.rows(); ++i)
+    non_finite += cloud.V.row(i).allFinite() ? 0 : 1;
   const Eigen::Index n = cloud.V.rows();
   std::printf("file:                 %s\n", path.c_str());
   std::printf("type:                 point cloud (no faces)\n");
-  std::printf("points:               %lld (%d non-finite)\n", static_cast<long long>(n), non_finite);
+  std::printf("points:               %lld (%d non-finite)\n", static_cast<long long>(n),
+              non_finite);
   // Bounds of the finite points only, as mesh_statistics gives a mesh's.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -77,7 +79,8 @@ void print_info(const InfoFlags& f, const Log& log) {
 void add_info_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("info", "Counts, bounds and connectivity statistics of a mesh");
   auto f = std::make_shared<InfoFlags>();
-  cmd->add_option("input", f->path, "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")->required();
+  cmd->add_option("input", f->path, "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+      ->required();
   add_read_flags(*cmd, f->read);
   cmd->footer("Example:\n  focal info bunny.off");
   cmd->callback([f, &log] { print_info(*f, log); });

@@ -58,10 +58,11 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr,
-                 "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|normals|eval|render ... "
-                 "(see focal -h)\n",
-                 e.what());
+    std::fprintf(
+        stderr,
+        "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|normals|eval|render ... "
+        "(see focal -h)\n",
+        e.what());
     return kUsageError;
   }
   return 0;

@@ -59,9 +59,11 @@ void run_normals(NormalsFlags& f, const Log& log) {
 void add_normals_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("normals", "Estimated, oriented vertex normals (meshes, clouds)");
   auto f = std::make_shared<NormalsFlags>();
-  cmd->add_option("input", f->input, "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+  cmd->add_option("input", f->input,
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
       ->required();
-  cmd->add_option("-o,--output", f->output, "OUT.ply, .obj, .off or .xyz: positions, faces, normals")
+  cmd->add_option("-o,--output", f->output,
+                  "OUT.ply, .obj, .off or .xyz: positions, faces, normals")
       ->required();
   f->estimator.add_to(*cmd);
   cmd->add_flag("--force", f->force, "replace a read-only output file");

@@ -14,9 +14,10 @@ namespace {
 // With exact normals every normal ray of a sphere passes through its centre, so the two-slit fit
 // is exact whatever the neighbours: k1 = k2 = 1/r to rounding (here r = 2).
 TEST(CloudCurvature, SphereIsExactWithExactNormals) {
-  AnalyticSurface s =
-      make_surface({.kind = SurfaceKind::sphere, .triangulation = Triangulation::irregular,
-                    .target_vertices = 3000, .a = 2.0});
+  AnalyticSurface s = make_surface({.kind = SurfaceKind::sphere,
+                                    .triangulation = Triangulation::irregular,
+                                    .target_vertices = 3000,
+                                    .a = 2.0});
   s.mesh.F.resize(0, 3);
   for (const CloudOptions& o : {CloudOptions{}, CloudOptions{.k = 6}, CloudOptions{.radius = 0.3},
                                 CloudOptions{.solver = Solver::levenberg_marquardt}}) {

@@ -43,8 +43,8 @@ TEST(PcaNormals, ExactOnATiltedPlane) {
 // Hoppe et al.'s MST orientation on unoriented samples of the closed analytic surfaces, two
 // densities and two seeds: no normal may point inward.
 TEST(OrientNormals, NoFlippedNormalOnClosedSurfaces) {
-  for (SurfaceKind kind : {SurfaceKind::sphere, SurfaceKind::torus, SurfaceKind::ellipsoid,
-                           SurfaceKind::pear}) {
+  for (SurfaceKind kind :
+       {SurfaceKind::sphere, SurfaceKind::torus, SurfaceKind::ellipsoid, SurfaceKind::pear}) {
     for (int n : {1000, 5000}) {
       for (std::uint64_t seed : {1, 2}) {
         const AnalyticSurface s = test::cloud_of(kind, n, seed);
@@ -79,8 +79,8 @@ TEST(OrientNormals, TowardsAViewpoint) {
   RowMatrixX3d N = s.mesh.N;
   orient_towards_viewpoint(s.mesh.V, Eigen::Vector3d::Zero(), N);  // the centre: all inward
   EXPECT_EQ(flipped(N, s.mesh.N), N.rows());
-  const RowMatrixX3d outward = cloud_normals(
-      s.mesh.V, nearest_neighbours(s.mesh.V, 16), {.viewpoint = Eigen::Vector3d(0.0, 0.0, 0.0)});
+  const RowMatrixX3d outward = cloud_normals(s.mesh.V, nearest_neighbours(s.mesh.V, 16),
+                                             {.viewpoint = Eigen::Vector3d(0.0, 0.0, 0.0)});
   EXPECT_EQ(flipped(outward, s.mesh.N), N.rows());
   EXPECT_THROW(orient_towards_viewpoint(s.mesh.V, Eigen::Vector3d(NAN, 0, 0), N), InvalidInput);
 }
@@ -92,8 +92,8 @@ TEST(CloudNormals, JetsBeatPcaOnAnEllipsoid) {
   for (std::uint64_t seed : {1, 2}) {
     const AnalyticSurface s = test::cloud_of(SurfaceKind::ellipsoid, 4000, seed);
     const Neighbourhoods nb = nearest_neighbours(s.mesh.V, 16);
-    const double pca = worst_angle(cloud_normals(s.mesh.V, nb, {.method = CloudNormalMethod::pca}),
-                                   s.mesh.N);
+    const double pca =
+        worst_angle(cloud_normals(s.mesh.V, nb, {.method = CloudNormalMethod::pca}), s.mesh.N);
     const double jet = worst_angle(cloud_normals(s.mesh.V, nb), s.mesh.N);
     EXPECT_LT(3.0 * jet, pca);
   }

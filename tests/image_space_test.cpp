@@ -4,7 +4,6 @@
 // The accuracy table of docs/IMAGE_SPACE.md is printed (not asserted: the tests below assert) by
 //   build/release/tests/image_space_test --gtest_also_run_disabled_tests --gtest_filter='*Table'
 #include "focal/image_space/image_space.h"
-#include "focal/surfaces/geometry_image.h"
 
 #include <gtest/gtest.h>
 
@@ -19,12 +18,13 @@
 #include <vector>
 
 #include "cuda/triangle_fit.h"
-#include "kernels/triplet.h"
+#include "focal/core/error.h"
 #include "focal/cuda/curvature.h"
 #include "focal/cuda/device.h"
-#include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/curvature/triangle_curvature.h"
+#include "focal/surfaces/geometry_image.h"
+#include "kernels/triplet.h"
 #include "test_meshes.h"
 
 namespace focal {

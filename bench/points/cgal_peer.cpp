@@ -58,17 +58,16 @@ int main(int argc, char** argv) {
     while (n < 6 && s >> v[n]) ++n;
     if (n < 3) continue;
     has_normals = n == 6;
-    points.emplace_back(Point(v[0], v[1], v[2]), n == 6 ? Vector(v[3], v[4], v[5]) : Vector(0, 0, 0),
-                        points.size());
+    points.emplace_back(Point(v[0], v[1], v[2]),
+                        n == 6 ? Vector(v[3], v[4], v[5]) : Vector(0, 0, 0), points.size());
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   if (!has_normals) {
     CGAL::jet_estimate_normals<CGAL::Sequential_tag>(
-        points, k,
-        CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+        points, k, CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
     CGAL::mst_orient_normals(points, k,
-        CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
+                             CGAL::parameters::point_map(PointMap()).normal_map(NormalMap()));
   }
   std::sort(points.begin(), points.end(),
             [](const auto& a, const auto& b) { return std::get<2>(a) < std::get<2>(b); });

@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   std::ofstream out(argv[3]);
   out << "k1,k2,H\n";
   out.precision(9);
-  for (const auto& c : curvatures) out << c.pc1 << ',' << c.pc2 << ',' << 0.5 * (c.pc1 + c.pc2) << '\n';
+  for (const auto& c : curvatures)
+    out << c.pc1 << ',' << c.pc2 << ',' << 0.5 * (c.pc1 + c.pc2) << '\n';
   std::printf("%.4f %.4f\n", std::chrono::duration<double>(t1 - t0).count(),
               std::chrono::duration<double>(t2 - t1).count());
   return 0;

@@ -42,7 +42,8 @@ class Timer {
   double cpu_ = cpu_seconds();
 };
 
-/// Torus (R = 1, r = 0.4) points uniform by area: v accepted with probability (R + r cos v) / (R + r).
+/// Torus (R = 1, r = 0.4) points uniform by area: v accepted with probability (R + r cos v) / (R +
+/// r).
 void torus_cloud(int n, focal::RowMatrixX3d& V, focal::RowMatrixX3d& N) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi), unit(0.0, 1.0);
@@ -50,7 +51,8 @@ void torus_cloud(int n, focal::RowMatrixX3d& V, focal::RowMatrixX3d& N) {
   for (int i = 0; i < n;) {
     const double u = angle(rng), v = angle(rng);
     if (unit(rng) * 1.4 > 1.0 + 0.4 * std::cos(v)) continue;
-    const Eigen::RowVector3d normal(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
+    const Eigen::RowVector3d normal(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u),
+                                    std::sin(v));
     N.row(i) = normal;
     V.row(i) = Eigen::RowVector3d(std::cos(u), std::sin(u), 0.0) + 0.4 * normal;
     ++i;

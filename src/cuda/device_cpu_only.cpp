@@ -1,6 +1,6 @@
 // The device API of a build without the CUDA backend.
-#include "focal/cuda/device.h"
 #include "focal/core/error.h"
+#include "focal/cuda/device.h"
 
 namespace focal {
 

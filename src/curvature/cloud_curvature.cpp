@@ -9,8 +9,8 @@
 #include "curvature/curvature_detail.h"
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
-#include "normals/cloud_normals_detail.h"
 #include "mesh/prepared_detail.h"
+#include "normals/cloud_normals_detail.h"
 
 namespace focal {
 namespace {
@@ -94,9 +94,8 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   // Without jets (CloudNormalMethod::pca) there is no noise to judge by: the file's are kept.
   // 1e-9 rad: exact normals of an exactly fitted cloud (noise 0) still agree.
-  out.file_normals_used =
-      N && (!std::isfinite(out.noise) ||
-            median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
+  out.file_normals_used = N && (!std::isfinite(out.noise) ||
+                                median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
   out.normals_estimated = !out.file_normals_used;
   out.N = std::move(jets.N);
   if (N && !out.file_normals_used) {

@@ -104,9 +104,9 @@ class XyzReader {
     const int last = std::max(*std::max_element(columns_.position.begin(), columns_.position.end()),
                               columns_.normal ? (*columns_.normal)[2] : 0);
     if (width_ < 3 || static_cast<std::size_t>(last) >= width_) {
-      fail_at_line(path_, cursor_.line_number(),
-                   "expected at least 3 numbers (x y z [nx ny nz]), found " +
-                       std::to_string(width_));
+      fail_at_line(
+          path_, cursor_.line_number(),
+          "expected at least 3 numbers (x y z [nx ny nz]), found " + std::to_string(width_));
     }
   }
 
@@ -114,8 +114,8 @@ class XyzReader {
     double value = 0.0;
     if (!io_detail::parse_double(tokens_[column], value)) {
       fail_at_line(path_, cursor_.line_number(),
-                   "column " + std::to_string(column + 1) + ": " + io_detail::quoted(tokens_[column]) +
-                       " is not a number");
+                   "column " + std::to_string(column + 1) + ": " +
+                       io_detail::quoted(tokens_[column]) + " is not a number");
     }
     return value;
   }

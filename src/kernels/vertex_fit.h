@@ -63,12 +63,12 @@ struct VertexFitParams {
   const int* offsets;               ///< CSR of the neighbourhoods (#V + 1)
   const int* indices;
   int vertex_count;
-  bool gaussian;                      ///< Gaussian weights; else uniform
-  T inverse_two_width_squared;        ///< Gaussian weights exp(-d^2 * this), d in scaled units
-  T curvature_unit;                   ///< 1 / length_unit: k = (eigenvalue of W) x this (exact)
-  T zero_tolerance;                   ///< |k| at or below this is zero (absolute curvature)
-  T umbilic_tolerance;                ///< relative gap at or below this is umbilic
-  T min_relative_determinant;         ///< det / (trace/3)^3 at or below this: undefined
+  bool gaussian;                ///< Gaussian weights; else uniform
+  T inverse_two_width_squared;  ///< Gaussian weights exp(-d^2 * this), d in scaled units
+  T curvature_unit;             ///< 1 / length_unit: k = (eigenvalue of W) x this (exact)
+  T zero_tolerance;             ///< |k| at or below this is zero (absolute curvature)
+  T umbilic_tolerance;          ///< relative gap at or below this is umbilic
+  T min_relative_determinant;   ///< det / (trace/3)^3 at or below this: undefined
   VertexFitOutput<T> out;
 };
 

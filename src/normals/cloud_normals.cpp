@@ -145,8 +145,8 @@ JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
   if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
-  const JetOptions jet{.rings = 1, .degree = options.jet_degree, .iterations = 2,
-                       .threads = options.threads};
+  const JetOptions jet{
+      .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
   return detail::jet_normals_from(V, neighbours, N, jet);
 }
 

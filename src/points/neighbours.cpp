@@ -1,12 +1,11 @@
 #include "focal/points/neighbours.h"
 
-#include <nanoflann.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <nanoflann.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -147,28 +146,30 @@ Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
   // farther point: then every point at that distance is gathered and the tie broken by index
   // rather than by the traversal order (rare on measured data, common on grids).
   const std::size_t wanted = std::min<std::size_t>(static_cast<std::size_t>(k) + 2, tree.size());
-  return gather(V.rows(), tree.leaf_order(), threads, [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
-    if (wanted == 0) return;
-    std::uint32_t index[64];
-    double distance[64];
-    std::vector<std::uint32_t> big_index;
-    std::vector<double> big_distance;
-    std::uint32_t* idx = index;
-    double* dist = distance;
-    if (wanted > 64) {
-      big_index.resize(wanted), big_distance.resize(wanted);
-      idx = big_index.data(), dist = big_distance.data();
-    }
-    const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
-    const std::size_t found = tree.tree().knnSearch(q, wanted, idx, dist);
-    c.clear();
-    if (found == wanted && wanted >= 2 && dist[wanted - 1] == dist[wanted - 2]) {
-      tree.within(q, dist[wanted - 1], c);
-    } else {
-      for (std::size_t j = 0; j < found; ++j) c.emplace_back(dist[j], tree.row(idx[j]));
-    }
-    keep_sorted(c, i, static_cast<std::size_t>(k) + out.size(), out);
-  });
+  return gather(V.rows(), tree.leaf_order(), threads,
+                [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
+                  if (wanted == 0) return;
+                  std::uint32_t index[64];
+                  double distance[64];
+                  std::vector<std::uint32_t> big_index;
+                  std::vector<double> big_distance;
+                  std::uint32_t* idx = index;
+                  double* dist = distance;
+                  if (wanted > 64) {
+                    big_index.resize(wanted), big_distance.resize(wanted);
+                    idx = big_index.data(), dist = big_distance.data();
+                  }
+                  const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
+                  const std::size_t found = tree.tree().knnSearch(q, wanted, idx, dist);
+                  c.clear();
+                  if (found == wanted && wanted >= 2 && dist[wanted - 1] == dist[wanted - 2]) {
+                    tree.within(q, dist[wanted - 1], c);
+                  } else {
+                    for (std::size_t j = 0; j < found; ++j)
+                      c.emplace_back(dist[j], tree.row(idx[j]));
+                  }
+                  keep_sorted(c, i, static_cast<std::size_t>(k) + out.size(), out);
+                });
 }
 
 Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, int threads) {
@@ -180,13 +181,16 @@ Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, i
   const PointTree tree(V);
   const std::size_t limit =
       max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
-  return gather(V.rows(), tree.leaf_order(), threads, [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
-    const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
-    c.clear();
-    tree.within(q, radius * radius, c);
-    keep_sorted(c, i, limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
-                out);
-  });
+  return gather(V.rows(), tree.leaf_order(), threads,
+                [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
+                  const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
+                  c.clear();
+                  tree.within(q, radius * radius, c);
+                  keep_sorted(
+                      c, i,
+                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
+                      out);
+                });
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {

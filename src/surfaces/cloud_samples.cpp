@@ -68,8 +68,8 @@ AnalyticSurface sample_cloud(const CloudSampleOptions& options) {
   SurfaceOptions surface = options.surface;
   surface.triangulation = Triangulation::irregular;
   const std::uint64_t seed = surface.seed;
-  surface.target_vertices = static_cast<int>(
-      std::lround(surface.target_vertices / (1.0 - 0.5 * options.graded)));
+  surface.target_vertices =
+      static_cast<int>(std::lround(surface.target_vertices / (1.0 - 0.5 * options.graded)));
   AnalyticSurface s = make_surface(surface);
   if (options.position_noise > 0) add_position_noise(s.mesh, options.position_noise, seed + 1);
   if (options.normal_noise > 0) add_normal_noise(s.mesh, options.normal_noise, seed + 2);

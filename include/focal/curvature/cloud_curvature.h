@@ -57,7 +57,7 @@ struct CloudOptions {
 /// The fields and what they were computed from.
 struct CloudCurvature {
   CurvatureResult curvature;
-  RowMatrixX3d N;                 ///< #V x 3 unit normals used (given or estimated); NaN rows
+  RowMatrixX3d N;                  ///< #V x 3 unit normals used (given or estimated); NaN rows
   bool normals_estimated = false;  ///< true when N was estimated (the cloud had none)
   Neighbourhoods neighbours;       ///< the neighbourhoods of the fit (and of the normals)
   double spacing = 0.0;            ///< mean_spacing of the cloud
