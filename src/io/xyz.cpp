@@ -1,8 +1,9 @@
 // Point-cloud text (.xyz, .pts, .txt, .csv): one point per line, `x y z [nx ny nz]`, numbers
 // separated by blanks or commas (or both), `#` starting a comment. Optional first lines:
-//  - a header line with a token that is not a number ("x,y,z,nx,ny,nz", "X Y Z"): when it names
-//    the columns x, y, z (and nx, ny, nz), those columns are read; otherwise the first three
-//    columns are the position and, in a six-column file, the last three the normal;
+//  - a header line with a token that is not a number ("x,y,z,nx,ny,nz", "X Y Z"): it must name
+//    the columns x, y, z (and may name nx, ny, nz), which are read, other columns skipped;
+//    without a header the first three columns are the position and, in a six-column file, the
+//    last three the normal;
 //  - a single integer (the point count of Leica .pts files), which is skipped.
 // Every data line has the column count of the first one. Columns beyond those read (intensity,
 // colours) are skipped; a file of other than six columns without a header naming nx, ny, nz has
@@ -72,7 +73,14 @@ class XyzReader {
     if (!next_line()) fail(path_, "no points (expected lines of x y z [nx ny nz])");
     std::optional<Columns> named;
     if (!all_numbers(tokens_)) {
+      // A header that names no x, y, z is not a point list (a table of other values, such as
+      // focal's own curvature CSV): an error rather than numbers read as positions.
       named = columns_named(tokens_);
+      if (!named) {
+        fail_at_line(path_, cursor_.line_number(),
+                     "the header names no x, y, z columns (a point cloud needs them, e.g. "
+                     "'x,y,z,nx,ny,nz', or no header)");
+      }
       if (!next_line()) fail(path_, "no points after the header line");
     }
     std::int64_t count = 0;

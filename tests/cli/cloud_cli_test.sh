@@ -87,6 +87,8 @@ printf '# nothing\n' >empty.xyz
 expect_error "no points" "no points" empty.csv curvature empty.xyz -o empty.csv
 printf '1 2\n3 4\n' >two.xyz
 expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two.csv
+printf 'k1,k2,H\n1,2,3\n' >table.csv
+expect_error "a CSV whose header names no x, y, z: an error, not positions" "names no x, y, z" t.csv curvature table.csv -o t.csv
 expect_error "--rings on a cloud" "applies to meshes" r.csv curvature bare.xyz -o r.csv --rings 2
 expect_error "render on a cloud: not a mesh" "point cloud" r.png render bare.xyz -o r.png
 
