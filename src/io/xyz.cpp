@@ -179,15 +179,7 @@ void write_xyz(const std::filesystem::path& path, const Mesh& mesh) {
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
     std::string& out = sink.buffer();
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        if (c > 0) out += ' ';
-        io_detail::append_number(out, mesh.V(i, c));
-      }
-      for (int c = 0; normals && c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, mesh.N(i, c));
-      }
-      out += '\n';
+      io_detail::append_vertex_line(out, mesh, i, normals);
       sink.maybe_flush();
     }
   });
