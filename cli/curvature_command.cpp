@@ -32,8 +32,19 @@ struct FocalMeshFlags {
   FocalMeshOptions focal;
 };
 
+/// A point cloud's fields: the CSV, or the cloud (with the normals used) and its fields as PLY.
+void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
+  CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
+  Stage stage(log, "write");
+  if (lower_extension(f.output) == ".csv") return write_curvature_csv(f.output, c.curvature);
+  input.mesh.N = std::move(c.N);
+  write_curvature_ply(f.output, input.mesh, c.curvature,
+                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
+}
+
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Input input(f.input, f.estimator, log);
+  if (input.cloud) return run_cloud_curvature(f, input, log);
   Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
@@ -48,16 +59,23 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
                       {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
 }
 
+/// The focal meshes of a mesh, or the focal point clouds (no faces) of a point cloud.
+FocalMeshes focal_meshes_of(const Input& input, FocalMeshFlags& f, const Log& log) {
+  FocalMeshOptions o = f.focal;
+  o.threads = f.estimator.threads;
+  if (input.cloud) {
+    const CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
+    Stage stage(log, "focal points");
+    return focal_meshes(input.mesh.V, RowMatrixX3i(0, 3), c.N, c.curvature, o);
+  }
+  const Estimate e = run_estimate(input, f.input, f.estimator, log);
+  Stage stage(log, "focal meshes");
+  return focal_meshes(estimated_mesh(input, e), e.curvature, o);
+}
+
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   const Input input(f.input, f.estimator, log);
-  const Estimate e = run_estimate(input, f.input, f.estimator, log);
-  FocalMeshes meshes;
-  {
-    Stage stage(log, "focal meshes");
-    FocalMeshOptions o = f.focal;
-    o.threads = f.estimator.threads;
-    meshes = focal_meshes(estimated_mesh(input, e), e.curvature, o);
-  }
+  const FocalMeshes meshes = focal_meshes_of(input, f, log);
   Stage stage(log, "write");
   const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads};
   // All or nothing: a failed run leaves neither new focal mesh, and existing files as they were.
@@ -72,7 +90,9 @@ void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
 void add_curvature_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("curvature", "Principal curvatures and directions per vertex");
   auto f = std::make_shared<CurvatureFlags>();
-  cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("input", f->input,
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+      ->required();
   cmd->add_option("-o,--output", f->output,
                   "OUT.csv (one row per input vertex) or OUT.ply (the mesh with per-vertex "
                   "properties k1,k2,H,K,d1x..d2z,residual,class)")
@@ -100,7 +120,9 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
   auto* cmd =
       app.add_subcommand("focal-mesh", "The two focal meshes Gamma_1, Gamma_2 (paper eq. 2)");
   auto f = std::make_shared<FocalMeshFlags>();
-  cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("input", f->input,
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+      ->required();
   cmd->add_option("-o,--output", f->prefix, "writes PREFIX.focal1.ply and PREFIX.focal2.ply")
       ->required();
   cmd->add_option("--max-distance", f->focal.max_distance,

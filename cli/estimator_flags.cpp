@@ -203,10 +203,51 @@ void EstimatorFlags::add_to(CLI::App& command) {
   command.add_option("--threads", threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
       ->check(CLI::NonNegativeNumber);
   add_read_flags(command, read);
+  add_cloud_flags(command);
   command.add_flag("--strict", strict,
                    "fail (exit 2, nothing written) when the input has problems such as NaN "
                    "coordinates, degenerate or non-manifold faces or bad normals, instead of "
                    "warning and leaving the affected vertices undefined");
+}
+
+void EstimatorFlags::add_cloud_flags(CLI::App& command) {
+  const std::map<std::string, CloudNormalMethod> methods = {{"pca", CloudNormalMethod::pca},
+                                                            {"jet", CloudNormalMethod::jet}};
+  command
+      .add_option("--k", cloud.k,
+                  "point clouds: neighbours per point, the k nearest (0 = " +
+                      std::to_string(default_cloud_neighbours) + ", docs/POINTS.md)")
+      ->check(CLI::Range(0, 1024));
+  command
+      .add_option("--radius", cloud.radius,
+                  "point clouds: neighbours within this distance instead of the k nearest")
+      ->check(CLI::PositiveNumber);
+  command
+      .add_option("--viewpoint", viewpoint,
+                  "point clouds without normals: orient estimated normals towards X,Y,Z (the "
+                  "scanner) instead of by a minimum spanning tree")
+      ->delimiter(',')
+      ->expected(3);
+  command
+      .add_option("--cloud-normals", cloud.normals.method,
+                  "point clouds without normals: pca, or jet (PCA then a quadratic jet)")
+      ->transform(CLI::CheckedTransformer(methods))
+      ->default_str("jet");
+}
+
+CloudOptions EstimatorFlags::cloud_options() const {
+  for (const CLI::Option* o : method_options) {
+    if (o->count() > 0 && o->get_name() != "--solver") {
+      throw InvalidInput(o->get_name() +
+                         " applies to meshes; the input is a point cloud (use --k or --radius)");
+    }
+  }
+  CloudOptions o = cloud;
+  o.solver = options.solver;
+  o.threads = threads;
+  if (viewpoint.size() == 3)
+    o.normals.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
+  return o;
 }
 
 bool EstimatorFlags::recommended() const {
@@ -243,6 +284,11 @@ Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& lo
     log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
              " triangles");
   }
+  cloud = mesh.is_cloud();
+  if (cloud) {
+    check_cloud(mesh, path, flags.strict, log);
+    return;
+  }
   // No output of these commands maps triangles back to input polygons: 4 bytes per face less.
   mesh.face_source = Eigen::VectorXi();
   // The one validation of the arrays for the whole run.
@@ -253,6 +299,9 @@ Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& lo
 
 Estimate run_estimate(const Input& input, const std::string& mesh_name, const EstimatorFlags& flags,
                       const Log& log) {
+  if (input.cloud) {
+    throw InvalidInput(mesh_name + ": is a point cloud (no faces); this command needs a mesh");
+  }
   const EstimateOptions options = flags.estimate_options();
   const PreparedMesh& mesh = *input.prepared;
   PreparedNormals normals;
@@ -273,6 +322,20 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
   report_undefined(mesh, mesh_name, options, e, log);
   print_summary(e.curvature, log);
   return e;
+}
+
+CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags, const Log& log) {
+  const CloudOptions options = flags.cloud_options();
+  CloudCurvature c;
+  {
+    Stage stage(log, "cloud curvature");
+    c = estimate_cloud_curvature(input.mesh.V, input.mesh.normals(), options);
+  }
+  log.info(std::string("  normals: ") +
+           (c.normals_estimated ? "estimated from the positions" : "the file's") +
+           "; mean spacing " + std::to_string(c.spacing));
+  print_summary(c.curvature, log);
+  return c;
 }
 
 PreparedMesh estimated_mesh(const Input& input, const Estimate& e) {

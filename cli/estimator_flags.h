@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "focal/core/mesh.h"
+#include "focal/curvature/cloud_curvature.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/estimate.h"
 #include "focal/io/mesh_io.h"
@@ -27,8 +28,16 @@ struct EstimatorFlags {
   ReadOptions read;     ///< --no-weld, --weld-tolerance (STL); threads set from --threads
   /// --method, --solver, --rings, --weights, --normals: giving any selects the paper's method.
   std::vector<CLI::Option*> method_options;
+  /// Point clouds: --k, --radius, --viewpoint, --cloud-normals (and --solver, --threads).
+  CloudOptions cloud;
+  std::vector<double> viewpoint;
+
+  /// The options of a point-cloud run. \throw InvalidInput when an option that only meshes
+  /// have (--method, --rings, --weights, --normals) was given.
+  [[nodiscard]] CloudOptions cloud_options() const;
 
   void add_to(CLI::App& command);
+  void add_cloud_flags(CLI::App& command);
   /// Whether the run uses focal's recommended estimator (recommended.h): no estimator option and
   /// no --paper were given.
   [[nodiscard]] bool recommended() const;
@@ -51,6 +60,9 @@ struct Input {
   Input& operator=(const Input&) = delete;
 
   Mesh mesh;
+  /// The file has no faces: a point cloud (`prepared` is then empty; the cloud functions take
+  /// mesh.V and mesh.N).
+  bool cloud = false;
   /// mesh.V, mesh.F and the normals the run uses (the file's, else none).
   std::optional<PreparedMesh> prepared;
   /// check_mesh of `prepared` (also kept in it, where the normals stage reads it again).
@@ -62,6 +74,11 @@ struct Input {
 /// \throw InvalidInput when `--normals file` is asked for and the file has none.
 [[nodiscard]] Estimate run_estimate(const Input& input, const std::string& mesh_name,
                                     const EstimatorFlags& flags, const Log& log);
+
+/// The curvature of a point cloud (cloud_curvature.h) with the flags' options, timed in stages,
+/// with -v a summary. \throw InvalidInput as EstimatorFlags::cloud_options.
+[[nodiscard]] CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags,
+                                                const Log& log);
 
 /// The mesh the estimate ran on: the input's positions with the estimate's faces and normals.
 /// Views input and e, which must outlive it.

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "eval_points.h"
 #include "focal/core/error.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/recommended.h"
@@ -33,6 +34,7 @@ struct EvalFlags {
   std::string markdown;
   std::string export_dir;          ///< analytic mode: the cases; scan mode: coloured H fields
   std::vector<std::string> scans;  ///< scan mode when non-empty
+  bool points = false;             ///< --points: the cloud estimator on analytic clouds
 };
 
 /// One estimator: a name and how it runs on a mesh whose N holds the file's normals.
@@ -689,6 +691,11 @@ void add_eval_command(CLI::App& app, const Log& log) {
   auto* scan = cmd->add_option("--scan", f->scans,
                                "scanned meshes: smoothness of H (range, variance, sign changes "
                                "across edges) per method instead of the analytic suite");
+  auto* points = cmd->add_flag("--points", f->points,
+                               "point clouds: the cloud estimator on samples of every surface "
+                               "(exact/no normals, noise, graded density, outliers; POINTS.md)");
+  points->excludes(scan);
+  cmd->get_option("--export")->excludes(points);
   cmd->get_option("--vertices")->excludes(scan);
   cmd->get_option("--seed")->excludes(scan);
   cmd->get_option("--suite")->excludes(scan);
@@ -701,7 +708,9 @@ void add_eval_command(CLI::App& app, const Log& log) {
     if (!f->markdown.empty()) require_extension("--markdown", f->markdown, {".md"});
   });
   cmd->callback([f, &log] {
-    if (f->scans.empty()) {
+    if (f->points) {
+      run_eval_points(f->vertices, f->seed, f->csv, f->markdown, log);
+    } else if (f->scans.empty()) {
       run_eval(*f, log);
     } else {
       run_scans(*f, log);

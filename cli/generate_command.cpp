@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "focal/io/mesh_io.h"
+#include "focal/surfaces/cloud_samples.h"
 #include "focal/surfaces/surfaces.h"
 #include "paths.h"
 
@@ -21,7 +22,28 @@ struct GenerateFlags {
   SurfaceOptions options;
   double position_noise = 0.0;
   double normal_noise = 0.0;
+  bool cloud = false;  ///< --cloud: point samples without faces (cloud_samples.h)
+  double graded = 0.0;
+  double outliers = 0.0;
+  bool no_normals = false;
 };
+
+/// The mesh, or with --cloud the point samples, noise included.
+AnalyticSurface make_output(const GenerateFlags& f) {
+  if (f.cloud) {
+    return sample_cloud({.surface = f.options,
+                         .position_noise = f.position_noise,
+                         .normal_noise = f.normal_noise,
+                         .graded = f.graded,
+                         .outliers = f.outliers,
+                         .normals = !f.no_normals});
+  }
+  AnalyticSurface s = make_surface(f.options);
+  if (f.position_noise > 0) add_position_noise(s.mesh, f.position_noise, f.options.seed + 1);
+  if (f.normal_noise > 0) add_normal_noise(s.mesh, f.normal_noise, f.options.seed + 2);
+  if (f.no_normals) s.mesh.N.resize(0, 3);
+  return s;
+}
 
 /// The exact principal curvatures and directions, one row per vertex.
 void write_truth(const std::string& path, const AnalyticSurface& s) {
@@ -38,10 +60,8 @@ void generate(GenerateFlags& f, const Log& log) {
   AnalyticSurface s;
   {
     Stage stage(log, "generate");
-    s = make_surface(f.options);
+    s = make_output(f);
   }
-  if (f.position_noise > 0) add_position_noise(s.mesh, f.position_noise, f.options.seed + 1);
-  if (f.normal_noise > 0) add_normal_noise(s.mesh, f.normal_noise, f.options.seed + 2);
   write_mesh(f.output, s.mesh);
   if (!f.truth.empty()) {
     try {
@@ -75,7 +95,8 @@ void add_generate_command(CLI::App& app, const Log& log) {
   cmd->add_option("surface", f->surface, "one of: " + names)
       ->required()
       ->check(CLI::IsMember(known));
-  cmd->add_option("-o,--output", f->output, "output mesh (.ply .obj .off), with exact normals")
+  cmd->add_option("-o,--output", f->output,
+                  "output mesh (.ply .obj .off) or cloud (also .xyz), with exact normals")
       ->required();
   cmd->add_option("--truth", f->truth, "also write the exact k1,k2,H,K,d1,d2 per vertex as CSV");
   const std::map<std::string, Triangulation> tri = {{"regular", Triangulation::regular},
@@ -98,12 +119,25 @@ void add_generate_command(CLI::App& app, const Log& log) {
   cmd->add_option("--normal-noise", f->normal_noise,
                   "perturb normals: normalize(n + u), u uniform in [-a, a]^3 (paper: 0.05)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--cloud", f->cloud,
+                "point samples without faces (the irregular samples; docs/POINTS.md)");
+  cmd->add_option("--graded", f->graded,
+                  "--cloud: density falls by this fraction along x, in [0, 1)")
+      ->check(CLI::Range(0.0, 0.99));
+  cmd->add_option("--outliers", f->outliers,
+                  "--cloud: this fraction of points moved off the surface (truth NaN)")
+      ->check(CLI::Range(0.0, 0.99));
+  cmd->add_flag("--no-normals", f->no_normals, "write no normals");
   cmd->footer(
-      "Example:\n  focal generate torus --triangulation irregular --vertices 5000 -o torus.ply "
-      "--truth torus-truth.csv");
+      "Examples:\n  focal generate torus --triangulation irregular --vertices 5000 -o torus.ply "
+      "--truth torus-truth.csv\n"
+      "  focal generate torus --cloud --vertices 5000 --no-normals -o torus.xyz --truth t.csv");
   cmd->add_flag("--force", f->force, "replace read-only output files");
   cmd->parse_complete_callback([f] {
-    require_extension("-o", f->output, {".ply", ".obj", ".off"});
+    require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz"});
+    if (!f->cloud && (f->graded > 0 || f->outliers > 0)) {
+      throw CLI::ValidationError("--graded and --outliers need --cloud");
+    }
     check_output("-o", f->output, "", f->force);
     if (!f->truth.empty()) check_output("--truth", f->truth, "", f->force);
   });

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -6,6 +7,7 @@
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
+#include "focal/points/neighbours.h"
 
 namespace focal::cli {
 namespace {
@@ -15,6 +17,30 @@ struct InfoFlags {
   ReadOptions read;
 };
 
+void print_cloud_info(const std::string& path, const Mesh& cloud) {
+  const Neighbourhoods nearest = nearest_neighbours(cloud.V, 1);
+  int non_finite = 0;
+  for (Eigen::Index i = 0; i < cloud.V.rows(); ++i)
+    non_finite += cloud.V.row(i).allFinite() ? 0 : 1;
+  const Eigen::Index n = cloud.V.rows();
+  std::printf("file:                 %s\n", path.c_str());
+  std::printf("type:                 point cloud (no faces)\n");
+  std::printf("points:               %lld (%d non-finite)\n", static_cast<long long>(n),
+              non_finite);
+  // Bounds of the finite points only, as mesh_statistics gives a mesh's.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!cloud.V.row(i).allFinite()) continue;
+    lo = lo.cwiseMin(cloud.V.row(i).transpose()), hi = hi.cwiseMax(cloud.V.row(i).transpose());
+  }
+  if (non_finite == n) lo.setZero(), hi.setZero();
+  std::printf("bounds:               [%g, %g, %g] - [%g, %g, %g]\n", lo.x(), lo.y(), lo.z(), hi.x(),
+              hi.y(), hi.z());
+  std::printf("mean spacing:         %g (mean distance to the nearest other point)\n",
+              mean_spacing(cloud.V, nearest));
+  std::printf("normals:              %s\n", cloud.has_normals() ? "present" : "none");
+}
+
 void print_info(const InfoFlags& f, const Log& log) {
   const std::string& path = f.path;
   Mesh mesh;
@@ -22,6 +48,7 @@ void print_info(const InfoFlags& f, const Log& log) {
     Stage stage(log, "read");
     mesh = read_mesh(path, f.read);
   }
+  if (mesh.is_cloud()) return print_cloud_info(path, mesh);
   const MeshStatistics s = mesh_statistics(mesh.V, mesh.F);
   const OrientationReport orientation = orientation_report(mesh.V, mesh.F);
   std::printf("file:                 %s\n", path.c_str());
@@ -52,7 +79,8 @@ void print_info(const InfoFlags& f, const Log& log) {
 void add_info_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("info", "Counts, bounds and connectivity statistics of a mesh");
   auto f = std::make_shared<InfoFlags>();
-  cmd->add_option("input", f->path, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("input", f->path, "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+      ->required();
   add_read_flags(*cmd, f->read);
   cmd->footer("Example:\n  focal info bunny.off");
   cmd->callback([f, &log] { print_info(*f, log); });

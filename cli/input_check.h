@@ -19,4 +19,8 @@ namespace focal::cli {
 MeshFindings check_input(const PreparedMesh& mesh, const std::string& mesh_name, bool strict,
                          const Log& log);
 
+/// The same for a point cloud: counts points with a NaN or infinite coordinate and normals that
+/// are zero or not finite (those points get no curvature). \throw as check_input.
+void check_cloud(const Mesh& cloud, const std::string& cloud_name, bool strict, const Log& log);
+
 }  // namespace focal::cli

@@ -31,6 +31,7 @@ int run(int argc, char** argv) {
   focal::cli::add_generate_command(app, log);
   focal::cli::add_curvature_command(app, log);
   focal::cli::add_focal_mesh_command(app, log);
+  focal::cli::add_normals_command(app, log);
   focal::cli::add_eval_command(app, log);
   focal::cli::add_render_command(app, log);
   focal::cli::add_devices_command(app, log);
@@ -41,6 +42,8 @@ int run(int argc, char** argv) {
       "  focal curvature mesh.ply -o fields.csv\n"
       "  focal -v curvature mesh.ply -o fields.ply --rings 2\n"
       "  focal focal-mesh mesh.ply -o prefix   # prefix.focal1.ply, prefix.focal2.ply\n"
+      "  focal curvature scan.xyz -o fields.csv --k 16   # point clouds (no faces) too\n"
+      "  focal normals scan.xyz -o scan-normals.ply      # estimated, oriented normals\n"
       "  focal eval --markdown eval.md         # every estimator against analytic truth\n"
       "  focal render mesh.ply -o mesh-H.png --field H   # a picture of H\n"
       "  focal devices                      # the GPUs the CUDA backend can use\n"
@@ -58,7 +61,8 @@ int run(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr,
-                 "Error: %s\nUsage: focal [-v] info|generate|curvature|focal-mesh|eval|render|devices ... "
+                 "Error: %s\nUsage: focal [-v] "
+                 "info|generate|curvature|focal-mesh|normals|eval|render|devices ... "
                  "(see focal -h)\n",
                  focal::cli::one_line(e.what()).c_str());
     return kUsageError;

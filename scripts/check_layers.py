@@ -10,8 +10,8 @@ import re
 import sys
 
 # Lowest first: a folder may include itself and the folders before it.
-LAYERS = ["core", "kernels", "io", "mesh", "normals", "curvature", "tiles", "cuda", "image_space",
-          "surfaces", "evaluation", "render"]
+LAYERS = ["core", "kernels", "io", "mesh", "points", "normals", "curvature", "tiles", "cuda",
+          "image_space", "surfaces", "evaluation", "render"]
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
 include = re.compile(r'^\s*#\s*include\s+"([^"]+)"')

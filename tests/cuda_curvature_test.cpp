@@ -22,7 +22,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,9 +29,9 @@
 #include <vector>
 
 #include "cuda/vertex_fit.h"
+#include "focal/core/error.h"
 #include "focal/cuda/curvature.h"
 #include "focal/cuda/device.h"
-#include "focal/core/error.h"
 #include "focal/surfaces/surfaces.h"
 #include "gpu_required.h"
 #include "test_meshes.h"
@@ -119,7 +118,8 @@ Comparison compare(const CurvatureResult& want, const CurvatureResult& got, doub
     }
     if (!std::isfinite(want.k1[i]) || !std::isfinite(got.k1[i])) continue;
     const double kappa = std::max(std::abs(want.k1[i]), std::abs(want.k2[i]));
-    for (const auto& [a, b] : {std::pair{want.k1[i], got.k1[i]}, std::pair{want.k2[i], got.k2[i]}}) {
+    for (const auto& [a, b] :
+         {std::pair{want.k1[i], got.k1[i]}, std::pair{want.k2[i], got.k2[i]}}) {
       c.max_kappa_error = std::max(c.max_kappa_error, std::abs(a - b) / kappa);
       if (std::abs(a) * h >= 1e-2) c.relative_errors.push_back(std::abs(a - b) / std::abs(a));
     }
@@ -132,8 +132,8 @@ Comparison compare(const CurvatureResult& want, const CurvatureResult& got, doub
       const double bound = 1e-5 * kappa / gap;
       c.max_direction_excess = std::max(c.max_direction_excess, angle / bound);
     }
-    c.max_residual_error = std::max(
-        c.max_residual_error, std::abs(want.residual[i] - got.residual[i]) / (kappa * h));
+    c.max_residual_error =
+        std::max(c.max_residual_error, std::abs(want.residual[i] - got.residual[i]) / (kappa * h));
   }
   return c;
 }
@@ -143,8 +143,9 @@ void expect_float_agreement(const Comparison& c, const std::string& name) {
   std::printf(
       "%-36s |dk|/kappa max %.2e; |dk|/|k| (|k|h>=1e-2, %zu values) max %.2e median %.2e; "
       "d1 excess %.2f; residual err/(kappa h) %.2e; class mismatches %d\n",
-      name.c_str(), c.max_kappa_error, r.size(), r.empty() ? 0.0 : *std::max_element(r.begin(), r.end()),
-      median(r), c.max_direction_excess, c.max_residual_error, c.class_mismatches);
+      name.c_str(), c.max_kappa_error, r.size(),
+      r.empty() ? 0.0 : *std::max_element(r.begin(), r.end()), median(r), c.max_direction_excess,
+      c.max_residual_error, c.class_mismatches);
   EXPECT_LT(c.max_kappa_error, 1e-5) << name;
   for (double e : r) ASSERT_LT(e, 1e-4) << name;
   EXPECT_LE(c.max_direction_excess, 1.0) << name;
@@ -191,12 +192,14 @@ TEST(CudaVertexFitOnHost, FloatAccuracyIndependentOfPlacementAndUnits) {
   const CurvatureOptions o;
   const CurvatureResult want = estimate_curvature(m.V, m.F, m.N, o);
   const CurvatureResult got = cuda::fit_vertices_on_host<float>(m.V, m.F, m.N, o);
-  expect_float_agreement(compare(want, got, mean_edge_length(m.V, m.F), o), "torus far, 1e-6 units");
+  expect_float_agreement(compare(want, got, mean_edge_length(m.V, m.F), o),
+                         "torus far, 1e-6 units");
 }
 
 // Invalid normals and positions: the same vertices undefined, NaN fields and ray counts as the CPU.
 TEST(CudaVertexFitOnHost, DegenerateInputFlaggedAsOnCpu) {
-  Mesh m = test::analytic_surface(SurfaceKind::ellipsoid, Triangulation::irregular, 500, 0.0, 1).mesh;
+  Mesh m =
+      test::analytic_surface(SurfaceKind::ellipsoid, Triangulation::irregular, 500, 0.0, 1).mesh;
   m.N.row(3).setZero();
   m.N(7, 0) = std::nan("");
   m.V(11, 2) = std::numeric_limits<double>::infinity();

@@ -236,13 +236,14 @@ TEST_F(MeshIo, FormatFromExtensionIsCaseInsensitive) {
   EXPECT_EQ(focal::mesh_format_from_path("b.Ply"), focal::MeshFormat::ply);
   EXPECT_EQ(focal::mesh_format_from_path("b.off"), focal::MeshFormat::off);
   EXPECT_EQ(focal::mesh_format_from_path("b.stl"), focal::MeshFormat::stl);
-  expect_error<focal::IoError>([] { (void)focal::mesh_format_from_path("dir/mesh.xyz"); },
-                               {"dir/mesh.xyz", ".xyz"});
+  EXPECT_EQ(focal::mesh_format_from_path("cloud.XYZ"), focal::MeshFormat::xyz);
+  expect_error<focal::IoError>([] { (void)focal::mesh_format_from_path("dir/mesh.abc"); },
+                               {"dir/mesh.abc", ".abc"});
   expect_error<focal::IoError>([] { (void)focal::mesh_format_from_path("noext"); }, {"noext"});
 }
 
 TEST_F(MeshIo, ReadErrorsNameThePath) {
-  const fs::path unknown = write("mesh.xyz", "v 0 0 0\n");
+  const fs::path unknown = write("mesh.abc", "v 0 0 0\n");
   expect_io_error(unknown, {"unknown mesh format"});
   expect_io_error(file("missing.ply"), {"no such file"});
   fs::create_directories(file("folder.obj"));
@@ -705,9 +706,13 @@ TEST_F(MeshIo, ObjNormalsFromEveryCornerForm) {
                                              "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 -1\n"
                                              "f 1//1 2//1 3//1\nf 1//2 3//2 2//2\n"));
   EXPECT_TRUE(cancel.N.row(0).array().isNaN().all());
-  // vn lines that no face references give no normals.
-  const Mesh unused = focal::read_mesh(write("unused.obj", "v 0 0 0\nvn 0 0 1\n"));
+  // vn lines that no face references give no normals, unless the file is a point cloud (no
+  // faces) with one vn per v: then they pair in order (docs/POINTS.md).
+  const Mesh unused = focal::read_mesh(write("unused.obj", "v 0 0 0\nv 1 0 0\nvn 0 0 1\n"));
   EXPECT_FALSE(unused.has_normals());
+  const Mesh cloud = focal::read_mesh(write("cloud.obj", "v 0 0 0\nv 1 0 0\nvn 0 0 1\nvn 0 1 0\n"));
+  ASSERT_TRUE(cloud.has_normals());
+  EXPECT_EQ(cloud.N(1, 1), 1.0);
 }
 
 TEST_F(MeshIo, ObjNegativeIndicesAreRelative) {

@@ -760,3 +760,7 @@ def image_space_curvature(
     d = _ext.image_space_curvature(pos, nor, m, float(discontinuity_ratio), int(window),
                                    _threads(threads), None if device is None else int(device))
     return ImageCurvature(**d)
+
+from ._clouds import cloud_curvature, cloud_normals  # noqa: E402  (point clouds, docs/POINTS.md)
+
+__all__ += ["cloud_curvature", "cloud_normals"]

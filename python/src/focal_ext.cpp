@@ -23,6 +23,7 @@ void bind_meshes(nb::module_& m);
 void bind_render(nb::module_& m);
 void bind_image_space(nb::module_& m);
 void bind_tiles(nb::module_& m);
+void bind_clouds(nb::module_& m);
 }  // namespace focal_python
 
 namespace {
@@ -49,6 +50,7 @@ void translate_errors(const std::exception_ptr& p, void*) {
 
 }  // namespace
 
+
 NB_MODULE(_focal_ext, m) {
   m.doc() = "focal's C++ library (the focal package wraps it; use that).";
 
@@ -65,4 +67,5 @@ NB_MODULE(_focal_ext, m) {
   focal_python::bind_render(m);
   focal_python::bind_image_space(m);
   focal_python::bind_tiles(m);
+  focal_python::bind_clouds(m);
 }

@@ -113,6 +113,19 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
   out += '\n';
 }
 
+/// "x y z[ nx ny nz]\n": vertex i as OFF and point-cloud text write it (normals when `normals`).
+inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index i, bool normals) {
+  for (int c = 0; c < 3; ++c) {
+    if (c > 0) out += ' ';
+    append_number(out, mesh.V(i, c));
+  }
+  for (int c = 0; normals && c < 3; ++c) {
+    out += ' ';
+    append_number(out, mesh.N(i, c));
+  }
+  out += '\n';
+}
+
 /// STL welding (ReadOptions): `mesh` as the STL parsers return it, one vertex per corner in file
 /// order; replaces V by the welded vertices (first-appearance order), remaps F and fills
 /// Mesh::corner_vertex. tolerance 0: exactly equal coordinates (-0 == 0; non-finite corners stay
@@ -124,6 +137,8 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+/// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
+[[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
 
 // The same readers on the contents of a file already in memory (read_X(path) is

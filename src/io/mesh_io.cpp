@@ -15,8 +15,10 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::ply;
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".stl") return MeshFormat::stl;
+  if (ext == ".xyz" || ext == ".pts" || ext == ".txt" || ext == ".csv") return MeshFormat::xyz;
   io_detail::fail(path, "unknown mesh format '" + path.extension().string() +
-                            "' (expected .obj, .ply, .off or .stl)");
+                            "' (expected .obj, .ply, .off, .stl, or .xyz .pts .txt .csv for "
+                            "point clouds)");
 }
 
 Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
@@ -36,6 +38,8 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
       io_detail::weld_corners(mesh, options.weld_tolerance, options.weld);
       return mesh;
     }
+    case MeshFormat::xyz:
+      return io_detail::read_xyz(path);
   }
   io_detail::fail(path, "unknown mesh format");
 }
@@ -50,6 +54,9 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh) {
       return;
     case MeshFormat::off:
       write_off(path, mesh);
+      return;
+    case MeshFormat::xyz:
+      write_xyz(path, mesh);
       return;
     case MeshFormat::stl:
       break;

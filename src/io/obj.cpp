@@ -183,7 +183,12 @@ class ObjReader {
     mesh.V = Eigen::Map<const RowMatrixX3d>(positions_.data(), vertex_count, 3);
     const bool any_normal = std::any_of(corners_.begin(), corners_.end(),
                                         [](const Corner& c) { return c.normal >= 0; });
-    if (any_normal) mesh.N = vertex_normals(vertex_count);
+    if (any_normal) {
+      mesh.N = vertex_normals(vertex_count);
+    } else if (polygon_end_.empty() && vertex_count > 0 && normals_.size() == positions_.size()) {
+      // A point cloud (no faces) with one `vn` per `v`, as write_obj writes one: paired in order.
+      mesh.N = Eigen::Map<const RowMatrixX3d>(normals_.data(), vertex_count, 3);
+    }
 
     io_detail::TriangleCollector triangles;
     triangles.reserve(polygon_end_.size());

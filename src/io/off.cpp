@@ -245,15 +245,7 @@ void write_off(const std::filesystem::path& path, const Mesh& mesh) {
     out += normals ? "NOFF\n" : "OFF\n";
     out += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        if (c > 0) out += ' ';
-        io_detail::append_number(out, mesh.V(i, c));
-      }
-      for (int c = 0; normals && c < 3; ++c) {
-        out += ' ';
-        io_detail::append_number(out, mesh.N(i, c));
-      }
-      out += '\n';
+      io_detail::append_vertex_line(out, mesh, i, normals);
       sink.maybe_flush();
     }
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {

@@ -63,6 +63,11 @@ int main() {
   check(r.curvature.k1.size() == 12 && r.N.rows() == 12, "recommended: wrong shapes");
   const focal::FocalMeshes f = focal::focal_meshes(prepared.with_normals(r.N), r.curvature);
   check(f.gamma1.mesh.V.rows() == 12, "focal meshes: wrong shapes");
+  // The vertices as a point cloud (the kd-tree, nanoflann, is private to the library): exact
+  // with exact normals over the k nearest, as on the mesh.
+  const focal::CloudCurvature cloud =
+      focal::estimate_cloud_curvature(mesh.V, mesh.normals(), {.k = 5});
+  check((cloud.curvature.k1.array() - 1.0).abs().maxCoeff() <= kTolerance, "cloud: k1 != 1");
 
   // The library's errors cross the package boundary as focal::InvalidInput.
   focal::RowMatrixX3i bad = mesh.F;

@@ -40,6 +40,9 @@ struct Mesh {
   /// formats, whose vertices are the file's.
   Eigen::VectorXi corner_vertex;
 
+  /// A point cloud: vertices without faces (the cloud functions of points/, normals/ and
+  /// curvature/cloud_curvature.h take it).
+  [[nodiscard]] bool is_cloud() const { return F.rows() == 0 && V.rows() > 0; }
   [[nodiscard]] bool has_normals() const { return N.rows() == V.rows() && V.rows() > 0; }
   /// N as the functions taking optional normals want it: std::nullopt when N has 0 rows.
   [[nodiscard]] std::optional<NormalsRef> normals() const {

@@ -2,7 +2,9 @@
 /// \file mesh_io.h
 /// Reading and writing meshes and per-vertex tables.
 ///
-/// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary).
+/// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary), and
+/// point-cloud text (.xyz .pts .txt .csv: `x y z [nx ny nz]` per line, see docs/POINTS.md).
+/// A file without faces is a point cloud: Mesh::F has 0 rows (Mesh::is_cloud).
 /// Vertex order and count of indexed formats (OBJ, PLY, OFF) are preserved exactly; polygons are
 /// fan-triangulated and Mesh::face_source maps each triangle to its input polygon. STL has no
 /// shared vertices: corners at the same position are welded into one vertex (ReadOptions), the
@@ -29,9 +31,10 @@
 
 namespace focal {
 
-enum class MeshFormat { obj, ply, off, stl };
+enum class MeshFormat { obj, ply, off, stl, xyz };
 
-/// The format named by the file extension (case-insensitive .obj .ply .off .stl).
+/// The format named by the file extension (case-insensitive .obj .ply .off .stl; .xyz .pts .txt
+/// and .csv are point-cloud text, MeshFormat::xyz).
 /// \throw IoError for any other extension.
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
@@ -98,7 +101,12 @@ void write_obj(const std::filesystem::path& path, const Mesh& mesh);
 /// \throw InvalidInput for invalid arrays (see write_ply); IoError naming the path on failure.
 void write_off(const std::filesystem::path& path, const Mesh& mesh);
 
-/// Writes a mesh in the format named by the extension (.ply binary, .obj, .off).
+/// Writes V (and N when present) as point-cloud text: one `x y z [nx ny nz]` line per point,
+/// faces left out. \throw InvalidInput for invalid arrays; IoError naming the path on failure.
+void write_xyz(const std::filesystem::path& path, const Mesh& mesh);
+
+/// Writes a mesh in the format named by the extension (.ply binary, .obj, .off; .xyz and the
+/// other point-cloud text extensions: write_xyz).
 /// \throw IoError for .stl (it cannot keep shared vertices) and unknown extensions.
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh);
 

@@ -1,0 +1,63 @@
+#pragma once
+/// \file cloud_normals.h
+/// Normals of point clouds from positions and neighbourhoods (points/neighbours.h), and their
+/// consistent orientation.
+///
+/// - pca_normals: the direction of least variance of each point and its neighbours (Hoppe et al.,
+///   "Surface reconstruction from unorganized points", SIGGRAPH 1992): a line, not a side.
+/// - orient_normals_mst: one side for all, by a minimum spanning tree over the symmetrised
+///   neighbour graph with weights 1 - |n_i . n_j| (Hoppe et al. 1992; CGAL mst_orient_normals):
+///   the tree is grown from the point of largest z of each connected component, whose normal is
+///   turned to +z (outward there on a closed surface), and each point takes the side of its
+///   parent. Prim's algorithm with ties broken by index: deterministic.
+/// - orient_towards_viewpoint: each normal turned to face a viewpoint (scanner position).
+/// - cloud_normals: all of it, then jet normals (normals/jets.h) over the same neighbourhoods,
+///   which keep each PCA normal's side and are second-order accurate (PCA is first-order on
+///   uneven neighbourhoods).
+///
+/// Rows without a normal (fewer than 2 finite neighbours, non-finite position) are NaN.
+/// Results are gathered per point: identical for any thread count.
+#include <optional>
+
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
+
+namespace focal {
+
+/// #V x 3 unit normals by PCA over each point and its neighbours; the sign is arbitrary.
+/// \throw InvalidInput when the neighbourhoods do not have #V points.
+[[nodiscard]] RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours,
+                                       int threads = 0);
+
+/// Flips rows of N (in place) to one consistent side per connected component of the neighbour
+/// graph, as described above. NaN rows are left as they are and break the graph.
+/// Returns the number of components oriented. \throw InvalidInput when shapes differ.
+int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N);
+
+/// Flips rows of N (in place) so that each faces `viewpoint`: (viewpoint - V_i) . N_i >= 0.
+/// \throw InvalidInput when shapes differ or the viewpoint is not finite.
+void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, RowMatrixX3d& N);
+
+enum class CloudNormalMethod {
+  pca,  ///< PCA only
+  jet,  ///< PCA for the side, then a jet of `jet_degree` in the PCA frame (default)
+};
+
+struct CloudNormalOptions {
+  CloudNormalMethod method = CloudNormalMethod::jet;
+  /// 1 to 4: degree of the height polynomial of the jet normals. 3: over 16 neighbours, H errors
+  /// of the fit on them were those of exact normals within 5% on 6 of the 8 analytic clouds
+  /// (degree 2: up to 40% larger; docs/POINTS.md).
+  int jet_degree = 3;
+  /// Orientation: towards this point when given, else by the minimum spanning tree.
+  std::optional<Eigen::Vector3d> viewpoint{};
+  int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
+};
+
+/// Estimated and oriented normals of a cloud over the given neighbourhoods.
+/// \throw InvalidInput when the neighbourhoods do not have #V points or an option is out of
+/// range.
+[[nodiscard]] RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
+                                         const CloudNormalOptions& options = {});
+
+}  // namespace focal

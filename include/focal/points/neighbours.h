@@ -1,0 +1,38 @@
+#pragma once
+/// \file neighbours.h
+/// Neighbourhoods of point clouds: the k nearest neighbours or the neighbours within a radius of
+/// every point, from a kd-tree (nanoflann), as the same CSR lists (mesh/neighbourhood.h) that
+/// mesh k-rings are, so that everything after "neighbourhoods" is shared by meshes and clouds.
+///
+/// Each list is sorted by distance, ties broken by the smaller index, and never holds the point
+/// itself. Points with a NaN or infinite coordinate are left out of the tree: their lists are
+/// empty and they are in no list. Queries run in parallel and gather per point: the lists do not
+/// depend on the thread count. `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware
+/// threads.
+///
+/// A kNN neighbourhood adapts to the local density by itself (its radius is the distance to the
+/// k-th neighbour, about sqrt(k / (pi rho)) at density rho), which is why focal's cloud estimators
+/// default to kNN rather than to a fixed radius (docs/POINTS.md).
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
+
+namespace focal {
+
+/// The k nearest other points of every point (fewer where the cloud has fewer than k + 1 finite
+/// points). Exactly equal positions (duplicates) are neighbours at distance 0.
+/// \throw InvalidInput when k < 1, threads < 0 or the lists would not fit 32-bit offsets.
+[[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads = 0);
+
+/// Every other point within Euclidean distance `radius` (inclusive), at most `max_count` of them
+/// (the nearest; 0 = no limit).
+/// \throw InvalidInput when radius is not finite and positive, max_count < 0, threads < 0 or
+/// the lists would not fit 32-bit offsets.
+[[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count = 0,
+                                               int threads = 0);
+
+/// The mean over finite points of the distance to their nearest other point (0 when no point
+/// has a neighbour): the sampling spacing of a cloud, the scale of its class tolerances as the
+/// mean edge length is a mesh's.
+[[nodiscard]] double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours);
+
+}  // namespace focal

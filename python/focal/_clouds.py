@@ -1,0 +1,89 @@
+"""Point clouds: curvature and normals of points without connectivity.
+
+``focal.cloud_curvature(points, normals=None, k=16)`` takes what Open3D, trimesh or a scanner
+gives (``np.asarray(pcd.points)``, ``np.asarray(pcd.normals)``; ``trimesh.PointCloud.vertices``)
+and returns the same ``Curvature`` as ``focal.curvature`` on a mesh. ``focal.read_mesh`` reads a
+cloud file (PLY/OBJ without faces, .xyz .pts .txt .csv text) with ``F`` of shape ``(0, 3)``.
+See docs/POINTS.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from . import Curvature, InvalidInputError, _as_rows, _shape_error, _threads
+from . import _focal_ext as _ext
+
+
+def _cloud_arguments(points: Any, k: int, radius: Optional[float], threads: Optional[int]):
+    P = _as_rows(points, "points", np.float64)
+    if int(k) < 0:
+        raise InvalidInputError(f"k must be >= 0 (0: the default), got {k}")
+    r = 0.0 if radius is None else float(radius)
+    if radius is not None and not r > 0.0:
+        raise InvalidInputError(f"radius must be None or > 0, got {radius}")
+    return P, int(k), r, _threads(threads)
+
+
+def _viewpoint(viewpoint: Optional[Sequence[float]]):
+    return None if viewpoint is None else [float(x) for x in viewpoint]
+
+
+def cloud_curvature(
+    points: Any,
+    normals: Any = None,
+    *,
+    k: int = 16,
+    radius: Optional[float] = None,
+    normal_method: str = "jet",
+    viewpoint: Optional[Sequence[float]] = None,
+    solver: str = "closed-form",
+    threads: Optional[int] = None,
+) -> Curvature:
+    """Principal curvatures and directions, H and K of a point cloud, by the two-slit fit of the
+    normal rays of each point's neighbours (include/focal/curvature/cloud_curvature.h).
+
+    Parameters
+    ----------
+    points : (n, 3) positions. normals : (n, 3) outward normals (need not be unit), or None:
+        estimated (PCA, oriented by a minimum spanning tree or towards ``viewpoint``, then a
+        quadratic jet; ``normal_method="pca"`` stops after PCA).
+    k : neighbours per point (the k nearest; 0 = the library default, 16). radius : the
+        neighbours within this distance instead (at most 1024, the nearest).
+    viewpoint : (x, y, z) the scanner position: estimated normals face it.
+    solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
+    threads : worker threads; None: FOCAL_NUM_THREADS if set, else all. Results do not depend
+        on it.
+
+    Returns
+    -------
+    Curvature (as focal.curvature) with ``N`` the unit normals used. A sphere of radius r with
+    outward normals has k1 = k2 = +1/r. NaN and ``undefined`` where a point has no normal or
+    fewer than two usable neighbours.
+    """
+    P, k, r, t = _cloud_arguments(points, k, radius, threads)
+    N = None
+    if normals is not None:
+        N = _as_rows(normals, "normals", np.float64)
+        if N.shape[0] != P.shape[0]:
+            raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
+    d = _ext.cloud_curvature(P, N, k, r, normal_method, _viewpoint(viewpoint), solver, t)
+    return Curvature(**d)
+
+
+def cloud_normals(
+    points: Any,
+    *,
+    k: int = 16,
+    radius: Optional[float] = None,
+    normal_method: str = "jet",
+    viewpoint: Optional[Sequence[float]] = None,
+    threads: Optional[int] = None,
+) -> np.ndarray:
+    """(n, 3) unit normals of a point cloud, estimated and consistently oriented (as
+    cloud_curvature estimates them; include/focal/normals/cloud_normals.h). NaN rows where a
+    point has fewer than two neighbours."""
+    P, k, r, t = _cloud_arguments(points, k, radius, threads)
+    return _ext.cloud_normals(P, k, r, normal_method, _viewpoint(viewpoint), t)

@@ -1,0 +1,144 @@
+#include "focal/curvature/cloud_curvature.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "curvature/curvature_detail.h"
+#include "focal/core/error.h"
+#include "focal/points/neighbours.h"
+#include "mesh/prepared_detail.h"
+#include "normals/cloud_normals_detail.h"
+
+namespace focal {
+namespace {
+
+/// Radius neighbourhoods keep at most this many (the nearest): a radius far larger than the
+/// spacing would otherwise make the lists, and the fit, quadratic in the density.
+constexpr int kMaxRadiusNeighbours = 1024;
+
+/// The default's plan (cloud_curvature.h; measured in docs/POINTS.md): above this noise (median
+/// jet residual / mean spacing) positions are noisy and the neighbourhood grows by this factor
+/// (16 -> 64: on 10% noise, the H error of 64 neighbours was 1.2-9x below that of 16 on sphere,
+/// ellipsoid, torus and saddle; 2.2x above on the helix tube) ...
+constexpr double kNoisyPositions = 0.03;
+constexpr int kNoisyNeighbourFactor = 4;
+/// ... and the cloud's normals are used when their median angle to the jet normals is at most
+/// this many times the noise.
+constexpr double kFileAgreement = 2.5;
+
+void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o) {
+  if (o.k < 0) throw InvalidInput("cloud curvature: k must be >= 0, got " + std::to_string(o.k));
+  if (!(o.radius >= 0.0)) throw InvalidInput("cloud curvature: radius must be >= 0");
+  if (o.threads < 0) throw InvalidInput("cloud curvature: threads must be >= 0");
+  if (N && N->rows() != V.rows()) {
+    throw InvalidInput("cloud curvature: " + std::to_string(N->rows()) + " normals for " +
+                       std::to_string(V.rows()) + " points");
+  }
+}
+
+CloudNormalOptions normal_options(const CloudOptions& o) {
+  CloudNormalOptions normals = o.normals;
+  normals.threads = o.threads;
+  return normals;
+}
+
+/// Neighbours as given (k or radius), the cloud's normals or cloud_normals over them.
+CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
+                                const CloudOptions& options) {
+  CloudCurvature out;
+  out.neighbours = cloud_neighbourhoods(V, options);
+  out.spacing = mean_spacing(V, out.neighbours);
+  out.k = options.radius > 0.0 ? 0 : options.k;
+  out.file_normals_used = N.has_value();
+  out.normals_estimated = !N;
+  out.N = N ? RowMatrixX3d(*N) : cloud_normals(V, out.neighbours, normal_options(options));
+  return out;
+}
+
+double median_of(std::vector<double> values) {
+  std::erase_if(values, [](double x) { return !std::isfinite(x); });
+  if (values.empty()) return NAN;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+/// Median angle (radians) between the lines of N and M, where both are finite.
+double median_angle(NormalsRef N, const RowMatrixX3d& M) {
+  std::vector<double> angles(static_cast<std::size_t>(N.rows()));
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    const double c = std::abs(N.row(i).normalized().dot(M.row(i)));
+    angles[static_cast<std::size_t>(i)] = std::acos(std::min(1.0, c));
+  }
+  return median_of(std::move(angles));
+}
+
+/// The default's plan (cloud_curvature.h, steps 1-3).
+CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
+                             const CloudOptions& options) {
+  CloudCurvature out;
+  out.k = default_cloud_neighbours;
+  out.neighbours = nearest_neighbours(V, out.k, options.threads);
+  out.spacing = mean_spacing(V, out.neighbours);
+  CloudNormalOptions normals = normal_options(options);
+  JetNormals jets = detail::cloud_jets(V, out.neighbours, normals);
+  out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
+  if (out.noise > kNoisyPositions) {
+    out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
+    out.neighbours = nearest_neighbours(V, out.k, options.threads);
+    normals.jet_degree = 2;
+    jets = detail::cloud_jets(V, out.neighbours, normals);
+  }
+  // Without jets (CloudNormalMethod::pca) there is no noise to judge by: the file's are kept.
+  // 1e-9 rad: exact normals of an exactly fitted cloud (noise 0) still agree.
+  out.file_normals_used = N && (!std::isfinite(out.noise) ||
+                                median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
+  out.normals_estimated = !out.file_normals_used;
+  out.N = std::move(jets.N);
+  if (N && !out.file_normals_used) {
+    for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+      if (out.N.row(i).dot(N->row(i)) < 0.0) out.N.row(i) *= -1.0;  // the file's side
+    }
+  }
+  if (out.file_normals_used) out.N = *N;
+  return out;
+}
+
+}  // namespace
+
+Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options) {
+  if (options.k < 0 || !(options.radius >= 0.0) || options.threads < 0) {
+    throw InvalidInput("cloud neighbourhoods: k, radius and threads must be >= 0");
+  }
+  if (options.radius > 0.0) {
+    return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, options.threads);
+  }
+  const int k = options.k > 0 ? options.k : default_cloud_neighbours;
+  return nearest_neighbours(V, k, options.threads);
+}
+
+CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
+                                        const CloudOptions& options) {
+  validate(V, N, options);
+  CloudCurvature out = options.k == 0 && options.radius == 0.0 ? adaptive_plan(V, N, options)
+                                                               : given_neighbours(V, N, options);
+  std::vector<char> ok;
+  out.N = detail::unit_rows(out.N, ok, options.threads);
+  CurvatureOptions fit;
+  fit.solver = options.solver;
+  fit.levenberg_marquardt = options.levenberg_marquardt;
+  fit.zero_tolerance = options.zero_tolerance;
+  fit.umbilic_tolerance = options.umbilic_tolerance;
+  fit.threads = options.threads;
+  detail::validate_curvature_options(fit);
+  // A spacing of 0 (a single point, or all duplicates) would make every |k| "not zero"; 1 keeps
+  // the tolerance finite, and such points are undefined anyway (fewer than two rays).
+  const double scale = out.spacing > 0.0 ? out.spacing : 1.0;
+  out.curvature = detail::fit_vertices({V, out.N, ok, out.neighbours, scale}, fit);
+  return out;
+}
+
+}  // namespace focal

@@ -1,0 +1,164 @@
+#include "focal/normals/cloud_normals.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/parallel.h"
+#include "focal/core/error.h"
+#include "focal/normals/jets.h"
+#include "normals/cloud_normals_detail.h"
+#include "normals/jets_detail.h"
+
+namespace focal {
+namespace {
+
+void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* what) {
+  if (neighbours.vertex_count() != V.rows()) {
+    throw InvalidInput(std::string(what) + ": the neighbourhoods have " +
+                       std::to_string(neighbours.vertex_count()) + " points, the cloud " +
+                       std::to_string(V.rows()));
+  }
+}
+
+/// The neighbour graph made symmetric (j in i's list or i in j's), as CSR, each edge once per
+/// direction, lists sorted. Built in place in one flat array (a vector per point cost 200 bytes
+/// per point more at 1M points).
+Neighbourhoods symmetric(const Neighbourhoods& nb) {
+  const int n = nb.vertex_count();
+  std::vector<std::int64_t> start(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    for (const int* j = nb.begin(i); j != nb.end(i); ++j) ++start[i + 1], ++start[*j + 1];
+  }
+  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<int> both(static_cast<std::size_t>(start[n]));
+  std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+  for (int i = 0; i < n; ++i) {
+    for (const int* j = nb.begin(i); j != nb.end(i); ++j) {
+      both[static_cast<std::size_t>(fill[i]++)] = *j;
+      both[static_cast<std::size_t>(fill[*j]++)] = i;
+    }
+  }
+  Neighbourhoods out;
+  out.offsets.resize(n + 1);
+  out.offsets[0] = 0;
+  std::int64_t kept = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto first = both.begin() + start[i], last = both.begin() + start[i + 1];
+    std::sort(first, last);
+    const auto end = std::unique(first, last);
+    std::copy(first, end, both.begin() + kept);  // leftwards: the destination starts before first
+    kept += end - first;
+    out.offsets[i + 1] = static_cast<int>(kept);
+  }
+  out.indices = Eigen::Map<const Eigen::VectorXi>(both.data(), static_cast<Eigen::Index>(kept));
+  return out;
+}
+
+}  // namespace
+
+RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours, int threads) {
+  check_sizes(V, neighbours, "pca_normals");
+  RowMatrixX3d N(V.rows(), 3);
+  detail::parallel_for(V.rows(), threads, [&](std::int64_t i64) {
+    const int i = static_cast<int>(i64);
+    N.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+    if (neighbours.size(i) < 2 || !V.row(i).allFinite()) return;
+    // Offsets from the point itself (not the centroid first): the covariance about the mean is
+    // the same, and the small offsets keep it accurate far from the origin.
+    const Eigen::RowVector3d p = V.row(i);
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+    const double count = neighbours.size(i) + 1.0;
+    for (const int* j = neighbours.begin(i); j != neighbours.end(i); ++j) {
+      const Eigen::RowVector3d q = V.row(*j) - p;
+      sum += q;
+      moment += q.transpose() * q;
+    }
+    const Eigen::Matrix3d covariance = moment / count - sum.transpose() * sum / (count * count);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(covariance);
+    const Eigen::Vector3d n = eig.eigenvectors().col(0);  // of the smallest eigenvalue
+    if (n.allFinite() && n.norm() > 0.0) N.row(i) = n.normalized().transpose();
+  });
+  return N;
+}
+
+int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
+  check_sizes(V, neighbours, "orient_normals_mst");
+  if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
+  const Neighbourhoods graph = symmetric(neighbours);
+  const auto n = static_cast<int>(V.rows());
+  const auto usable = [&](int i) { return N.row(i).allFinite() && V.row(i).allFinite(); };
+  // Seeds in order of falling z (ties by index): the first unvisited point of a component is
+  // its highest.
+  std::vector<int> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return V(a, 2) > V(b, 2); });
+  std::vector<char> done(static_cast<std::size_t>(n), 0);
+  using Edge = std::tuple<double, int, int>;  // weight, point, parent: ties by point index
+  std::priority_queue<Edge, std::vector<Edge>, std::greater<>> heap;
+  int components = 0;
+  for (const int seed : order) {
+    if (done[static_cast<std::size_t>(seed)] || !usable(seed)) continue;
+    ++components;
+    if (N(seed, 2) < 0.0) N.row(seed) *= -1.0;
+    heap.emplace(0.0, seed, seed);
+    while (!heap.empty()) {
+      const auto [weight, i, parent] = heap.top();
+      heap.pop();
+      if (done[static_cast<std::size_t>(i)]) continue;
+      done[static_cast<std::size_t>(i)] = 1;
+      if (N.row(i).dot(N.row(parent)) < 0.0) N.row(i) *= -1.0;
+      for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
+        if (done[static_cast<std::size_t>(*j)] || !usable(*j)) continue;
+        heap.emplace(1.0 - std::abs(N.row(i).dot(N.row(*j))), *j, i);
+      }
+    }
+  }
+  return components;
+}
+
+void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, RowMatrixX3d& N) {
+  if (N.rows() != V.rows()) throw InvalidInput("orient_towards_viewpoint: N does not have #V rows");
+  if (!viewpoint.allFinite()) throw InvalidInput("orient_towards_viewpoint: viewpoint not finite");
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if ((viewpoint.transpose() - V.row(i)).dot(N.row(i)) < 0.0) N.row(i) *= -1.0;
+  }
+}
+
+JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                              const CloudNormalOptions& options) {
+  check_sizes(V, neighbours, "cloud_normals");
+  if (options.jet_degree < 1 || options.jet_degree > 4) {
+    throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
+                       std::to_string(options.jet_degree));
+  }
+  if (options.threads < 0) throw InvalidInput("cloud_normals: threads must be >= 0");
+  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  if (options.viewpoint) {
+    orient_towards_viewpoint(V, *options.viewpoint, N);
+  } else {
+    orient_normals_mst(V, neighbours, N);
+  }
+  if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
+  // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
+  // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
+  const JetOptions jet{
+      .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
+  return detail::jet_normals_from(V, neighbours, N, jet);
+}
+
+RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
+                           const CloudNormalOptions& options) {
+  return detail::cloud_jets(V, neighbours, options).N;
+}
+
+}  // namespace focal

@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# Tests of the `focal` command on point clouds (files without faces): reading (.xyz text, PLY and
+# OBJ without faces), `info`, `curvature`, `focal-mesh`, `normals`, `generate --cloud`, and the
+# error contract (what, where, exit 2, no output written).
+#
+# Usage: cloud_cli_test.sh FOCAL_BINARY SCRATCH_DIR. Prints one line per check, then
+# "N passed, M failed"; exits 1 when any check failed. The helpers follow cli_test.sh's.
+# shellcheck disable=SC2016
+set -euo pipefail
+[[ $# -eq 2 ]] || { echo "usage: $0 FOCAL_BINARY SCRATCH_DIR" >&2; exit 2; }
+FOCAL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+SCRATCH=$2
+[[ -n $SCRATCH && $SCRATCH != / ]] || { echo "refusing to use '$SCRATCH'" >&2; exit 2; }
+rm -rf "$SCRATCH" && mkdir -p "$SCRATCH" && cd "$SCRATCH"
+OUT=$PWD/.stdout
+ERR=$PWD/.stderr
+passed=0
+failed=0
+check() {
+  local name=$1
+  shift
+  if "$@"; then printf 'ok    %s\n' "$name"; passed=$((passed + 1)); else
+    printf 'FAIL  %s -- %s\n' "$name" "$(head -c 300 "$ERR")"; failed=$((failed + 1)); fi
+}
+rc=0
+run() { rc=0; "$FOCAL" "$@" >"$OUT" 2>"$ERR" || rc=$?; }
+# expect_error NAME TEXT OUTPUT ARGS...: exit 2, an `Error:` line containing TEXT, no OUTPUT.
+expect_error() {
+  local name=$1 text=$2 output=$3
+  shift 3
+  run "$@"
+  check "$name" bash -c '[[ $1 -eq 2 && ! -e $2 ]] && grep "^Error: " "$3" | grep -qF -- "$4"' \
+    _ "$rc" "$output" "$ERR" "$text"
+}
+# max_dev FILE COLUMN TARGET: max |x - TARGET| of a CSV column; "bad" on NaN or no rows.
+max_dev() {
+  awk -F, -v c="$2" -v t="$3" 'NR > 1 { rows++; x = $c; if (x !~ /^[-+0-9.eE]+$/) bad = 1;
+    d = x - t; if (d < 0) d = -d; if (d > m) m = d }
+    END { if (bad || rows == 0) print "bad"; else printf "%.3g\n", m }' "$1"
+}
+below() { awk -v x="$1" -v b="$2" 'BEGIN { exit !(x ~ /^[-+0-9.eE]+$/ && x + 0 <= b + 0) }'; }
+
+# A unit sphere sampled as a cloud with exact normals: the fit is exact (k1 = k2 = 1).
+run generate sphere --cloud --vertices 2000 -o sphere.xyz --truth sphere-truth.csv
+check "generate --cloud writes an .xyz cloud" bash -c '[[ $1 -eq 0 && $(wc -l <sphere.xyz) -gt 1500 ]]' _ "$rc"
+run info sphere.xyz
+check "info says point cloud" grep -q "point cloud" "$OUT"
+check "info has no unreferenced-vertex line for clouds" bash -c '! grep -q unreferenced "$1"' _ "$OUT"
+run curvature sphere.xyz -o sphere.csv
+check "curvature on a cloud: exit 0, no warning" bash -c '[[ $1 -eq 0 && ! -s $2 ]]' _ "$rc" "$ERR"
+check "sphere cloud with exact normals: k1 = 1 to 1e-9" below "$(max_dev sphere.csv 1 1)" 1e-9
+check "sphere cloud with exact normals: k2 = 1 to 1e-9" below "$(max_dev sphere.csv 2 1)" 1e-9
+
+# Without normals (estimated, MST-oriented), and the same points as PLY and OBJ without faces.
+cut -d' ' -f1-3 sphere.xyz >bare.xyz
+run curvature bare.xyz -o bare.csv
+# Jet normals over 16 neighbours at 2000 points: measured max |H - 1| 0.00026; bound 0.01.
+check "no normals: H = 1 within 0.01 (normals estimated and oriented outward)" \
+  below "$(max_dev bare.csv 3 1)" 0.01
+run curvature bare.xyz -o bare.ply --k 24
+check "curvature -o cloud.ply: exit 0" test "$rc" -eq 0
+run curvature bare.ply -o from-ply.csv --k 24
+check "a PLY without faces is a cloud: H = 1 within 0.01" below "$(max_dev from-ply.csv 3 1)" 0.01
+awk '{ print "v", $1, $2, $3 } END { }' sphere.xyz >s.obj
+awk '{ print "vn", $4, $5, $6 }' sphere.xyz >>s.obj
+run curvature s.obj -o obj.csv
+check "OBJ v/vn without faces: normals paired in order, k1 = 1 to 1e-9" below "$(max_dev obj.csv 1 1)" 1e-9
+{ echo "x,y,z,nx,ny,nz"; tr ' ' ',' <sphere.xyz; } >s.csv
+run curvature s.csv -o csv-out.csv
+check "comma-separated text with a header: k1 = 1 to 1e-9" below "$(max_dev csv-out.csv 1 1)" 1e-9
+run focal-mesh bare.xyz -o fm
+check "focal-mesh on a cloud writes two focal point clouds" \
+  bash -c '[[ $1 -eq 0 && -s fm.focal1.ply && -s fm.focal2.ply ]]' _ "$rc"
+run normals bare.xyz -o normals.xyz
+check "normals: estimated normals point outward on the sphere" \
+  bash -c '[[ $1 -eq 0 ]] && awk "{ if (\$1*\$4 + \$2*\$5 + \$3*\$6 <= 0.99) bad++ } END { exit bad > 0 }" normals.xyz' _ "$rc"
+run normals bare.xyz -o inward.xyz --viewpoint 0,0,0
+check "normals --viewpoint 0,0,0 (the centre): every normal inward" \
+  bash -c '[[ $1 -eq 0 ]] && awk "{ if (\$1*\$4 + \$2*\$5 + \$3*\$6 >= 0) bad++ } END { exit bad > 0 }" inward.xyz' _ "$rc"
+
+# Errors: what and where, exit 2, nothing written.
+printf '1 2 3\n4 5 6\n7 8\n' >short.xyz
+expect_error "a short row: line named" "line 3" short.csv curvature short.xyz -o short.csv
+printf '1 2 3\n4 5 x\n' >word.xyz
+expect_error "a word where a number belongs: line and column named" "line 2: column 3" word.csv curvature word.xyz -o word.csv
+printf '# nothing\n' >empty.xyz
+expect_error "no points" "no points" empty.csv curvature empty.xyz -o empty.csv
+printf '1 2\n3 4\n' >two.xyz
+expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two.csv
+printf 'k1,k2,H\n1,2,3\n' >table.csv
+expect_error "a CSV whose header names no x, y, z: an error, not positions" "names no x, y, z" t.csv curvature table.csv -o t.csv
+expect_error "--rings on a cloud" "applies to meshes" r.csv curvature bare.xyz -o r.csv --rings 2
+expect_error "render on a cloud: not a mesh" "point cloud" r.png render bare.xyz -o r.png
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]

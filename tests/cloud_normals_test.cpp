@@ -1,0 +1,113 @@
+#include "focal/normals/cloud_normals.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "focal/core/error.h"
+#include "focal/points/neighbours.h"
+#include "test_clouds.h"
+
+namespace focal {
+namespace {
+
+/// Points whose estimated normal points against the exact outward one.
+int flipped(const RowMatrixX3d& N, const RowMatrixX3d& exact) {
+  int count = 0;
+  for (Eigen::Index i = 0; i < N.rows(); ++i) count += N.row(i).dot(exact.row(i)) < 0.0 ? 1 : 0;
+  return count;
+}
+
+/// The largest angle (radians) between estimated and exact normals, sides ignored.
+double worst_angle(const RowMatrixX3d& N, const RowMatrixX3d& exact) {
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    worst = std::max(worst, std::acos(std::min(1.0, std::abs(N.row(i).dot(exact.row(i))))));
+  }
+  return worst;
+}
+
+TEST(PcaNormals, ExactOnATiltedPlane) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, -2.0, 0.5).normalized();
+  const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+  RowMatrixX3d V(500, 3);
+  for (int i = 0; i < 500; ++i) V.row(i) = (u(rng) * a + u(rng) * b).transpose();
+  const RowMatrixX3d N = pca_normals(V, nearest_neighbours(V, 10));
+  for (int i = 0; i < 500; ++i) EXPECT_NEAR(std::abs(N.row(i).dot(n.transpose())), 1.0, 1e-12);
+}
+
+// Hoppe et al.'s MST orientation on unoriented samples of the closed analytic surfaces, two
+// densities and two seeds: no normal may point inward.
+TEST(OrientNormals, NoFlippedNormalOnClosedSurfaces) {
+  for (SurfaceKind kind :
+       {SurfaceKind::sphere, SurfaceKind::torus, SurfaceKind::ellipsoid, SurfaceKind::pear}) {
+    for (int n : {1000, 5000}) {
+      for (std::uint64_t seed : {1, 2}) {
+        const AnalyticSurface s = test::cloud_of(kind, n, seed);
+        const Neighbourhoods nb = nearest_neighbours(s.mesh.V, 16);
+        RowMatrixX3d pca = pca_normals(s.mesh.V, nb);
+        EXPECT_EQ(orient_normals_mst(s.mesh.V, nb, pca), 1);
+        EXPECT_EQ(flipped(pca, s.mesh.N), 0) << surface_name(kind) << " n=" << n;
+        const RowMatrixX3d jet = cloud_normals(s.mesh.V, nb);
+        EXPECT_EQ(flipped(jet, s.mesh.N), 0) << surface_name(kind) << " n=" << n;
+      }
+    }
+  }
+}
+
+TEST(OrientNormals, RandomlyFlippedExactNormalsAreRestoredPerComponent) {
+  AnalyticSurface a = test::cloud_of(SurfaceKind::sphere, 800);
+  // Two spheres 10 apart: two components, each oriented from its own highest point.
+  RowMatrixX3d V(2 * a.mesh.V.rows(), 3), exact(V.rows(), 3);
+  V << a.mesh.V, a.mesh.V.rowwise() + Eigen::RowVector3d(10.0, 0.0, 0.0);
+  exact << a.mesh.N, a.mesh.N;
+  RowMatrixX3d N = exact;
+  std::mt19937_64 rng(3);
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    if (rng() % 2) N.row(i) *= -1.0;
+  }
+  EXPECT_EQ(orient_normals_mst(V, nearest_neighbours(V, 12), N), 2);
+  EXPECT_EQ(N, exact);
+}
+
+TEST(OrientNormals, TowardsAViewpoint) {
+  const AnalyticSurface s = test::cloud_of(SurfaceKind::sphere, 500);
+  RowMatrixX3d N = s.mesh.N;
+  orient_towards_viewpoint(s.mesh.V, Eigen::Vector3d::Zero(), N);  // the centre: all inward
+  EXPECT_EQ(flipped(N, s.mesh.N), N.rows());
+  const RowMatrixX3d outward = cloud_normals(s.mesh.V, nearest_neighbours(s.mesh.V, 16),
+                                             {.viewpoint = Eigen::Vector3d(0.0, 0.0, 0.0)});
+  EXPECT_EQ(flipped(outward, s.mesh.N), N.rows());
+  EXPECT_THROW(orient_towards_viewpoint(s.mesh.V, Eigen::Vector3d(NAN, 0, 0), N), InvalidInput);
+}
+
+// Jets (degree 2) over the kNN are more accurate than PCA, whose normal tilts with any
+// asymmetry of the neighbourhood: measured worst angles on the 4000-point ellipsoid, seeds 1-2,
+// PCA 0.037-0.045 rad, jets 0.0059-0.0060 rad (a factor 6-7); asserted: jets 3x better.
+TEST(CloudNormals, JetsBeatPcaOnAnEllipsoid) {
+  for (std::uint64_t seed : {1, 2}) {
+    const AnalyticSurface s = test::cloud_of(SurfaceKind::ellipsoid, 4000, seed);
+    const Neighbourhoods nb = nearest_neighbours(s.mesh.V, 16);
+    const double pca =
+        worst_angle(cloud_normals(s.mesh.V, nb, {.method = CloudNormalMethod::pca}), s.mesh.N);
+    const double jet = worst_angle(cloud_normals(s.mesh.V, nb), s.mesh.N);
+    EXPECT_LT(3.0 * jet, pca);
+  }
+}
+
+TEST(CloudNormals, RejectInvalidInput) {
+  const AnalyticSurface s = test::cloud_of(SurfaceKind::sphere, 100);
+  const Neighbourhoods nb = nearest_neighbours(s.mesh.V, 8);
+  const RowMatrixX3d other = s.mesh.V.topRows(10);
+  EXPECT_THROW((void)pca_normals(other, nb), InvalidInput);
+  EXPECT_THROW((void)cloud_normals(s.mesh.V, nb, {.jet_degree = 5}), InvalidInput);
+  RowMatrixX3d short_normals = RowMatrixX3d::Zero(3, 3);
+  EXPECT_THROW((void)orient_normals_mst(s.mesh.V, nb, short_normals), InvalidInput);
+}
+
+}  // namespace
+}  // namespace focal

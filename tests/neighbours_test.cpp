@@ -1,0 +1,122 @@
+#include "focal/points/neighbours.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "focal/core/error.h"
+
+namespace focal {
+namespace {
+
+RowMatrixX3d random_cloud(int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  RowMatrixX3d V(n, 3);
+  for (int i = 0; i < n; ++i) V.row(i) << u(rng), u(rng), u(rng);
+  return V;
+}
+
+/// A 12 x 12 x 12 integer lattice: every point has many neighbours at exactly equal distances.
+RowMatrixX3d lattice() {
+  RowMatrixX3d V(12 * 12 * 12, 3);
+  int r = 0;
+  for (int x = 0; x < 12; ++x) {
+    for (int y = 0; y < 12; ++y) {
+      for (int z = 0; z < 12; ++z) V.row(r++) << x, y, z;
+    }
+  }
+  return V;
+}
+
+/// The expected list: all other finite points by (squared distance, index), cut at k or radius.
+std::vector<int> brute_force(const RowMatrixX3d& V, int i, int k, double radius) {
+  std::vector<std::pair<double, int>> all;
+  for (int j = 0; j < V.rows(); ++j) {
+    if (j == i || !V.row(j).allFinite()) continue;
+    const double d = (V.row(j) - V.row(i)).squaredNorm();
+    if (radius > 0.0 && d > radius * radius) continue;
+    all.emplace_back(d, j);
+  }
+  std::sort(all.begin(), all.end());
+  std::vector<int> out;
+  for (const auto& [d, j] : all) {
+    if (k > 0 && static_cast<int>(out.size()) == k) break;
+    out.push_back(j);
+  }
+  return out;
+}
+
+void expect_lists(const Neighbourhoods& nb, const RowMatrixX3d& V, int k, double radius) {
+  ASSERT_EQ(nb.vertex_count(), V.rows());
+  for (int i = 0; i < V.rows(); ++i) {
+    const std::vector<int> got(nb.begin(i), nb.end(i));
+    ASSERT_EQ(got, brute_force(V, i, k, radius)) << "point " << i;
+  }
+}
+
+TEST(NearestNeighbours, MatchBruteForceWithTiesBrokenByIndex) {
+  const RowMatrixX3d random = random_cloud(1500, 7);
+  expect_lists(nearest_neighbours(random, 10, 2), random, 10, 0.0);
+  // On the lattice the 6th, 18th, ... neighbours tie with others at the same distance.
+  const RowMatrixX3d grid = lattice();
+  for (int k : {1, 6, 7, 20}) expect_lists(nearest_neighbours(grid, k, 2), grid, k, 0.0);
+}
+
+TEST(NearestNeighbours, SameForAnyThreadCount) {
+  const RowMatrixX3d V = random_cloud(20000, 3);
+  const Neighbourhoods one = nearest_neighbours(V, 16, 1);
+  const Neighbourhoods two = nearest_neighbours(V, 16, 2);
+  const Neighbourhoods five = nearest_neighbours(V, 16, 5);
+  EXPECT_EQ(one.offsets, two.offsets);
+  EXPECT_EQ(one.indices, two.indices);
+  EXPECT_EQ(one.indices, five.indices);
+}
+
+TEST(NearestNeighbours, NonFinitePointsAreLeftOutAndFewPointsGiveShortLists) {
+  RowMatrixX3d V = random_cloud(50, 1);
+  V(3, 1) = NAN;
+  V(10, 0) = INFINITY;
+  const Neighbourhoods nb = nearest_neighbours(V, 60, 1);
+  EXPECT_EQ(nb.size(3), 0);
+  EXPECT_EQ(nb.size(10), 0);
+  for (int i = 0; i < 50; ++i) {
+    if (i == 3 || i == 10) continue;
+    EXPECT_EQ(nb.size(i), 47);  // every other finite point
+    for (const int* j = nb.begin(i); j != nb.end(i); ++j) EXPECT_TRUE(*j != 3 && *j != 10);
+  }
+  const RowMatrixX3d single = RowMatrixX3d::Zero(1, 3);
+  EXPECT_EQ(nearest_neighbours(single, 4).size(0), 0);
+  EXPECT_EQ(nearest_neighbours(RowMatrixX3d(0, 3), 4).vertex_count(), 0);
+}
+
+TEST(RadiusNeighbours, MatchBruteForceAndLimit) {
+  const RowMatrixX3d V = random_cloud(1500, 11);
+  expect_lists(radius_neighbours(V, 0.15, 0, 2), V, 0, 0.15);
+  expect_lists(radius_neighbours(V, 0.3, 12, 2), V, 12, 0.3);
+  // The radius is inclusive: lattice neighbours at distance exactly 1.
+  const RowMatrixX3d grid = lattice();
+  expect_lists(radius_neighbours(grid, 1.0, 0, 2), grid, 0, 1.0);
+}
+
+TEST(Neighbours, MeanSpacingOfALattice) {
+  const RowMatrixX3d grid = lattice() * 0.5;
+  EXPECT_DOUBLE_EQ(mean_spacing(grid, nearest_neighbours(grid, 3)), 0.5);
+}
+
+TEST(Neighbours, RejectInvalidArguments) {
+  const RowMatrixX3d V = random_cloud(10, 1);
+  EXPECT_THROW((void)nearest_neighbours(V, 0), InvalidInput);
+  EXPECT_THROW((void)nearest_neighbours(V, 4, -1), InvalidInput);
+  EXPECT_THROW((void)radius_neighbours(V, 0.0), InvalidInput);
+  EXPECT_THROW((void)radius_neighbours(V, NAN), InvalidInput);
+  EXPECT_THROW((void)radius_neighbours(V, INFINITY), InvalidInput);
+  EXPECT_THROW((void)radius_neighbours(V, 1.0, -1), InvalidInput);
+}
+
+}  // namespace
+}  // namespace focal
