@@ -563,7 +563,8 @@ TEST(ImageSpaceTripletKernel, InDoubleItIsTriangleCurvature) {
 constexpr double kShapeRoundingBound = 2.0;
 
 struct RoundingBound {
-  double H, k;  ///< the largest float rounding of H (and K / |k|) and of k1, k2
+  double H, k;     ///< the largest float rounding of H (and K / |k|) and of k1, k2
+  double R = 0.0;  ///< of R, the square root's argument (dR)
 };
 
 /// The rounding bound of a characteristic equation whose shape operator (in exact arithmetic) is
@@ -575,7 +576,7 @@ RoundingBound rounding_bound(const triplet::Mat2<double>& m, double k_max, doubl
   const double R = 0.25 * (m.a - m.d) * (m.a - m.d) + m.b * m.c;
   const double root_error =
       R > 0.0 ? std::min(dR / (2.0 * std::sqrt(R)), std::sqrt(dR)) : std::sqrt(dR);
-  return {dM, dM + root_error};
+  return {dM, dM + root_error, dR};
 }
 
 RoundingBound triplet_rounding(const triplet::TripletSolution<double>& d, double h) {
@@ -621,24 +622,31 @@ TripletPair solve_both(const image_kernel::ImageView& v, int x, int y) {
   return {triplet::solve_triplet(pf, nf), triplet::solve_triplet(pd, nd)};
 }
 
+/// Calls visit(x, y, pair) for every triplet of g whose three pixels are covered.
+template <class Visit>
+void for_each_triplet(const GBuffer& g, Visit visit) {
+  const image_kernel::ImageView v = detail::view_of(g);
+  for (int y = 0; y + 1 < g.height; ++y) {
+    for (int x = 0; x + 1 < g.width; ++x) {
+      if (image_kernel::covered(v, x, y) && image_kernel::covered(v, x + 1, y) &&
+          image_kernel::covered(v, x, y + 1)) {
+        visit(x, y, solve_both(v, x, y));
+      }
+    }
+  }
+}
+
 /// The largest ratio of float rounding to its bound over the valid triplets of g: the H error
 /// over RoundingBound::H and the k1, k2 errors over RoundingBound::k.
 double max_rounding_ratio(const GBuffer& g) {
-  const image_kernel::ImageView v = detail::view_of(g);
   double worst = 0.0;
-  for (int y = 0; y + 1 < g.height; ++y) {
-    for (int x = 0; x + 1 < g.width; ++x) {
-      if (!image_kernel::covered(v, x, y) || !image_kernel::covered(v, x + 1, y) ||
-          !image_kernel::covered(v, x, y + 1)) {
-        continue;
-      }
-      const auto [f, d] = solve_both(v, x, y);
-      if (!f.valid || !d.valid) continue;
-      const RoundingBound b = triplet_rounding(d, triplet_edge(g, x, y));
-      worst = std::max({worst, std::abs(f.H - d.H) / b.H, std::abs(f.k1 - d.k1) / b.k,
-                        std::abs(f.k2 - d.k2) / b.k});
-    }
-  }
+  for_each_triplet(g, [&](int x, int y, const TripletPair& p) {
+    const auto& [f, d] = p;
+    if (!f.valid || !d.valid) return;
+    const RoundingBound b = triplet_rounding(d, triplet_edge(g, x, y));
+    worst = std::max({worst, std::abs(f.H - d.H) / b.H, std::abs(f.k1 - d.k1) / b.k,
+                      std::abs(f.k2 - d.k2) / b.k});
+  });
   return worst;
 }
 
@@ -788,27 +796,13 @@ TEST(ImageSpaceFloat, TripletRoundingIsWithinItsErrorBound) {
 /// window, and its R is unknown here, so the root takes the umbilic's sqrt(dR). Infinite where the
 /// double solution is invalid (the comparison then checks validity only).
 std::vector<RoundingBound> field_bounds(const GBuffer& g, int window) {
-  const image_kernel::ImageView v = detail::view_of(g);
   const std::size_t n = g.mask.size();
-  std::vector<RoundingBound> own(n, {INFINITY, INFINITY});
-  std::vector<double> dR(n, 0.0);
-  for (int y = 0; y + 1 < g.height; ++y) {
-    for (int x = 0; x + 1 < g.width; ++x) {
-      if (!image_kernel::covered(v, x, y) || !image_kernel::covered(v, x + 1, y) ||
-          !image_kernel::covered(v, x, y + 1)) {
-        continue;
-      }
-      const auto [f, d] = solve_both(v, x, y);
-      if (!d.valid) continue;
-      own[pixel(g, x, y)] = triplet_rounding(d, triplet_edge(g, x, y));
-      const double dM = own[pixel(g, x, y)].H;
-      const triplet::Mat2<double>& m = d.shape;
-      dR[pixel(g, x, y)] =
-          (std::abs(m.a - m.d) + std::abs(m.b) + std::abs(m.c)) * dM + 2.0 * dM * dM;
-    }
-  }
+  std::vector<RoundingBound> own(n, {INFINITY, INFINITY, 0.0});
+  for_each_triplet(g, [&](int x, int y, const TripletPair& p) {
+    if (p.d.valid) own[pixel(g, x, y)] = triplet_rounding(p.d, triplet_edge(g, x, y));
+  });
   if (window == 0) return own;
-  std::vector<RoundingBound> out(n, {INFINITY, INFINITY});
+  std::vector<RoundingBound> out(n, {INFINITY, INFINITY, 0.0});
   for (int y = 0; y < g.height; ++y) {
     for (int x = 0; x < g.width; ++x) {
       double dM = 0.0, worst_dR = 0.0;
@@ -816,10 +810,10 @@ std::vector<RoundingBound> field_bounds(const GBuffer& g, int window) {
         for (int i = std::max(0, x - window); i <= std::min(g.width - 1, x + window); ++i) {
           if (std::isinf(own[pixel(g, i, j)].H)) continue;
           dM = std::max(dM, own[pixel(g, i, j)].H);
-          worst_dR = std::max(worst_dR, dR[pixel(g, i, j)]);
+          worst_dR = std::max(worst_dR, own[pixel(g, i, j)].R);
         }
       }
-      if (dM > 0.0) out[pixel(g, x, y)] = {dM, dM + std::sqrt(worst_dR)};
+      if (dM > 0.0) out[pixel(g, x, y)] = {dM, dM + std::sqrt(worst_dR), worst_dR};
     }
   }
   return out;
