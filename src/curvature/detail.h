@@ -59,4 +59,24 @@ inline void store_vertex(CurvatureResult& r, Eigen::Index i, const TangentFrame&
   r.point_class[i] = static_cast<std::uint8_t>(classify(p.k1, p.k2, tol.zero, tol.umbilic));
 }
 
+/// Vertices of isolated triangles (each corner in no other face) get `undefined` when their
+/// normals were estimated: all three normals are then the one face normal, so any fit returns
+/// k1 = k2 = 0 (`flat`) whatever the surface was (an STL read with --no-weld is all such
+/// triangles). With normals from the file the rays differ and the fit stands.
+inline void undefine_isolated_triangles(FacesRef F, CurvatureResult& r) {
+  std::vector<std::uint8_t> faces_at(static_cast<std::size_t>(r.k1.size()), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      std::uint8_t& n = faces_at[static_cast<std::size_t>(F(f, c))];
+      n = static_cast<std::uint8_t>(std::min(n + 1, 2));
+    }
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    bool isolated = true;
+    for (int c = 0; c < 3; ++c) isolated &= faces_at[static_cast<std::size_t>(F(f, c))] == 1;
+    if (!isolated) continue;
+    for (int c = 0; c < 3; ++c) detail::store_undefined(r, F(f, c));
+  }
+}
+
 }  // namespace focal::detail

@@ -85,26 +85,6 @@ NormalWeighting weighting_of(NormalsSource source) {
 
 /// The mesh the estimator runs on: the prepared faces and normals, sharing what `mesh` has built
 /// when the faces are its own.
-/// Vertices of isolated triangles (each corner in no other face) get `undefined` when their
-/// normals were estimated: all three normals are then the one face normal, so any fit returns
-/// k1 = k2 = 0 (`flat`) whatever the surface was (an STL read with --no-weld is all such
-/// triangles). With normals from the file the rays differ and the fit stands.
-void undefine_isolated_triangles(FacesRef F, CurvatureResult& r) {
-  std::vector<std::uint8_t> faces_at(static_cast<std::size_t>(r.k1.size()), 0);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      std::uint8_t& n = faces_at[static_cast<std::size_t>(F(f, c))];
-      n = static_cast<std::uint8_t>(std::min(n + 1, 2));
-    }
-  }
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    bool isolated = true;
-    for (int c = 0; c < 3; ++c) isolated &= faces_at[static_cast<std::size_t>(F(f, c))] == 1;
-    if (!isolated) continue;
-    for (int c = 0; c < 3; ++c) detail::store_undefined(r, F(f, c));
-  }
-}
-
 PreparedMesh mesh_to_fit(const PreparedMesh& mesh, const PreparedNormals& normals) {
   const std::optional<NormalsRef> N =
       normals.N ? std::optional<NormalsRef>(*normals.N) : mesh.normals();
@@ -175,10 +155,10 @@ Estimate estimate(const PreparedMesh& mesh, PreparedNormals normals,
     } else {
       out.curvature = run_paper(fit, options.paper);
     }
-    const bool estimated_normals = options.estimator == Estimator::recommended
-                                       ? !out.file_normals_used
-                                       : !uses_mesh_normals(mesh, options.normals);
-    if (estimated_normals) undefine_isolated_triangles(fit.F(), out.curvature);
+    // (The recommended estimator does this itself.)
+    if (options.estimator == Estimator::paper && !uses_mesh_normals(mesh, options.normals)) {
+      detail::undefine_isolated_triangles(fit.F(), out.curvature);
+    }
   }
   if (options.estimator == Estimator::paper && normals.N) out.N = std::move(normals.N);
   out.F = std::move(normals.F);

@@ -564,6 +564,7 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
                  out.curvature);
   }
   fill_undefined(c, out.plan, no_skip, out.N, out.curvature);
+  if (!out.file_normals_used) detail::undefine_isolated_triangles(mesh.F(), out.curvature);
   return out;
 }
 
