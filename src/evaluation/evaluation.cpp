@@ -121,14 +121,24 @@ ErrorMetrics evaluate_at(const AnalyticSurface& truth, const CurvatureResult& es
   return measure(truth, estimate, at, umbilic_gap(truth));
 }
 
+namespace {
+
+/// Rings from the boundary per vertex (0 on it), counted up to `max_rings` (beyond: more), after
+/// `what`'s checks of F against vertex_count.
+Eigen::VectorXi rings_from_boundary(int vertex_count, FacesRef F, int max_rings, const char* what) {
+  const RowMatrixX3d no_normals(0, 3);
+  validate_mesh_arrays(RowMatrixX3d::Zero(vertex_count, 3), F, no_normals, what);
+  const Neighbourhoods one_ring = vertex_adjacency(vertex_count, F);
+  return rings_to_boundary(one_ring, boundary_vertices(vertex_count, F), max_rings);
+}
+
+}  // namespace
+
 VectorXu8 boundary_band_mask(int vertex_count, FacesRef F, int first_ring, int last_ring) {
   if (first_ring < 0 || last_ring < first_ring || vertex_count < 0)
     throw InvalidInput("boundary_band_mask: need 0 <= first_ring <= last_ring");
-  const RowMatrixX3d no_normals(0, 3);
-  validate_mesh_arrays(RowMatrixX3d::Zero(vertex_count, 3), F, no_normals, "boundary_band_mask");
-  const Neighbourhoods one_ring = vertex_adjacency(vertex_count, F);
   const Eigen::VectorXi distance =
-      rings_to_boundary(one_ring, boundary_vertices(vertex_count, F), last_ring);
+      rings_from_boundary(vertex_count, F, last_ring, "boundary_band_mask");
   VectorXu8 mask(vertex_count);
   for (int i = 0; i < vertex_count; ++i)
     mask[i] = distance[i] >= first_ring && distance[i] <= last_ring ? 1 : 0;
@@ -138,11 +148,8 @@ VectorXu8 boundary_band_mask(int vertex_count, FacesRef F, int first_ring, int l
 VectorXu8 interior_mask(int vertex_count, FacesRef F, int boundary_rings) {
   if (boundary_rings < 0 || vertex_count < 0)
     throw InvalidInput("interior_mask: boundary_rings and vertex_count must be >= 0");
-  const RowMatrixX3d no_normals(0, 3);
-  validate_mesh_arrays(RowMatrixX3d::Zero(vertex_count, 3), F, no_normals, "interior_mask");
-  const Neighbourhoods one_ring = vertex_adjacency(vertex_count, F);
   const Eigen::VectorXi distance =
-      rings_to_boundary(one_ring, boundary_vertices(vertex_count, F), boundary_rings);
+      rings_from_boundary(vertex_count, F, boundary_rings, "interior_mask");
   VectorXu8 mask(vertex_count);
   for (int i = 0; i < vertex_count; ++i) mask[i] = distance[i] > boundary_rings ? 1 : 0;
   return mask;

@@ -4,9 +4,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/baselines.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/prepared.h"
+#include "mesh/prepared_detail.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines::ball {
@@ -30,5 +33,18 @@ struct Scratch {
 /// by the sphere with no corner inside is left out: its part inside is O(h^3 / r) in area).
 void gather(PositionsRef V, const Neighbourhoods& one_ring,
             const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s);
+
+/// Calls visit(i, faces) for every vertex i of `mesh`, on the pool's threads, with the faces of
+/// its ball of radius r (gather); each thread reuses its scratch.
+template <class Visit>
+void for_each_ball(const PreparedMesh& mesh, double r, int threads, Visit visit) {
+  const auto incidence = focal::detail::incidence(mesh);
+  const auto one_ring = focal::detail::one_ring(mesh);
+  focal::detail::parallel_for(mesh.vertex_count(), threads, [&](std::int64_t i) {
+    thread_local Scratch scratch;
+    gather(mesh.V(), *one_ring, *incidence, static_cast<int>(i), r, scratch);
+    visit(i, scratch.faces);
+  });
+}
 
 }  // namespace focal::baselines::ball

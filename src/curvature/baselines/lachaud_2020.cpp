@@ -126,16 +126,12 @@ CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRe
     }
     face[static_cast<std::size_t>(f)] = triangle_measures(x, n);
   });
-  const auto incidence = focal::detail::incidence(mesh);
-  const auto one_ring = focal::detail::one_ring(mesh);
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  focal::detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
-    thread_local ball::Scratch scratch;
-    ball::gather(V, *one_ring, *incidence, static_cast<int>(i), r, scratch);
+  ball::for_each_ball(mesh, r, options.threads, [&](std::int64_t i, const std::vector<int>& faces) {
     const Eigen::Vector3d normal = u.row(i);
-    const Measures sum = ball_measures(V, F, face, scratch.faces, V.row(i), r);
+    const Measures sum = ball_measures(V, F, face, faces, V.row(i), r);
     if (!(sum.mu0 > 0.0) || !normal.allFinite()) return;
     const TangentFrame frame = tangent_frame(normal);
     const focal::detail::Principal2 p = principal_of(sum, frame);
@@ -144,7 +140,7 @@ CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRe
     focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);
     result.H[i] = H;  // the papers' H and K are mu1 / (2 mu0) and mu2 / mu0 themselves
     result.K[i] = sum.mu2 / sum.mu0;
-    result.rays_used[i] = static_cast<int>(scratch.faces.size());  // faces reached
+    result.rays_used[i] = static_cast<int>(faces.size());  // faces reached
   });
   return result;
 }

@@ -134,20 +134,17 @@ CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball,
       V, F, std::nullopt, {.threads = options.threads}, "YLHP06");
   const double r = ball::radius(ball, 4.0, mesh.mean_edge_length(), "YLHP06");
   const auto incidence = focal::detail::incidence(mesh);
-  const auto one_ring = focal::detail::one_ring(mesh);
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  focal::detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
-    thread_local ball::Scratch scratch;
-    ball::gather(V, *one_ring, *incidence, static_cast<int>(i), r, scratch);
-    const Moments m = ball_moments(V, F, scratch.faces, V.row(i), r);
+  ball::for_each_ball(mesh, r, options.threads, [&](std::int64_t i, const std::vector<int>& faces) {
+    const Moments m = ball_moments(V, F, faces, V.row(i), r);
     const Eigen::Vector3d orientation = area_normal(V, F, *incidence, i);
     if (!(m.area > 0.0) || !(r > 0.0) || !(orientation.norm() > 0.0)) return;
     const std::optional<PatchCurvature> c = patch_curvature(m, orientation, r);
     if (!c) return;
     focal::detail::store_vertex(result, i, c->frame, c->principal, c->residual, tol);
-    result.rays_used[i] = static_cast<int>(scratch.faces.size());  // faces reached
+    result.rays_used[i] = static_cast<int>(faces.size());  // faces reached
   });
   return result;
 }
