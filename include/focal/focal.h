@@ -6,6 +6,7 @@
 // normals, curvature, the device backends, the image-space estimator, test surfaces, evaluation.
 #include "focal/core/error.h"
 #include "focal/core/mesh.h"
+#include "focal/core/edge_lengths.h"
 #include "focal/core/fields.h"
 #include "focal/io/mesh_io.h"
 #include "focal/io/fields_io.h"

@@ -31,7 +31,7 @@ import numpy as np
 import focal
 from focal import _focal_ext as _ext
 
-__all__ = ["curvature", "main"]
+__all__ = ["curvature", "curvature_stream", "main"]
 
 #: The per-vertex fields of focal.Curvature that tiles write back.
 FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
@@ -175,6 +175,72 @@ def curvature(
     return focal.Curvature(**out)
 
 
+def curvature_stream(
+    path: "str | os.PathLike",
+    parts: "str | os.PathLike",
+    client: Any = None,
+    *,
+    output: "Optional[str | os.PathLike]" = None,
+    tile_vertices: int = 250_000,
+    workers: Optional[int] = None,
+    memory_limit: Any = None,
+    retries: int = 2,
+    progress: bool = False,
+    **options: Any,
+) -> dict:
+    """``curvature`` of a binary PLY mesh that no process holds whole (focal/stream.py): the
+    driver plans the tiles in streamed passes over the file; each task reads its tile (with its
+    halo) from the file and the plan's files, and writes its owned rows to a part in `parts`
+    (part-NNNNNN.npz: ``ids`` and the fields); ``parts/manifest.json`` lists the parts. With
+    `output` (.npz), the parts are also concatenated in input order. The same bits as
+    ``focal.curvature`` on the whole mesh.
+
+    The plan's files (the tiles' vertex and face ids, about 4 bytes per vertex and 16 to 48 per
+    face) go to ``parts/plan``; `parts` must be a folder every worker can read and write (a
+    shared file system on a cluster). Runs estimator="paper" with the file's normals only (see
+    focal.stream). Returns the manifest (a dict). Options as ``curvature``.
+    """
+    import json
+
+    from distributed import as_completed
+
+    from focal import stream
+
+    own_cluster = client is None
+    if own_cluster and options.get("threads") is None:
+        options["threads"] = 1
+    estimator, threads, opts = focal._curvature_options(options)
+    o = focal._estimate_options(estimator, threads, opts)
+    parts = os.fspath(parts)
+    os.makedirs(parts, exist_ok=True)
+    plan = stream.plan(path, os.path.join(parts, "plan"), o, int(tile_vertices))
+    cluster = None
+    if own_cluster:
+        client, cluster = _local_client(workers, memory_limit)
+    try:
+        futures = [client.submit(stream.estimate_tile, plan, t, parts, retries=retries,
+                                 key=f"focal-stream-tile-{t}-{uuid.uuid4().hex}")
+                   for t in range(plan["tile_count"])]
+        if progress:
+            from distributed import progress as dask_progress
+
+            dask_progress(futures)
+        done = [r for _, r in as_completed(futures, with_results=True)]
+    finally:
+        if cluster is not None:
+            client.close()
+            cluster.close()
+    manifest = {k: plan[k] for k in ("path", "vertex_count", "face_count", "tile_count",
+                                      "halo_rings", "choices", "options")}
+    manifest["fields"] = list(stream.FIELDS)
+    manifest["parts"] = sorted(done, key=lambda r: r["tile"])
+    with open(os.path.join(parts, "manifest.json"), "w") as f:
+        json.dump(manifest, f, indent=1)
+    if output is not None:
+        stream.concatenate(manifest, parts, os.fspath(output))
+    return manifest
+
+
 def _empty_fields(n: int) -> dict:
     return {
         "k1": np.empty(n), "k2": np.empty(n), "H": np.empty(n), "K": np.empty(n),
@@ -237,7 +303,11 @@ def main(argv: Optional[list] = None) -> int:
         "numbers as `focal curvature`).",
     )
     p.add_argument("input", help="mesh file (.ply, .obj, .off, .stl)")
-    p.add_argument("-o", "--output", required=True, help="fields, .npz or .csv (input order)")
+    p.add_argument("-o", "--output", help="fields, .npz or .csv (input order); with --parts, "
+                   "the parts concatenated (.npz)")
+    p.add_argument("--parts", help="stream the input (binary PLY, paper's estimator, file "
+                   "normals): no process holds the whole mesh; each tile's fields go to "
+                   "PARTS/part-NNNNNN.npz, listed in PARTS/manifest.json")
     p.add_argument("--scheduler", help="address of a running Dask scheduler "
                    "(default: a LocalCluster here)")
     p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
@@ -250,19 +320,25 @@ def main(argv: Optional[list] = None) -> int:
     args = p.parse_args(argv)
     if args.scheduler and (args.workers or args.memory_limit):
         p.error("--workers and --memory-limit configure a LocalCluster: not with --scheduler")
-    if not args.output.endswith((".npz", ".csv")):
+    if args.output is None and args.parts is None:
+        p.error("one of -o/--output and --parts is required")
+    if args.output is not None and not args.output.endswith((".npz", ".csv")):
         p.error(f"{args.output}: the output must end in .npz or .csv")
+    if args.parts is not None and args.output is not None and not args.output.endswith(".npz"):
+        p.error(f"{args.output}: with --parts, the concatenated output is .npz")
     client = None
     try:
         if args.scheduler:
             from distributed import Client
 
             client = Client(args.scheduler)
-        c = curvature(args.input, client, tile_vertices=args.tile_vertices,
-                      workers=args.workers, memory_limit=args.memory_limit,
-                      progress=args.progress, threads=args.threads,
-                      estimator="paper" if args.paper else "recommended")
-        _write_fields(args.output, c)
+        common = dict(tile_vertices=args.tile_vertices, workers=args.workers,
+                      memory_limit=args.memory_limit, progress=args.progress,
+                      threads=args.threads, estimator="paper" if args.paper else "recommended")
+        if args.parts is not None:
+            curvature_stream(args.input, args.parts, client, output=args.output, **common)
+        else:
+            _write_fields(args.output, curvature(args.input, client, **common))
     except (focal.FocalIOError, focal.InvalidInputError, OSError) as e:
         print(f"Error: {e}", file=sys.stderr)
         return 2

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "focal/core/edge_lengths.h"
 #include "focal/curvature/estimate.h"
 #include "focal/mesh/prepared.h"
 
@@ -117,6 +118,23 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
   return curvature_dict(std::move(r));
 }
 
+/// mean_edge_length's partial sums of a run of whole blocks of faces (focal/core/mesh.h), for
+/// the streaming reader (focal/stream.py): (sums, counts) per block of edge_length_block faces.
+nb::tuple edge_length_sums(const DoubleRows& V, const IntRows& F, int threads) {
+  focal::EdgeLengthSums s;
+  {
+    nb::gil_scoped_release release;
+    const focal::RowMatrixX3d no_normals;
+    focal::validate_mesh_arrays(view(V), view(F), no_normals, "edge_length_sums", threads);
+    s = focal::edge_length_sums(view(V), view(F), threads);
+  }
+  const auto n = static_cast<Eigen::Index>(s.sums.size());
+  return nb::make_tuple(
+      to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(s.sums.data(), n))),
+      to_numpy(Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>(
+          Eigen::Map<const Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>>(s.counts.data(), n))));
+}
+
 }  // namespace
 
 void bind_tiles(nb::module_& m) {
@@ -126,6 +144,13 @@ void bind_tiles(nb::module_& m) {
         "N"_a.none().noconvert(), "vertices"_a.noconvert(), "faces"_a.noconvert());
   m.def("estimate_tile", &estimate_tile, "V"_a.noconvert(), "F"_a.noconvert(),
         "N"_a.none().noconvert(), "options"_a, "choices"_a);
+  m.def("edge_length_sums", &edge_length_sums, "V"_a.noconvert(), "F"_a.noconvert(),
+        "threads"_a);
+  m.attr("edge_length_block") = focal::kEdgeLengthBlock;
+  m.def(
+      "estimate_reach",
+      [](const nb::dict& options) { return focal::estimate_reach(estimate_options(options)); },
+      "options"_a);
 }
 
 }  // namespace focal_python

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "focal/core/edge_lengths.h"
 #include "focal/core/error.h"
 #include "core/parallel.h"
 
@@ -43,36 +44,41 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
   }
 }
 
-double mean_edge_length(PositionsRef V, FacesRef F, int threads) {
+EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F, int threads) {
   // Edges with a NaN or infinite end are left out: one bad coordinate would otherwise make the
   // tolerances derived from this length NaN for the whole mesh, not just near the bad vertex.
-  // Summed per block of faces, the blocks' sums then added in block order: blocks do not depend
-  // on the thread count, so neither does the result (and a mesh of one block sums as before).
-  constexpr std::int64_t kBlock = 1 << 15;
   const std::int64_t faces = F.rows();
-  const std::int64_t blocks = (faces + kBlock - 1) / kBlock;
-  std::vector<double> sums(static_cast<std::size_t>(blocks), 0.0);
-  std::vector<std::int64_t> counts(static_cast<std::size_t>(blocks), 0);
-  detail::parallel_for_blocks(faces, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
-    double sum = 0.0;
-    std::int64_t count = 0;
-    for (std::int64_t f = begin; f < end; ++f) {
-      for (int c = 0; c < 3; ++c) {
-        const double length = (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
-        if (std::isfinite(length)) {
-          sum += length;
-          ++count;
+  const std::int64_t blocks = (faces + kEdgeLengthBlock - 1) / kEdgeLengthBlock;
+  EdgeLengthSums out{std::vector<double>(static_cast<std::size_t>(blocks), 0.0),
+                     std::vector<std::int64_t>(static_cast<std::size_t>(blocks), 0)};
+  detail::parallel_for_blocks(
+      faces, kEdgeLengthBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+        double sum = 0.0;
+        std::int64_t count = 0;
+        for (std::int64_t f = begin; f < end; ++f) {
+          for (int c = 0; c < 3; ++c) {
+            const double length = (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+            if (std::isfinite(length)) {
+              sum += length;
+              ++count;
+            }
+          }
         }
-      }
-    }
-    sums[static_cast<std::size_t>(begin / kBlock)] = sum;
-    counts[static_cast<std::size_t>(begin / kBlock)] = count;
-  });
+        out.sums[static_cast<std::size_t>(begin / kEdgeLengthBlock)] = sum;
+        out.counts[static_cast<std::size_t>(begin / kEdgeLengthBlock)] = count;
+      });
+  return out;
+}
+
+double mean_edge_length(PositionsRef V, FacesRef F, int threads) {
+  // The blocks' sums added in block order: blocks do not depend on the thread count, so
+  // neither does the result (and a mesh of one block sums as before).
+  const EdgeLengthSums blocks = edge_length_sums(V, F, threads);
   double sum = 0.0;
   std::int64_t count = 0;
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    sum += sums[static_cast<std::size_t>(b)];
-    count += counts[static_cast<std::size_t>(b)];
+  for (std::size_t b = 0; b < blocks.sums.size(); ++b) {
+    sum += blocks.sums[b];
+    count += blocks.counts[b];
   }
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }

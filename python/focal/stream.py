@@ -1,0 +1,400 @@
+"""Streaming input of a tiled run: a binary PLY mesh read in chunks, so that no process holds
+the whole mesh (docs/SCALE.md, "Streaming input").
+
+The file's vertex and face records are memory-mapped (fixed-size records: triangles only) and
+read a chunk at a time; the operating system's page cache, not the process, holds what is read.
+
+- **Plan** (the driver, ``plan``): pass 1 over the vertices finds the box of the finite ones;
+  pass 2 counts the vertices per cell of a coarse Morton grid (``MORTON_BITS`` per axis) and
+  cuts the cells, in Morton order, into runs of about ``tile_vertices`` vertices: a vertex's
+  tile is a function of its position (``TileMap``), nothing per vertex is kept; pass 2 also
+  writes each tile's owned vertex ids to a file. Pass 3 over the faces, in whole blocks of
+  ``_focal_ext.edge_length_block`` faces, writes each face (its id and corners) to the face file
+  of every tile owning one of its corners, and adds up the edge lengths per block, added in
+  block order as ``mean_edge_length`` does: the whole mesh's mean edge length, bit for bit.
+- **Tile** (a worker, ``estimate_tile``): the halo by rings from the face files: round r takes,
+  from the face files of the tiles owning the vertices found in round r - 1, the faces incident
+  to them, as ``partition_mesh`` does in memory (every face of a vertex is in the face file of
+  the tile owning it). Then the tile's vertices and faces, sorted by global id, are read from the
+  file and estimated with the whole mesh's choices; the owned rows are written to a part file.
+
+Memory: the driver holds the cell counts (8 bytes x 2^(3 x MORTON_BITS) = 16 MB), the cell ->
+tile table and one chunk; a worker holds one tile with its halo, its face files' records and
+one neighbouring tile's face file at a time (16 bytes per face record).
+
+What the plan can take from the whole mesh in one streamed pass is the mean edge length; the
+other whole-mesh choices (the recommended estimator's noise and file-normal comparison, the
+orientation of closed components when the normals come from the faces) need the whole mesh, so
+streaming runs the paper's estimator with the file's normals only, and says so otherwise.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+from typing import Any, Iterator, Optional
+
+import numpy as np
+
+import focal
+from focal import _focal_ext as _ext
+
+__all__ = ["PlyMesh", "TileMap", "plan", "estimate_tile", "concatenate"]
+
+#: Bits per axis of the coarse Morton grid of the tiles: 2^21 cells.
+MORTON_BITS = 7
+
+#: Vertices or faces per chunk of a streamed pass.
+CHUNK = 1 << 20
+
+_PLY_TYPES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
+    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+}
+
+FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
+          "rays_excluded")
+
+
+class PlyMesh:
+    """A binary PLY triangle mesh, memory-mapped: vertex records (x, y, z, optionally nx, ny, nz)
+    and face records (a list of 3 corners), read by ranges or ids, never all at once."""
+
+    def __init__(self, path: "str | os.PathLike"):
+        self.path = os.fspath(path)
+        try:
+            with open(self.path, "rb") as f:
+                header, offset = _read_header(f, self.path)
+        except focal.FocalIOError:
+            raise
+        except OSError as e:  # not found, not readable
+            raise focal.FocalIOError(f"{self.path}: {e.strerror}") from e
+        fmt, elements = header
+        order = "<" if fmt == "binary_little_endian" else ">"
+        self.vertex_count, self.face_count = 0, 0
+        vdtype = fdtype = None
+        for name, count, props in elements:
+            if name == "vertex":
+                vdtype = self._vertex_dtype(props, order)
+                voffset, self.vertex_count = offset, count
+                offset += count * vdtype.itemsize
+            elif name == "face":
+                fdtype = self._face_dtype(props, order)
+                foffset, self.face_count = offset, count
+                offset += count * fdtype.itemsize
+            elif all(p[0] != "list" for p in props) and vdtype is not None and fdtype is not None:
+                break  # trailing fixed-size elements: not read
+            else:
+                raise focal.FocalIOError(
+                    f"{self.path}: element '{name}' before the faces: streaming reads files "
+                    "with the vertex element, then the face element")
+        if vdtype is None or fdtype is None:
+            raise focal.FocalIOError(f"{self.path}: needs a vertex and a face element")
+        size = os.path.getsize(self.path)
+        if size < offset:
+            raise focal.FocalIOError(
+                f"{self.path}: {size} bytes, the header's elements need {offset} (truncated, "
+                "or faces that are not all triangles)")
+        self.vertices = np.memmap(self.path, vdtype, "r", voffset, (self.vertex_count,))
+        self.faces = np.memmap(self.path, fdtype, "r", foffset, (self.face_count,))
+        self.has_normals = "nx" in vdtype.names
+
+    def _vertex_dtype(self, props, order):
+        fields = []
+        for p in props:
+            if p[0] == "list":
+                raise focal.FocalIOError(f"{self.path}: vertex property '{p[-1]}' is a list")
+            fields.append((p[1], order + p[0]))
+        names = [f[0] for f in fields]
+        for axis in ("x", "y", "z"):
+            if axis not in names:
+                raise focal.FocalIOError(f"{self.path}: the vertex element has no '{axis}'")
+        normals = [n in names for n in ("nx", "ny", "nz")]
+        if any(normals) and not all(normals):
+            raise focal.FocalIOError(f"{self.path}: the vertex normals need nx, ny and nz")
+        return np.dtype(fields)
+
+    def _face_dtype(self, props, order):
+        fields, lists = [], 0
+        for p in props:
+            if p[0] == "list":
+                if p[3] not in ("vertex_indices", "vertex_index"):
+                    raise focal.FocalIOError(f"{self.path}: face list '{p[3]}' is not read")
+                lists += 1
+                fields += [("count", order + p[1]), ("corners", order + p[2], (3,))]
+            else:
+                fields.append((p[1], order + p[0]))
+        if lists != 1:
+            raise focal.FocalIOError(f"{self.path}: the face element needs one vertex_indices")
+        return np.dtype(fields)
+
+    def positions(self, rows: Any) -> np.ndarray:
+        """(n, 3) float64 positions of `rows` (a slice or ascending ids)."""
+        r = self.vertices[rows]
+        return np.column_stack([r["x"], r["y"], r["z"]]).astype(np.float64)
+
+    def normals(self, rows: Any) -> Optional[np.ndarray]:
+        if not self.has_normals:
+            return None
+        r = self.vertices[rows]
+        return np.column_stack([r["nx"], r["ny"], r["nz"]]).astype(np.float64)
+
+    def corners(self, begin: int, end: int) -> np.ndarray:
+        """(end - begin, 3) int32 corners of faces begin .. end - 1, checked: triangles, in
+        range. \\raise FocalIOError naming the first bad face."""
+        r = self.faces[begin:end]
+        bad = np.flatnonzero(r["count"] != 3)
+        if bad.size:
+            f = begin + int(bad[0])
+            raise focal.FocalIOError(
+                f"{self.path}: face {f} has {int(r['count'][bad[0]])} corners: streaming reads "
+                "triangle meshes only (fixed-size face records)")
+        c = np.ascontiguousarray(r["corners"], dtype=np.int64)
+        out_of_range = np.flatnonzero(((c < 0) | (c >= self.vertex_count)).any(axis=1))
+        if out_of_range.size:
+            f = begin + int(out_of_range[0])
+            raise focal.FocalIOError(
+                f"{self.path}: face {f} refers to vertex {c[out_of_range[0]].tolist()}, but "
+                f"there are {self.vertex_count} vertices")
+        return c.astype(np.int32)
+
+
+def _read_header(f, path: str):
+    line = f.readline()
+    if line.strip() != b"ply":
+        raise focal.FocalIOError(f"{path}: not a PLY file")
+    fmt, elements = None, []
+    while True:
+        line = f.readline()
+        if not line:
+            raise focal.FocalIOError(f"{path}: the header has no end_header")
+        words = line.decode("ascii", "replace").split()
+        if not words or words[0] in ("comment", "obj_info"):
+            continue
+        if words[0] == "end_header":
+            return (fmt, elements), f.tell()
+        if words[0] == "format":
+            fmt = words[1]
+            if fmt not in ("binary_little_endian", "binary_big_endian"):
+                raise focal.FocalIOError(
+                    f"{path}: format {fmt}: streaming reads binary PLY only (focal.read_mesh "
+                    "reads ascii)")
+        elif words[0] == "element":
+            elements.append((words[1], int(words[2]), []))
+        elif words[0] == "property" and elements:
+            if words[1] == "list":
+                types = [_ply_type(w, path) for w in words[2:4]]
+                elements[-1][2].append(("list", *types, words[4]))
+            else:
+                elements[-1][2].append((_ply_type(words[1], path), words[2]))
+        else:
+            raise focal.FocalIOError(f"{path}: header line not understood: {line!r}")
+
+
+def _ply_type(name: str, path: str) -> str:
+    if name not in _PLY_TYPES:
+        raise focal.FocalIOError(f"{path}: unknown PLY type '{name}'")
+    return _PLY_TYPES[name]
+
+
+def _ranges(n: int, step: int) -> Iterator[tuple]:
+    for begin in range(0, n, step):
+        yield begin, min(n, begin + step)
+
+
+class TileMap:
+    """Vertex position -> tile: the coarse Morton cell of the position in the box of the finite
+    vertices, then the cell's tile; non-finite positions are in the last cell."""
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, cell_tile: np.ndarray):
+        self.lo, self.hi, self.cell_tile = lo, hi, cell_tile
+
+    @staticmethod
+    def cells(P: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        side = 1 << MORTON_BITS
+        extent = np.where(hi > lo, hi - lo, 1.0)
+        with np.errstate(invalid="ignore"):
+            t = np.clip((P - lo) / extent, 0.0, 1.0)
+        finite = np.isfinite(P).all(axis=1)
+        ijk = np.minimum((np.nan_to_num(t) * side).astype(np.int64), side - 1)
+        spread = np.zeros(side, np.int64)
+        for b in range(MORTON_BITS):
+            spread |= ((np.arange(side) >> b) & 1) << (3 * b)
+        code = spread[ijk[:, 0]] | spread[ijk[:, 1]] << 1 | spread[ijk[:, 2]] << 2
+        return np.where(finite, code, side ** 3)
+
+    def tiles(self, P: np.ndarray) -> np.ndarray:
+        return self.cell_tile[self.cells(P, self.lo, self.hi)]
+
+
+def _uniform_options(options: dict, mesh: PlyMesh) -> None:
+    if options["estimator"] != "paper":
+        raise focal.InvalidInputError(
+            "streaming input runs estimator='paper' only: the recommended estimator's "
+            "whole-mesh choices (noise, file normals) need the whole mesh in memory "
+            "(focal.distributed.curvature without stream)")
+    if options["normals"] not in ("auto", "file") or not mesh.has_normals:
+        raise focal.InvalidInputError(
+            f"{mesh.path}: streaming input needs the file's normals (nx, ny, nz): normals "
+            "from the faces are oriented per closed component over the whole mesh")
+
+
+def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: int) -> dict:
+    """The plan of a streamed tiled run, its files written under `workdir`: see the module's
+    docstring. `options` as focal._estimate_options gives them. Returns the plan (a dict that
+    the tile tasks take, small)."""
+    mesh = PlyMesh(path)
+    _uniform_options(options, mesh)
+    if int(tile_vertices) < 1:
+        raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
+    os.makedirs(workdir, exist_ok=True)
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for b, e in _ranges(mesh.vertex_count, CHUNK):
+        P = mesh.positions(slice(b, e))
+        P = P[np.isfinite(P).all(axis=1)]
+        if len(P):
+            lo, hi = np.minimum(lo, P.min(axis=0)), np.maximum(hi, P.max(axis=0))
+    counts = np.zeros((1 << 3 * MORTON_BITS) + 1, np.int64)
+    for b, e in _ranges(mesh.vertex_count, CHUNK):
+        counts += np.bincount(TileMap.cells(mesh.positions(slice(b, e)), lo, hi),
+                              minlength=counts.size)
+    # Cells in Morton order, cut into runs of about tile_vertices vertices (a cell is not cut).
+    before = np.cumsum(counts) - counts
+    _, cell_tile = np.unique(before // int(tile_vertices), return_inverse=True)
+    tiles = TileMap(lo, hi, cell_tile.astype(np.int32))
+    tile_count = int(cell_tile.max()) + 1
+    np.save(os.path.join(workdir, "cell_tile.npy"), tiles.cell_tile)
+    for t in range(tile_count):
+        for kind in ("vertices", "faces"):
+            open(_tile_file(workdir, kind, t), "wb").close()
+    for b, e in _ranges(mesh.vertex_count, CHUNK):
+        _append_grouped(workdir, "vertices", tiles.tiles(mesh.positions(slice(b, e))),
+                        np.arange(b, e, dtype=np.int32)[:, None])
+    block = int(_ext.edge_length_block)
+    edge_sum, edge_count = 0.0, 0
+    for b, e in _ranges(mesh.face_count, block * max(1, CHUNK // block)):
+        C = mesh.corners(b, e)
+        ids, local = np.unique(C, return_inverse=True)
+        P = mesh.positions(ids)
+        sums, n = _ext.edge_length_sums(P, local.reshape(-1, 3).astype(np.int32), 1)
+        for s, k in zip(sums.tolist(), n.tolist()):  # in block order, as mean_edge_length
+            edge_sum += s
+            edge_count += k
+        corner_tiles = tiles.tiles(P)[local].reshape(-1, 3)
+        records = np.column_stack([np.arange(b, e, dtype=np.int32), C])
+        for c in range(3):  # each face once per distinct tile of its corners
+            new = np.ones(len(C), bool)
+            for earlier in range(c):
+                new &= corner_tiles[:, c] != corner_tiles[:, earlier]
+            _append_grouped(workdir, "faces", corner_tiles[new, c], records[new])
+    mean_edge = edge_sum / edge_count if edge_count > 0 else 0.0
+    out = {
+        "path": os.path.abspath(mesh.path), "workdir": os.path.abspath(workdir),
+        "vertex_count": mesh.vertex_count, "face_count": mesh.face_count,
+        "tile_count": tile_count, "lo": lo.tolist(), "hi": hi.tolist(),
+        "choices": {"mean_edge_length": mean_edge},
+        "halo_rings": int(_ext.estimate_reach(options)), "options": options,
+    }
+    with open(os.path.join(workdir, "plan.json"), "w") as f:
+        json.dump(out, f, indent=1)
+    return out
+
+
+def _tile_file(workdir: str, kind: str, t: int) -> str:
+    return os.path.join(workdir, f"tile-{t:06d}.{kind}")
+
+
+def _append_grouped(workdir: str, kind: str, tile: np.ndarray, rows: np.ndarray) -> None:
+    """Appends rows (int32) to the files of their tiles."""
+    order = np.argsort(tile, kind="stable")
+    tile, rows = tile[order], rows[order]
+    starts = np.flatnonzero(np.r_[True, tile[1:] != tile[:-1]]) if len(tile) else []
+    for s, e in zip(starts, list(starts[1:]) + [len(tile)]):
+        with open(_tile_file(workdir, kind, int(tile[s])), "ab") as f:
+            f.write(np.ascontiguousarray(rows[s:e], np.int32).tobytes())
+
+
+def _tile_records(workdir: str, kind: str, t: int, width: int) -> np.ndarray:
+    return np.fromfile(_tile_file(workdir, kind, t), np.int32).reshape(-1, width)
+
+
+def tile_arrays(p: dict, t: int) -> dict:
+    """Tile t's arrays, read from the plan's files and the mesh: its vertices within the halo's
+    rings of the owned ones and the faces with a corner within one ring less, sorted by global
+    id (as partition_mesh and extract_tile give them)."""
+    mesh = PlyMesh(p["path"])
+    tiles = TileMap(np.array(p["lo"]), np.array(p["hi"]),
+                    np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"))
+    owned = np.sort(_tile_records(p["workdir"], "vertices", t, 1)[:, 0])
+    reached, frontier = owned, owned
+    taken = [np.empty((0, 4), np.int32)]
+    taken_ids = np.empty(0, np.int32)
+    for _ in range(p["halo_rings"]):
+        if frontier.size == 0:
+            break
+        found = []
+        for u in np.unique(tiles.tiles(mesh.positions(frontier))):
+            r = _tile_records(p["workdir"], "faces", int(u), 4)
+            r = r[np.isin(r[:, 1:], frontier).any(axis=1) & ~np.isin(r[:, 0], taken_ids)]
+            found.append(r)
+        new = np.concatenate(found)
+        new = new[np.unique(new[:, 0], return_index=True)[1]]
+        taken.append(new)
+        taken_ids = np.union1d(taken_ids, new[:, 0])
+        frontier = np.setdiff1d(np.unique(new[:, 1:]), reached)
+        reached = np.union1d(reached, frontier)
+    faces = np.concatenate(taken)
+    faces = faces[np.argsort(faces[:, 0], kind="stable")]
+    return {
+        "V": mesh.positions(reached), "N": mesh.normals(reached),
+        "F": np.searchsorted(reached, faces[:, 1:]).astype(np.int32),
+        "vertices": reached, "faces": faces[:, 0], "owned": np.searchsorted(reached, owned),
+    }
+
+
+def estimate_tile(p: dict, t: int, parts: str) -> dict:
+    """The task of tile t: its estimate with the whole mesh's choices, the owned rows written
+    to parts/part-NNNNNN.npz (ids and fields, through a temporary renamed); returns the part's
+    name, its row count and the process's peak RSS (bytes)."""
+    a = tile_arrays(p, t)
+    d = _ext.estimate_tile(a["V"], a["F"], a["N"], p["options"], p["choices"])
+    rows = a["owned"]
+    name = f"part-{t:06d}.npz"
+    tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as f:
+        np.savez(f, ids=a["vertices"][rows], **{k: d[k][rows] for k in FIELDS})
+    os.replace(tmp, os.path.join(parts, name))
+    return {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0]),
+            "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+
+
+def concatenate(manifest: dict, parts: str, output: str) -> None:
+    """The parts' rows in input order, as one .npz of the fields (written field by field
+    through memory-mapped .npy files, so that memory stays at one part)."""
+    import zipfile
+
+    n = manifest["vertex_count"]
+    columns = {}
+    for k in FIELDS:
+        shape = (n, 3) if k in ("d1", "d2") else (n,)
+        dtype = {"point_class": np.uint8, "rays_used": np.int32,
+                 "rays_excluded": np.int32}.get(k, np.float64)
+        columns[k] = np.lib.format.open_memmap(os.path.join(parts, f".{k}.npy"), "w+", dtype,
+                                               shape)
+    for part in manifest["parts"]:
+        with np.load(os.path.join(parts, part["part"])) as z:
+            ids = z["ids"]
+            for k in FIELDS:
+                columns[k][ids] = z[k]
+    tmp = output + ".tmp"
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
+        for k, column in columns.items():
+            column.flush()
+            del column
+            z.write(os.path.join(parts, f".{k}.npy"), f"{k}.npy")
+    columns.clear()
+    for k in FIELDS:
+        os.unlink(os.path.join(parts, f".{k}.npy"))
+    os.replace(tmp, output)
