@@ -186,6 +186,7 @@ def curvature_stream(
     memory_limit: Any = None,
     retries: int = 2,
     progress: bool = False,
+    on_phase: Optional[Callable[[str, float], None]] = None,
     **options: Any,
 ) -> dict:
     """``curvature`` of a binary PLY mesh that no process holds whole (focal/stream.py): the
@@ -198,9 +199,11 @@ def curvature_stream(
     The plan's files (the tiles' vertex and face ids, about 4 bytes per vertex and 16 to 48 per
     face) go to ``parts/plan``; `parts` must be a folder every worker can read and write (a
     shared file system on a cluster). Runs estimator="paper" with the file's normals only (see
-    focal.stream). Returns the manifest (a dict). Options as ``curvature``.
+    focal.stream). `on_phase(name, seconds)` is called after each phase ("plan", "tiles",
+    "concatenate"). Returns the manifest (a dict). Options as ``curvature``.
     """
     import json
+    import time
 
     from distributed import as_completed
 
@@ -213,7 +216,16 @@ def curvature_stream(
     o = focal._estimate_options(estimator, threads, opts)
     parts = os.fspath(parts)
     os.makedirs(parts, exist_ok=True)
+    phase = [time.perf_counter()]
+
+    def phase_done(name: str) -> None:
+        now = time.perf_counter()
+        if on_phase is not None:
+            on_phase(name, now - phase[0])
+        phase[0] = now
+
     plan = stream.plan(path, os.path.join(parts, "plan"), o, int(tile_vertices))
+    phase_done("plan")
     cluster = None
     if own_cluster:
         client, cluster = _local_client(workers, memory_limit)
@@ -230,6 +242,7 @@ def curvature_stream(
         if cluster is not None:
             client.close()
             cluster.close()
+    phase_done("tiles")
     manifest = {k: plan[k] for k in ("path", "vertex_count", "face_count", "tile_count",
                                       "halo_rings", "choices", "options")}
     manifest["fields"] = list(stream.FIELDS)
@@ -238,6 +251,7 @@ def curvature_stream(
         json.dump(manifest, f, indent=1)
     if output is not None:
         stream.concatenate(manifest, parts, os.fspath(output))
+        phase_done("concatenate")
     return manifest
 
 

@@ -97,9 +97,19 @@ class PlyMesh:
             raise focal.FocalIOError(
                 f"{self.path}: {size} bytes, the header's elements need {offset} (truncated, "
                 "or faces that are not all triangles)")
-        self.vertices = np.memmap(self.path, vdtype, "r", voffset, (self.vertex_count,))
-        self.faces = np.memmap(self.path, fdtype, "r", foffset, (self.face_count,))
+        self._vertex_map = (vdtype, voffset, (self.vertex_count,))
+        self._face_map = (fdtype, foffset, (self.face_count,))
         self.has_normals = "nx" in vdtype.names
+
+    # Mapped afresh for each read and unmapped after it: the pages read stay in the page cache,
+    # not in this process's resident memory.
+    @property
+    def vertices(self) -> np.memmap:
+        return np.memmap(self.path, self._vertex_map[0], "r", *self._vertex_map[1:])
+
+    @property
+    def faces(self) -> np.memmap:
+        return np.memmap(self.path, self._face_map[0], "r", *self._face_map[1:])
 
     def _vertex_dtype(self, props, order):
         fields = []
@@ -320,6 +330,18 @@ def _tile_records(workdir: str, kind: str, t: int, width: int) -> np.ndarray:
     return np.fromfile(_tile_file(workdir, kind, t), np.int32).reshape(-1, width)
 
 
+def _distinct(x: np.ndarray) -> np.ndarray:
+    """The distinct values of x, ascending (by a sort: NumPy's hashed unique is slower here)."""
+    s = np.sort(x, axis=None)
+    return s[np.r_[True, s[1:] != s[:-1]]] if s.size else s
+
+
+def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The union of two ascending arrays without common values, ascending (a stable sort of two
+    runs is a merge)."""
+    return np.sort(np.concatenate([a, b]), kind="stable")
+
+
 def tile_arrays(p: dict, t: int) -> dict:
     """Tile t's arrays, read from the plan's files and the mesh: its vertices within the halo's
     rings of the owned ones and the faces with a corner within one ring less, sorted by global
@@ -335,16 +357,18 @@ def tile_arrays(p: dict, t: int) -> dict:
         if frontier.size == 0:
             break
         found = []
-        for u in np.unique(tiles.tiles(mesh.positions(frontier))):
+        for u in _distinct(tiles.tiles(mesh.positions(frontier))):
             r = _tile_records(p["workdir"], "faces", int(u), 4)
-            r = r[np.isin(r[:, 1:], frontier).any(axis=1) & ~np.isin(r[:, 0], taken_ids)]
-            found.append(r)
+            r = r[np.isin(r[:, 1:], frontier).any(axis=1)]
+            found.append(r[~np.isin(r[:, 0], taken_ids, assume_unique=True)])
         new = np.concatenate(found)
-        new = new[np.unique(new[:, 0], return_index=True)[1]]
+        new = new[np.argsort(new[:, 0], kind="stable")]
+        new = new[np.r_[True, new[1:, 0] != new[:-1, 0]]] if len(new) else new
         taken.append(new)
-        taken_ids = np.union1d(taken_ids, new[:, 0])
-        frontier = np.setdiff1d(np.unique(new[:, 1:]), reached)
-        reached = np.union1d(reached, frontier)
+        taken_ids = _merge(taken_ids, new[:, 0])
+        corners = _distinct(new[:, 1:])
+        frontier = corners[~np.isin(corners, reached, assume_unique=True)]
+        reached = _merge(reached, frontier)
     faces = np.concatenate(taken)
     faces = faces[np.argsort(faces[:, 0], kind="stable")]
     return {
@@ -357,7 +381,7 @@ def tile_arrays(p: dict, t: int) -> dict:
 def estimate_tile(p: dict, t: int, parts: str) -> dict:
     """The task of tile t: its estimate with the whole mesh's choices, the owned rows written
     to parts/part-NNNNNN.npz (ids and fields, through a temporary renamed); returns the part's
-    name, its row count and the process's peak RSS (bytes)."""
+    name, its row count and the process's peak RSS (bytes, peak_rss)."""
     a = tile_arrays(p, t)
     d = _ext.estimate_tile(a["V"], a["F"], a["N"], p["options"], p["choices"])
     rows = a["owned"]
@@ -367,7 +391,20 @@ def estimate_tile(p: dict, t: int, parts: str) -> dict:
         np.savez(f, ids=a["vertices"][rows], **{k: d[k][rows] for k in FIELDS})
     os.replace(tmp, os.path.join(parts, name))
     return {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0]),
-            "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+            "peak_rss": peak_rss()}
+
+
+def peak_rss() -> int:
+    """This process's peak resident memory in bytes: VmHWM on Linux (unlike ru_maxrss, not
+    inherited across exec from the process that started it), else ru_maxrss."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def concatenate(manifest: dict, parts: str, output: str) -> None:
