@@ -20,6 +20,7 @@ struct CurvatureFlags {
   std::string output;
   bool ascii = false;
   bool force = false;
+  int tiles = 0;  ///< --tiles: 0, the whole mesh at once
   EstimatorFlags estimator;
 };
 
@@ -44,6 +45,11 @@ void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Input input(f.input, f.estimator, log);
+  if (f.tiles > 0) {
+    const CurvatureResult c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
+    Stage stage(log, "write");
+    return write_curvature_csv(f.output, c);
+  }
   if (input.cloud) return run_cloud_curvature(f, input, log);
   Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
@@ -109,7 +115,13 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
   cmd->add_flag("--force", f->force, "replace a read-only output file");
+  cmd->add_option("--tiles", f->tiles,
+                  "estimate the mesh in N spatial tiles with halos, one after the other: the "
+                  "same numbers, the memory of one tile's estimate (docs/SCALE.md; .csv output). "
+                  "On a Dask cluster: python -m focal.distributed")
+      ->check(CLI::PositiveNumber);
   cmd->parse_complete_callback([f] {
+    if (f->tiles > 0) require_extension("-o", f->output, {".csv"});
     require_extension("-o", f->output, {".csv", ".ply"});
     check_output("-o", f->output, f->input, f->force);
   });

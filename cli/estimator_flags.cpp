@@ -8,6 +8,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
+#include "focal/tiles/tiles.h"
 #include "input_check.h"
 
 namespace focal::cli {
@@ -322,6 +323,27 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
   report_undefined(mesh, mesh_name, options, e, log);
   print_summary(e.curvature, log);
   return e;
+}
+
+CurvatureResult run_tiled_estimate(const Input& input, const std::string& mesh_name,
+                                   const EstimatorFlags& flags, int tiles, const Log& log) {
+  if (input.cloud) {
+    throw InvalidInput(mesh_name + ": is a point cloud (no faces); --tiles cuts meshes only");
+  }
+  const PreparedMesh& mesh = *input.prepared;
+  const EstimateOptions options = flags.estimate_options();
+  if (options.normals == NormalsSource::file && !mesh.has_normals()) {
+    throw InvalidInput("--normals file: " + mesh_name + " has no vertex normals");
+  }
+  const std::int64_t n = mesh.vertex_count();
+  const auto per_tile = static_cast<int>(std::max<std::int64_t>(1, (n + tiles - 1) / tiles));
+  CurvatureResult c;
+  {
+    Stage stage(log, "curvature in tiles of " + std::to_string(per_tile) + " vertices");
+    c = estimate_tiled(mesh, options, {.tile_vertices = per_tile, .threads = flags.threads});
+  }
+  print_summary(c, log);
+  return c;
 }
 
 CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags, const Log& log) {

@@ -281,3 +281,47 @@ def test_command_line_streams_parts_and_a_manifest(tmp_path, client, awkward_ply
     r = run_cli(str(path), "--parts", str(tmp_path / "p2"), "--scheduler",
                 client.scheduler.address)
     assert r.returncode == 2 and "estimator='paper' only" in r.stderr
+
+
+def _vm_data_mb():
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmData:"))
+
+
+def _limit_data(extra_mb):
+    """Caps this process's data segment (RLIMIT_DATA: heap and private mappings, NumPy's and
+    focal's arrays included) at its current size + extra_mb: an allocation beyond fails."""
+    import resource
+
+    cap = int((_vm_data_mb() + extra_mb) * 2**20)
+    resource.setrlimit(resource.RLIMIT_DATA, (cap, cap))
+    return os.getpid()
+
+
+def _whole_estimate(path):
+    m = focal.read_mesh(path)
+    return float(np.nansum(focal.curvature(m.V, m.F, m.N, estimator="paper", threads=1).k1))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="VmData, RLIMIT_DATA: Linux")
+def test_a_mesh_larger_than_the_worker_memory_streams_to_the_same_bits(tmp_path):
+    """A worker whose memory is capped 40 MB above its idle size cannot estimate the whole
+    300K-vertex mesh (measured: it needs 60 to 150 MB more), and the streamed run, 20K-vertex
+    tiles, completes in that same worker process with the whole mesh's bits. The cap is the
+    kernel's (RLIMIT_DATA: an allocation beyond it fails), not Dask's memory_limit, which
+    samples the resident size and restarts a worker over it (a new process, without the cap)."""
+    s = focal.generate_surface("torus", 300_000)
+    path = tmp_path / "torus.ply"
+    focal.write_mesh(path, s.V, s.F, s.N)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
+        (pid,) = client.run(_limit_data, 40).values()
+        with pytest.raises((MemoryError, RuntimeError)):  # bad_alloc, or a thread not started
+            client.submit(_whole_estimate, str(path), retries=0).result()
+        fd.curvature_stream(path, tmp_path / "parts", client, output=tmp_path / "fields.npz",
+                            tile_vertices=20_000, threads=1, estimator="paper")
+        assert list(client.run(os.getpid).values()) == [pid]  # the capped process ran it all
+    m = focal.read_mesh(path)
+    whole = focal.curvature(m.V, m.F, m.N, estimator="paper")
+    saved = np.load(tmp_path / "fields.npz")
+    assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)

@@ -404,6 +404,17 @@ check "--threads 1 and --threads 3 give identical files (irregular torus)" \
 check "torus: both elliptic and hyperbolic vertices" \
   bash -c 'c=$(awk -F, "NR > 1 { print \$12 }" torus1.csv | sort -u); grep -qx elliptic <<<"$c" && grep -qx hyperbolic <<<"$c"'
 
+# --tiles N: the mesh in N tiles with halos, one after the other (docs/SCALE.md): the same file.
+run curvature torus.ply -o torus-tiles.csv --tiles 7 --threads 1
+check "--tiles 7 gives the file of the whole run (recommended estimator)" \
+  bash -c '[[ $1 -eq 0 && -s torus-tiles.csv ]] && cmp -s torus1.csv torus-tiles.csv' _ "$rc"
+run curvature torus.ply -o torus-paper.csv --paper --rings 2
+run curvature torus.ply -o torus-paper-tiles.csv --paper --rings 2 --tiles 5
+check "--tiles 5 gives the file of the whole run (--paper --rings 2)" \
+  bash -c '[[ $1 -eq 0 && -s torus-paper.csv ]] && cmp -s torus-paper.csv torus-paper-tiles.csv' _ "$rc"
+expect_error "--tiles 0: a usage error" 1 "--tiles" t0.csv curvature torus.ply -o t0.csv --tiles 0
+expect_error "--tiles with a .ply output: a usage error" 1 ".csv" t.ply curvature torus.ply -o t.ply --tiles 3
+
 # ---------------------------------------------------------------------------------------------
 # Meshes without normals
 ico off >ico.off
