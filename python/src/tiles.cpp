@@ -45,11 +45,11 @@ focal::MeshWideChoices choices_from(const nb::dict& d) {
   focal::MeshWideChoices c;
   c.mean_edge_length = nb::cast<double>(d["mean_edge_length"]);
   if (d.contains("noise")) {
-    c.recommended = focal::RecommendedMeshWide{
-        .noise = nb::cast<double>(d["noise"]),
-        .position_noise = nb::cast<double>(d["position_noise"]),
-        .file_disagreement = nb::cast<double>(d["file_disagreement"]),
-        .side = nb::cast<double>(d["side"])};
+    c.recommended =
+        focal::RecommendedMeshWide{.noise = nb::cast<double>(d["noise"]),
+                                   .position_noise = nb::cast<double>(d["position_noise"]),
+                                   .file_disagreement = nb::cast<double>(d["file_disagreement"]),
+                                   .side = nb::cast<double>(d["side"])};
   }
   return c;
 }
@@ -144,8 +144,7 @@ void bind_tiles(nb::module_& m) {
         "N"_a.none().noconvert(), "vertices"_a.noconvert(), "faces"_a.noconvert());
   m.def("estimate_tile", &estimate_tile, "V"_a.noconvert(), "F"_a.noconvert(),
         "N"_a.none().noconvert(), "options"_a, "choices"_a);
-  m.def("edge_length_sums", &edge_length_sums, "V"_a.noconvert(), "F"_a.noconvert(),
-        "threads"_a);
+  m.def("edge_length_sums", &edge_length_sums, "V"_a.noconvert(), "F"_a.noconvert(), "threads"_a);
   m.attr("edge_length_block") = focal::kEdgeLengthBlock;
   m.def(
       "estimate_reach",

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "core/parallel.h"
 #include "focal/core/edge_lengths.h"
 #include "focal/core/error.h"
-#include "core/parallel.h"
 
 namespace focal {
 

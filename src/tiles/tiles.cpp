@@ -163,19 +163,30 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
   detail::check_face_indices(V.rows(), F, "partition_mesh");
   const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, options.threads);
   const std::vector<int> order = morton_order(V, options.threads);
-  Marks marks{std::vector<int>(order.size(), -1),
-              std::vector<int>(static_cast<std::size_t>(F.rows()), -1)};
   Tiling out;
   out.halo_rings = halo_rings;
   const auto step = static_cast<std::size_t>(options.tile_vertices);
-  for (std::size_t first = 0; first < order.size(); first += step) {
-    const std::size_t last = std::min(order.size(), first + step);
-    std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
-                           order.begin() + static_cast<std::ptrdiff_t>(last));
-    sort_ids(owned);
-    out.tiles.push_back(
-        make_tile(std::move(owned), F, inc, halo_rings, static_cast<int>(out.tiles.size()), marks));
-  }
+  out.tiles.resize((order.size() + step - 1) / step);
+  // Tiles in parallel, each thread with its own marks (a tile's stamp is its index, so marks
+  // are never cleared): 8 bytes per vertex and face per thread, allocated on first use.
+  std::vector<std::unique_ptr<Marks>> marks(
+      static_cast<std::size_t>(detail::thread_count(options.threads)));
+  detail::parallel_chunks(
+      static_cast<std::int64_t>(out.tiles.size()), options.threads, [&](std::int64_t t) {
+        auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
+        if (!m) {
+          m = std::make_unique<Marks>(
+              Marks{std::vector<int>(order.size(), -1),
+                    std::vector<int>(static_cast<std::size_t>(F.rows()), -1)});
+        }
+        const std::size_t first = static_cast<std::size_t>(t) * step;
+        const std::size_t last = std::min(order.size(), first + step);
+        std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
+                               order.begin() + static_cast<std::ptrdiff_t>(last));
+        sort_ids(owned);
+        out.tiles[static_cast<std::size_t>(t)] =
+            make_tile(std::move(owned), F, inc, halo_rings, static_cast<int>(t), *m);
+      });
   return out;
 }
 
