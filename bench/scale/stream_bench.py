@@ -55,8 +55,11 @@ def main() -> None:
     out = os.path.join(a.parts, "fields.npz")
     timings = {}
 
+    peaks = {}
+
     def on_phase(name, seconds):
         timings[name] = seconds
+        peaks[name] = peak_rss() / 2**20  # the driver's peak so far
 
     t = time.perf_counter()
     manifest = fd.curvature_stream(a.mesh, a.parts, client, output=out,
@@ -72,7 +75,8 @@ def main() -> None:
           f"+{100 * halo:.1f}% vertices")
     driver = peak_rss() / 2**20
     print("stream: " + ", ".join(f"{k} {v:.1f} s" for k, v in timings.items()) +
-          f", total {total:.1f} s; driver peak RSS {driver:.0f} MB; task peak RSS "
+          f", total {total:.1f} s; driver peak RSS {driver:.0f} MB (after the plan "
+          f"{peaks['plan']:.0f} MB); task peak RSS "
           f"{workers:.0f} MB (limit {a.memory_limit})")
     sys.stdout.flush()
     if a.no_single:

@@ -408,30 +408,29 @@ def peak_rss() -> int:
 
 
 def concatenate(manifest: dict, parts: str, output: str) -> None:
-    """The parts' rows in input order, as one .npz of the fields (written field by field
-    through memory-mapped .npy files, so that memory stays at one part)."""
+    """The parts' rows in input order, as one .npz of the fields: each part's rows are written
+    by id into .npy columns mapped for that part only (the written pages then belong to the
+    page cache, not to this process), then the columns are stored in the .npz."""
     import zipfile
 
     n = manifest["vertex_count"]
-    columns = {}
-    for k in FIELDS:
+    columns = {k: os.path.join(parts, f".{k}.npy") for k in FIELDS}
+    for k, column in columns.items():
         shape = (n, 3) if k in ("d1", "d2") else (n,)
         dtype = {"point_class": np.uint8, "rays_used": np.int32,
                  "rays_excluded": np.int32}.get(k, np.float64)
-        columns[k] = np.lib.format.open_memmap(os.path.join(parts, f".{k}.npy"), "w+", dtype,
-                                               shape)
+        np.lib.format.open_memmap(column, "w+", dtype, shape).flush()  # header, size
     for part in manifest["parts"]:
         with np.load(os.path.join(parts, part["part"])) as z:
             ids = z["ids"]
-            for k in FIELDS:
-                columns[k][ids] = z[k]
+            for k, column in columns.items():
+                m = np.load(column, mmap_mode="r+")
+                m[ids] = z[k]
+                del m  # unmapped: its dirty pages are written back by the kernel
     tmp = output + ".tmp"
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
         for k, column in columns.items():
-            column.flush()
-            del column
-            z.write(os.path.join(parts, f".{k}.npy"), f"{k}.npy")
-    columns.clear()
-    for k in FIELDS:
-        os.unlink(os.path.join(parts, f".{k}.npy"))
+            z.write(column, f"{k}.npy")
+    for column in columns.values():
+        os.unlink(column)
     os.replace(tmp, output)
