@@ -46,6 +46,8 @@ def main() -> None:
     p.add_argument("--memory-limit", default="2GB")
     p.add_argument("--tile-vertices", type=int, default=1_000_000)
     p.add_argument("--no-single", action="store_true")
+    p.add_argument("--compare", help="a single run's fields (.npz, as this bench writes them) "
+                   "to compare with, in place of running it")
     a = p.parse_args()
     from distributed import Client, LocalCluster
 
@@ -79,6 +81,8 @@ def main() -> None:
           f"{peaks['plan']:.0f} MB); task peak RSS "
           f"{workers:.0f} MB (limit {a.memory_limit})")
     sys.stdout.flush()
+    if a.compare:
+        return print(f"identical to {a.compare}: {'yes' if same_fields(out, a.compare) else 'NO'}")
     if a.no_single:
         return
     single_out = os.path.join(a.parts, "single.npz")
@@ -90,9 +94,12 @@ def main() -> None:
     s = json.loads(r.stdout.strip().splitlines()[-1])
     print(f"single: {s['seconds']:.1f} s, peak RSS {s['peak_mb']:.0f} MB; stream / single "
           f"{total / s['seconds']:.2f} x")
-    with np.load(out) as x, np.load(single_out) as y:
-        same = all(x[k].tobytes() == y[k].tobytes() for k in fd.FIELDS)
-    print(f"identical: {'yes' if same else 'NO'}")
+    print(f"identical: {'yes' if same_fields(out, single_out) else 'NO'}")
+
+
+def same_fields(a: str, b: str) -> bool:
+    with np.load(a) as x, np.load(b) as y:
+        return all(x[k].tobytes() == y[k].tobytes() for k in fd.FIELDS)
 
 
 if __name__ == "__main__":

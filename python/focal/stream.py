@@ -336,6 +336,23 @@ def _distinct(x: np.ndarray) -> np.ndarray:
     return s[np.r_[True, s[1:] != s[:-1]]] if s.size else s
 
 
+def _member(x: np.ndarray, ascending: np.ndarray) -> np.ndarray:
+    """Whether each value of x (ids >= 0) is in `ascending`: a table of 2^24 bits by the ids' low
+    bits rules out most values, a binary search decides the rest (np.isin sorts both arrays;
+    a table over the whole id range would grow with the mesh)."""
+    out = np.zeros(x.shape, bool)
+    if ascending.size == 0:
+        return out
+    mask = (1 << 24) - 1
+    table = np.zeros(mask + 1, bool)
+    table[ascending & mask] = True
+    flat = x.ravel()
+    maybe = np.flatnonzero(table[flat & mask])
+    i = np.minimum(np.searchsorted(ascending, flat[maybe]), ascending.size - 1)
+    out.ravel()[maybe] = ascending[i] == flat[maybe]
+    return out
+
+
 def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The union of two ascending arrays without common values, ascending (a stable sort of two
     runs is a merge)."""
@@ -359,15 +376,18 @@ def tile_arrays(p: dict, t: int) -> dict:
         found = []
         for u in _distinct(tiles.tiles(mesh.positions(frontier))):
             r = _tile_records(p["workdir"], "faces", int(u), 4)
-            r = r[np.isin(r[:, 1:], frontier).any(axis=1)]
-            found.append(r[~np.isin(r[:, 0], taken_ids, assume_unique=True)])
+            if u != t or taken_ids.size:  # else: every face of t's file has an owned corner
+                m = _member(r[:, 1:], frontier)
+                r = r[m[:, 0] | m[:, 1] | m[:, 2]]
+                r = r[~_member(r[:, 0], taken_ids)]
+            found.append(r)
         new = np.concatenate(found)
         new = new[np.argsort(new[:, 0], kind="stable")]
         new = new[np.r_[True, new[1:, 0] != new[:-1, 0]]] if len(new) else new
         taken.append(new)
         taken_ids = _merge(taken_ids, new[:, 0])
         corners = _distinct(new[:, 1:])
-        frontier = corners[~np.isin(corners, reached, assume_unique=True)]
+        frontier = corners[~_member(corners, reached)]
         reached = _merge(reached, frontier)
     faces = np.concatenate(taken)
     faces = faces[np.argsort(faces[:, 0], kind="stable")]
