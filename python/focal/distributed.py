@@ -30,12 +30,12 @@ import numpy as np
 
 import focal
 from focal import _focal_ext as _ext
-
-__all__ = ["curvature", "curvature_stream", "main"]
+from focal import stream
 
 #: The per-vertex fields of focal.Curvature that tiles write back.
-FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
-          "rays_excluded")
+FIELDS = stream.FIELDS
+
+__all__ = ["curvature", "curvature_stream", "main"]
 
 #: Tasks in flight per worker thread: enough to keep workers busy while results come back,
 #: few enough that the scheduler holds only a few tiles' arrays.
@@ -206,8 +206,6 @@ def curvature_stream(
     import time
 
     from distributed import as_completed
-
-    from focal import stream
 
     own_cluster = client is None
     if own_cluster and options.get("threads") is None:

@@ -54,6 +54,7 @@ _PLY_TYPES = {
     "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
 }
 
+#: The per-vertex fields of focal.Curvature that tiles write back.
 FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
           "rays_excluded")
 
@@ -259,6 +260,8 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
     _uniform_options(options, mesh)
     if int(tile_vertices) < 1:
         raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
+    if mesh.vertex_count == 0:
+        raise focal.FocalIOError(f"{mesh.path}: no vertices, nothing to compute")
     os.makedirs(workdir, exist_ok=True)
     lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
     for b, e in _ranges(mesh.vertex_count, CHUNK):
@@ -271,10 +274,14 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
         counts += np.bincount(TileMap.cells(mesh.positions(slice(b, e)), lo, hi),
                               minlength=counts.size)
     # Cells in Morton order, cut into runs of about tile_vertices vertices (a cell is not cut).
+    # Tiles numbered densely over the cells that hold vertices (an empty cell maps nowhere).
     before = np.cumsum(counts) - counts
-    _, cell_tile = np.unique(before // int(tile_vertices), return_inverse=True)
-    tiles = TileMap(lo, hi, cell_tile.astype(np.int32))
-    tile_count = int(cell_tile.max()) + 1
+    full = counts > 0
+    _, dense = np.unique(before[full] // int(tile_vertices), return_inverse=True)
+    cell_tile = np.zeros(counts.size, np.int32)
+    cell_tile[full] = dense
+    tiles = TileMap(lo, hi, cell_tile)
+    tile_count = int(dense.max()) + 1
     np.save(os.path.join(workdir, "cell_tile.npy"), tiles.cell_tile)
     for t in range(tile_count):
         for kind in ("vertices", "faces"):

@@ -192,12 +192,13 @@ def awkward_ply(tmp_path_factory, awkward):
 @pytest.mark.parametrize(
     "options, tile_vertices",
     [({}, 400), ({"rings": 2, "ray_weighting": "gaussian"}, 250), ({"method": "triangle"}, 900),
-     ({}, 100_000)],
-    ids=["paper", "paper-2-rings", "paper-triangle", "one-tile"],
+     ({}, 100_000), ({}, None)],
+    ids=["paper", "paper-2-rings", "paper-triangle", "one-tile", "one-tile-exactly"],
 )
 def test_streamed_tiles_give_the_whole_mesh_bits(client, awkward_ply, tmp_path, options,
                                                 tile_vertices):
     path, (V, F, N) = awkward_ply
+    tile_vertices = tile_vertices or len(V)  # None: the vertex count (no empty tile after it)
     whole = focal.curvature(V, F, N, estimator="paper", **options)
     out = tmp_path / "fields.npz"
     manifest = fd.curvature_stream(path, tmp_path / "parts", client, output=out,
