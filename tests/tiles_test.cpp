@@ -203,6 +203,22 @@ TEST(Tiles, EveryVertexIsOwnedOnceAndItsReachIsInItsTile) {
   for (int v = 0; v < n; ++v) EXPECT_NE(owner[static_cast<std::size_t>(v)], -1) << v;
 }
 
+TEST(Tiles, TheTilesAreTheSameForAnyThreadCount) {
+  // The tiles are cut in parallel with per-thread marks: none of it may show in a tile.
+  const Mesh m = awkward_mesh(4);
+  const Tiling one = partition_mesh(m.V, m.F, 3, {.tile_vertices = 90, .threads = 1});
+  for (const int threads : {2, 3}) {
+    const Tiling many = partition_mesh(m.V, m.F, 3, {.tile_vertices = 90, .threads = threads});
+    ASSERT_EQ(one.tiles.size(), many.tiles.size());
+    ASSERT_GT(one.tiles.size(), 4U);
+    for (std::size_t t = 0; t < one.tiles.size(); ++t) {
+      EXPECT_EQ(one.tiles[t].vertices, many.tiles[t].vertices) << "tile " << t;
+      EXPECT_EQ(one.tiles[t].faces, many.tiles[t].faces) << "tile " << t;
+      EXPECT_EQ(one.tiles[t].owned, many.tiles[t].owned) << "tile " << t;
+    }
+  }
+}
+
 TEST(Tiles, AHaloOneRingShortOfThePapersReachChangesTheResult) {
   // The paper's reach is not loose: one ring less and some owned vertex sees a different
   // neighbourhood. (The recommended estimator's outermost rings decide only which of two normal
