@@ -9,7 +9,7 @@ read a chunk at a time; the operating system's page cache, not the process, hold
   cuts the cells, in Morton order, into runs of about ``tile_vertices`` vertices: a vertex's
   tile is a function of its position (``TileMap``), nothing per vertex is kept; pass 2 also
   writes each tile's owned vertex ids to a file. Pass 3 over the faces, in whole blocks of
-  ``_focal_ext.edge_length_block`` faces, writes each face (its id and corners) to the face file
+  ``_focal_ext.edge_length_block()`` faces, writes each face (its id and corners) to the face file
   of every tile owning one of its corners, and adds up the edge lengths per block, added in
   block order as ``mean_edge_length`` does: the whole mesh's mean edge length, bit for bit.
 - **Tile** (a worker, ``estimate_tile``): the halo by rings from the face files: round r takes,
@@ -289,7 +289,7 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
     for b, e in _ranges(mesh.vertex_count, CHUNK):
         _append_grouped(workdir, "vertices", tiles.tiles(mesh.positions(slice(b, e))),
                         np.arange(b, e, dtype=np.int32)[:, None])
-    block = int(_ext.edge_length_block)
+    block = int(_ext.edge_length_block())
     edge_sum, edge_count = 0.0, 0
     for b, e in _ranges(mesh.face_count, block * max(1, CHUNK // block)):
         C = mesh.corners(b, e)

@@ -119,7 +119,7 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
 }
 
 /// mean_edge_length's partial sums of a run of whole blocks of faces (focal/core/mesh.h), for
-/// the streaming reader (focal/stream.py): (sums, counts) per block of edge_length_block faces.
+/// the streaming reader (focal/stream.py): (sums, counts) per block of edge_length_block() faces.
 nb::tuple edge_length_sums(const DoubleRows& V, const IntRows& F, int threads) {
   focal::EdgeLengthSums s;
   {
@@ -145,7 +145,7 @@ void bind_tiles(nb::module_& m) {
   m.def("estimate_tile", &estimate_tile, "V"_a.noconvert(), "F"_a.noconvert(),
         "N"_a.none().noconvert(), "options"_a, "choices"_a);
   m.def("edge_length_sums", &edge_length_sums, "V"_a.noconvert(), "F"_a.noconvert(), "threads"_a);
-  m.attr("edge_length_block") = focal::kEdgeLengthBlock;
+  m.def("edge_length_block", [] { return focal::kEdgeLengthBlock; });
   m.def(
       "estimate_reach",
       [](const nb::dict& options) { return focal::estimate_reach(estimate_options(options)); },
