@@ -326,3 +326,35 @@ def test_a_mesh_larger_than_the_worker_memory_streams_to_the_same_bits(tmp_path)
     whole = focal.curvature(m.V, m.F, m.N, estimator="paper")
     saved = np.load(tmp_path / "fields.npz")
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
+
+
+@pytest.mark.parametrize("order", ["<", ">"], ids=["little-endian", "big-endian"])
+def test_streamed_float_ply_with_extra_properties_reads_as_read_mesh(client, awkward, tmp_path,
+                                                                      order):
+    """Another writer's layout: float vertices with a colour between the normals, uint counts,
+    a face property after the list, big- or little-endian: the same arrays as focal.read_mesh,
+    so the same bits."""
+    V, F, N = awkward
+    vertex = np.zeros(len(V), [("x", order + "f4"), ("y", order + "f4"), ("z", order + "f4"),
+                               ("red", "u1"), ("nx", order + "f4"), ("ny", order + "f4"),
+                               ("nz", order + "f4")])
+    for i, axis in enumerate("xyz"):
+        vertex[axis], vertex["n" + axis] = V[:, i], N[:, i]
+    face = np.zeros(len(F), [("count", order + "u4"), ("corners", order + "i4", (3,)),
+                             ("flags", order + "i2")])
+    face["count"], face["corners"] = 3, F
+    endian = "little" if order == "<" else "big"
+    header = (f"ply\nformat binary_{endian}_endian 1.0\ncomment another writer\n"
+              f"element vertex {len(V)}\nproperty float x\nproperty float y\nproperty float z\n"
+              "property uchar red\nproperty float nx\nproperty float ny\nproperty float nz\n"
+              f"element face {len(F)}\nproperty list uint int vertex_indices\n"
+              "property short flags\nend_header\n")
+    path = tmp_path / "float.ply"
+    path.write_bytes(header.encode() + vertex.tobytes() + face.tobytes())
+    m = focal.read_mesh(path)
+    whole = focal.curvature(m.V, m.F, m.N, estimator="paper")
+    out = tmp_path / "fields.npz"
+    fd.curvature_stream(path, tmp_path / "parts", client, output=out, tile_vertices=700,
+                        threads=1, estimator="paper")
+    saved = np.load(out)
+    assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
