@@ -358,3 +358,35 @@ def test_streamed_float_ply_with_extra_properties_reads_as_read_mesh(client, awk
                         threads=1, estimator="paper")
     saved = np.load(out)
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
+
+
+def test_a_worker_killed_during_a_streamed_run_gives_the_same_result(client, awkward_ply,
+                                                                     tmp_path):
+    """A task only reads files and writes its part through a rename: Dask reruns those of the
+    killed worker elsewhere and the parts are the whole mesh's."""
+    import threading
+    import time
+
+    path, (V, F, N) = awkward_ply
+    whole = focal.curvature(V, F, N, estimator="paper")
+    victim = next(iter(client.run(os.getpid).values()))
+    parts = tmp_path / "parts"
+    killed = []
+
+    def kill_at_the_first_part():
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not list(parts.glob("part-*.npz")):
+            time.sleep(0.005)
+        os.kill(victim, signal.SIGKILL)
+        killed.append(len(list(parts.glob("part-*.npz"))))
+
+    killer = threading.Thread(target=kill_at_the_first_part)
+    killer.start()
+    manifest = fd.curvature_stream(path, parts, client, output=tmp_path / "fields.npz",
+                                   tile_vertices=60, threads=1, estimator="paper")
+    killer.join()
+    assert killed and killed[0] < manifest["tile_count"]  # killed before the last part
+    saved = np.load(tmp_path / "fields.npz")
+    assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
+    client.wait_for_workers(2, timeout=60)
+    assert victim not in client.run(os.getpid).values()
