@@ -49,10 +49,16 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 /// same time within noise; 16 kept.
 class PointTree {
  public:
-  explicit PointTree(PositionsRef V) {
+  /// `excluded`: empty, or #V flags of points to leave out as the non-finite ones are.
+  PointTree(PositionsRef V, const std::vector<char>& excluded) {
+    if (!excluded.empty() && excluded.size() != static_cast<std::size_t>(V.rows())) {
+      throw InvalidInput("neighbours: " + std::to_string(excluded.size()) +
+                         " exclusion flags for " + std::to_string(V.rows()) + " points");
+    }
     points_.rows.reserve(static_cast<std::size_t>(V.rows()));
     for (Eigen::Index i = 0; i < V.rows(); ++i) {
-      if (V.row(i).allFinite()) points_.rows.push_back(static_cast<int>(i));
+      const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
+      if (!out && V.row(i).allFinite()) points_.rows.push_back(static_cast<int>(i));
     }
     points_.xyz.resize(3 * points_.rows.size());
     for (std::size_t j = 0; j < points_.rows.size(); ++j) {
@@ -204,9 +210,14 @@ class NearestQuery {
 }  // namespace
 
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
+  return nearest_neighbours(V, k, {}, threads);
+}
+
+Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
+                                  int threads) {
   if (k < 1) throw InvalidInput("neighbours: k must be >= 1, got " + std::to_string(k));
   check_threads(threads);
-  const PointTree tree(V);
+  const PointTree tree(V, excluded);
   const auto count = static_cast<std::int64_t>(tree.size());
   // Every finite point has the same number of neighbours: the CSR is laid out before the
   // queries, which write into it directly (no per-block lists, no second pass).
@@ -231,12 +242,17 @@ Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
 }
 
 Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, int threads) {
+  return radius_neighbours(V, radius, max_count, {}, threads);
+}
+
+Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
+                                 const std::vector<char>& excluded, int threads) {
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     throw InvalidInput("neighbours: radius must be finite and > 0, got " + std::to_string(radius));
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
   check_threads(threads);
-  const PointTree tree(V);
+  const PointTree tree(V, excluded);
   const std::size_t limit =
       max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
   return gather(V.rows(), tree, threads,
@@ -248,6 +264,46 @@ Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, i
                       limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
                       out);
                 });
+}
+
+std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
+                                 int threads) {
+  if (!(ratio > 1.0) || !std::isfinite(ratio)) {
+    throw InvalidInput("outlier_points: ratio must be finite and > 1, got " +
+                       std::to_string(ratio));
+  }
+  check_threads(threads);
+  const int n = neighbours.vertex_count();
+  if (n != V.rows()) throw InvalidInput("outlier_points: the neighbourhoods are not V's");
+  std::vector<double> reach(static_cast<std::size_t>(n), NAN);
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    const int p = static_cast<int>(i);
+    if (neighbours.size(p) == 0) return;
+    double sum = 0.0;
+    for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+      sum += (V.row(*j) - V.row(p)).norm();
+    }
+    reach[static_cast<std::size_t>(i)] = sum / neighbours.size(p);
+  });
+  std::vector<char> outlier(static_cast<std::size_t>(n), 0);
+  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<double> around;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const int p = static_cast<int>(i);
+      around.clear();
+      for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+        if (std::isfinite(reach[static_cast<std::size_t>(*j)])) {
+          around.push_back(reach[static_cast<std::size_t>(*j)]);
+        }
+      }
+      if (around.empty()) continue;
+      const auto middle = around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2);
+      std::nth_element(around.begin(), middle, around.end());
+      const double r = reach[static_cast<std::size_t>(i)];
+      outlier[static_cast<std::size_t>(i)] = r > ratio * *middle;
+    }
+  });
+  return outlier;
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {
