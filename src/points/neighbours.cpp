@@ -44,9 +44,9 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 /// A tree over the finite points of V, their copies stored in the tree's leaf order. Queries
 /// made in that order (tree index 0, 1, ...) walk the leaves their neighbours walked, which stay
 /// in cache, and read the points contiguously: on a randomly ordered 1M-point torus (k = 16),
-/// the permuted copy took the kNN from 2.2 s to ... s CPU, and querying in leaf order rather than
-/// input order had already given 3.1x (docs/POINTS.md). Leaves of 8, 16 and 32 points gave the
-/// same time within noise; 16 kept.
+/// the permuted copy (with the CSR written by the queries) took the kNN from 2.2 s to 1.8 s CPU,
+/// and querying in leaf order rather than input order had already given 3.1x (docs/POINTS.md).
+/// Leaves of 6 to 32 points gave the same time within noise; 16 kept.
 class PointTree {
  public:
   /// `excluded`: empty, or #V flags of points to leave out as the non-finite ones are.
