@@ -19,7 +19,9 @@
 ///  3. the cloud's own normals are used when their median angle to the jet normals is at most
 ///     2.5 times the noise (measured ratio: exact normals 0.49-0.62, exact normals on 10% noisy
 ///     positions 0.74-0.79, normal noise 0.05: 3.4 and more), else the jet normals turned to
-///     their side.
+///     their side;
+///  4. the two-slit fit, repeated without the rays far off it where there are such (the mesh
+///     default's robust fit, curvature/robust_fit.h; clean fits keep every ray).
 /// Before all of it (also with k or radius given), statistical outliers (outlier_points over the
 /// 16 nearest, CloudOptions::outlier_ratio) are left out as non-finite points are: they get no
 /// neighbours, are in no list, and are `undefined`.
