@@ -224,6 +224,11 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
                   "point clouds: neighbours within this distance instead of the k nearest")
       ->check(CLI::PositiveNumber);
   command
+      .add_option("--outlier-ratio", cloud.outlier_ratio,
+                  "point clouds: leave out points farther from their 16 nearest than this many "
+                  "times their neighbours' median (0 = keep every point; docs/POINTS.md)")
+      ->default_str(std::to_string(default_outlier_ratio).substr(0, 3));
+  command
       .add_option("--viewpoint", viewpoint,
                   "point clouds without normals: orient estimated normals towards X,Y,Z (the "
                   "scanner) instead of by a minimum spanning tree")

@@ -60,7 +60,7 @@ void add_normals_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("normals", "Estimated, oriented vertex normals (meshes, clouds)");
   auto f = std::make_shared<NormalsFlags>();
   cmd->add_option("input", f->input,
-                  "mesh or point cloud (.obj .ply .off .stl .xyz .pts .txt .csv)")
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .pwn .pts .txt .csv)")
       ->required();
   cmd->add_option("-o,--output", f->output,
                   "OUT.ply, .obj, .off or .xyz: positions, faces, normals")

@@ -237,6 +237,7 @@ TEST_F(MeshIo, FormatFromExtensionIsCaseInsensitive) {
   EXPECT_EQ(focal::mesh_format_from_path("b.off"), focal::MeshFormat::off);
   EXPECT_EQ(focal::mesh_format_from_path("b.stl"), focal::MeshFormat::stl);
   EXPECT_EQ(focal::mesh_format_from_path("cloud.XYZ"), focal::MeshFormat::xyz);
+  EXPECT_EQ(focal::mesh_format_from_path("oni.pwn"), focal::MeshFormat::xyz);  // CGAL's data
   expect_error<focal::IoError>([] { (void)focal::mesh_format_from_path("dir/mesh.abc"); },
                                {"dir/mesh.abc", ".abc"});
   expect_error<focal::IoError>([] { (void)focal::mesh_format_from_path("noext"); }, {"noext"});

@@ -108,6 +108,43 @@ TEST(Neighbours, MeanSpacingOfALattice) {
   EXPECT_DOUBLE_EQ(mean_spacing(grid, nearest_neighbours(grid, 3)), 0.5);
 }
 
+TEST(NearestNeighbours, ExcludedPointsAreLeftOut) {
+  const RowMatrixX3d V = random_cloud(400, 3);
+  std::vector<char> excluded(400, 0);
+  for (int i = 0; i < 400; i += 7) excluded[static_cast<std::size_t>(i)] = 1;
+  RowMatrixX3d without = V;  // the exclusion must be what non-finite points get
+  for (int i = 0; i < 400; i += 7) without(i, 0) = NAN;
+  const Neighbourhoods a = nearest_neighbours(V, 10, excluded, 2);
+  const Neighbourhoods b = nearest_neighbours(without, 10, 2);
+  EXPECT_EQ(a.offsets, b.offsets);
+  EXPECT_EQ(a.indices, b.indices);
+  const Neighbourhoods r = radius_neighbours(V, 0.3, 0, excluded, 2);
+  const Neighbourhoods s = radius_neighbours(without, 0.3, 0, 2);
+  EXPECT_EQ(r.offsets, s.offsets);
+  EXPECT_EQ(r.indices, s.indices);
+  EXPECT_THROW((void)nearest_neighbours(V, 10, std::vector<char>(3, 0)), InvalidInput);
+}
+
+// Points on a plane (a jittered grid) and a few far above it: the isolated ones are flagged,
+// no point of the plane is (its ratios lie near 1).
+TEST(Neighbours, OutlierPointsAreTheIsolatedOnes) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  RowMatrixX3d V(40 * 40 + 3, 3);
+  int r = 0;
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 40; ++y) V.row(r++) << x + jitter(rng), y + jitter(rng), 0.0;
+  }
+  V.row(r++) << 10.0, 10.0, 6.0;  // 6 spacings above the plane
+  V.row(r++) << 30.0, 5.0, -9.0;
+  V.row(r++) << 20.0, 30.0, 25.0;
+  const std::vector<char> outlier = outlier_points(V, nearest_neighbours(V, 16), 2.0);
+  for (int i = 0; i < 1600; ++i) ASSERT_FALSE(outlier[static_cast<std::size_t>(i)]) << i;
+  for (int i = 1600; i < 1603; ++i) EXPECT_TRUE(outlier[static_cast<std::size_t>(i)]) << i;
+  EXPECT_THROW((void)outlier_points(V, nearest_neighbours(V, 16), 1.0), InvalidInput);
+  EXPECT_THROW((void)outlier_points(V.topRows(10), nearest_neighbours(V, 16), 2.0), InvalidInput);
+}
+
 TEST(Neighbours, RejectInvalidArguments) {
   const RowMatrixX3d V = random_cloud(10, 1);
   EXPECT_THROW((void)nearest_neighbours(V, 0), InvalidInput);

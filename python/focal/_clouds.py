@@ -40,6 +40,7 @@ def cloud_curvature(
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
     solver: str = "closed-form",
+    outlier_ratio: float = 3.0,
     threads: Optional[int] = None,
 ) -> Curvature:
     """Principal curvatures and directions, H and K of a point cloud, by the two-slit fit of the
@@ -54,6 +55,9 @@ def cloud_curvature(
         neighbours within this distance instead (at most 1024, the nearest).
     viewpoint : (x, y, z) the scanner position: estimated normals face it.
     solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
+    outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
+        median of the same are left out (NaN, ``undefined``); 0 keeps every point (the library
+        default 3; docs/POINTS.md, "Outliers").
     threads : worker threads; None: FOCAL_NUM_THREADS if set, else all. Results do not depend
         on it.
 
@@ -69,7 +73,9 @@ def cloud_curvature(
         N = _as_rows(normals, "normals", np.float64)
         if N.shape[0] != P.shape[0]:
             raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
-    d = _ext.cloud_curvature(P, N, k, r, normal_method, _viewpoint(viewpoint), solver, t)
+    d = _ext.cloud_curvature(
+        P, N, k, r, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio), t
+    )
     return Curvature(**d)
 
 

@@ -16,10 +16,10 @@
 #include <utility>
 #include <vector>
 
+#include "bindings.h"
 #include "focal/core/error.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/normals/cloud_normals.h"
-#include "bindings.h"
 
 namespace focal_python {
 namespace {
@@ -58,8 +58,9 @@ focal::CloudOptions cloud_options(int k, double radius, const std::string& norma
 nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N, int k,
                          double radius, const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint,
-                         const std::string& solver, int threads) {
-  const focal::CloudOptions o = cloud_options(k, radius, normal_method, viewpoint, solver, threads);
+                         const std::string& solver, double outlier_ratio, int threads) {
+  focal::CloudOptions o = cloud_options(k, radius, normal_method, viewpoint, solver, threads);
+  o.outlier_ratio = outlier_ratio;
   focal::CloudCurvature c;
   {
     nb::gil_scoped_release release;
@@ -90,7 +91,8 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius,
 
 void bind_clouds(nb::module_& m) {
   m.def("cloud_curvature", &cloud_curvature, "V"_a.noconvert(), "N"_a.none().noconvert(), "k"_a,
-        "radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a, "threads"_a);
+        "radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a, "outlier_ratio"_a,
+        "threads"_a);
   m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "normal_method"_a,
         "viewpoint"_a.none(), "threads"_a);
 }

@@ -62,6 +62,18 @@ def test_invalid_input():
         focal.cloud_normals(P, viewpoint=(1, 2))
 
 
+def test_outliers_are_left_out():
+    P, N = sphere_points(n=2000, seed=5)
+    far = np.array([[0.0, 0.0, 5.0], [4.0, -3.0, 1.0]])  # isolated, far off the sphere
+    c = focal.cloud_curvature(np.vstack([P, far]), np.vstack([N, [[0, 0, 1], [1, 0, 0]]]))
+    assert c.undefined[-2:].all() and np.isnan(c.H[-2:]).all()
+    np.testing.assert_allclose(c.H[:-2], 0.5, atol=1e-12)  # exact normals: exact, as without
+    kept = focal.cloud_curvature(np.vstack([P, far]), outlier_ratio=0)
+    assert not np.isnan(kept.H[-2:]).any()
+    with pytest.raises(focal.InvalidInputError, match="outlier_ratio"):
+        focal.cloud_curvature(P, outlier_ratio=0.5)
+
+
 def test_read_mesh_of_a_cloud_has_no_faces(tmp_path):
     P, N = sphere_points(n=500)
     path = tmp_path / "cloud.xyz"

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "curvature/curvature_detail.h"
+#include "curvature/robust_fit.h"
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
 #include "mesh/prepared_detail.h"
@@ -33,10 +35,27 @@ void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o
   if (o.k < 0) throw InvalidInput("cloud curvature: k must be >= 0, got " + std::to_string(o.k));
   if (!(o.radius >= 0.0)) throw InvalidInput("cloud curvature: radius must be >= 0");
   if (o.threads < 0) throw InvalidInput("cloud curvature: threads must be >= 0");
+  if (!(o.outlier_ratio == 0.0 || (o.outlier_ratio > 1.0 && std::isfinite(o.outlier_ratio)))) {
+    throw InvalidInput("cloud curvature: outlier_ratio must be 0 (off) or finite and > 1, got " +
+                       std::to_string(o.outlier_ratio));
+  }
   if (N && N->rows() != V.rows()) {
     throw InvalidInput("cloud curvature: " + std::to_string(N->rows()) + " normals for " +
                        std::to_string(V.rows()) + " points");
   }
+}
+
+/// The neighbourhoods the options select, leaving out the `excluded` points (or none).
+Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& options,
+                                      const std::vector<char>& excluded) {
+  if (options.k < 0 || !(options.radius >= 0.0) || options.threads < 0) {
+    throw InvalidInput("cloud neighbourhoods: k, radius and threads must be >= 0");
+  }
+  if (options.radius > 0.0) {
+    return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, excluded, options.threads);
+  }
+  const int k = options.k > 0 ? options.k : default_cloud_neighbours;
+  return nearest_neighbours(V, k, excluded, options.threads);
 }
 
 CloudNormalOptions normal_options(const CloudOptions& o) {
@@ -49,7 +68,19 @@ CloudNormalOptions normal_options(const CloudOptions& o) {
 CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
                                 const CloudOptions& options) {
   CloudCurvature out;
-  out.neighbours = cloud_neighbourhoods(V, options);
+  out.neighbours = neighbourhoods_without(V, options, {});
+  if (options.outlier_ratio > 0.0) {
+    // The test is over the 16 nearest (where its ratio was measured): the lists at hand when
+    // they are those, else a query of their own.
+    const bool sixteen = options.radius == 0.0 && options.k == default_cloud_neighbours;
+    out.outlier = outlier_points(
+        V,
+        sixteen ? out.neighbours : nearest_neighbours(V, default_cloud_neighbours, options.threads),
+        options.outlier_ratio, options.threads);
+    if (std::find(out.outlier.begin(), out.outlier.end(), 1) != out.outlier.end()) {
+      out.neighbours = neighbourhoods_without(V, options, out.outlier);
+    }
+  }
   out.spacing = mean_spacing(V, out.neighbours);
   out.k = options.radius > 0.0 ? 0 : options.k;
   out.file_normals_used = N.has_value();
@@ -82,13 +113,19 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   CloudCurvature out;
   out.k = default_cloud_neighbours;
   out.neighbours = nearest_neighbours(V, out.k, options.threads);
+  if (options.outlier_ratio > 0.0) {
+    out.outlier = outlier_points(V, out.neighbours, options.outlier_ratio, options.threads);
+    if (std::find(out.outlier.begin(), out.outlier.end(), 1) != out.outlier.end()) {
+      out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
+    }
+  }
   out.spacing = mean_spacing(V, out.neighbours);
   CloudNormalOptions normals = normal_options(options);
   JetNormals jets = detail::cloud_jets(V, out.neighbours, normals);
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
   if (out.noise > kNoisyPositions) {
     out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
-    out.neighbours = nearest_neighbours(V, out.k, options.threads);
+    out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
     normals.jet_degree = 2;
     jets = detail::cloud_jets(V, out.neighbours, normals);
   }
@@ -110,14 +147,7 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
 }  // namespace
 
 Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options) {
-  if (options.k < 0 || !(options.radius >= 0.0) || options.threads < 0) {
-    throw InvalidInput("cloud neighbourhoods: k, radius and threads must be >= 0");
-  }
-  if (options.radius > 0.0) {
-    return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, options.threads);
-  }
-  const int k = options.k > 0 ? options.k : default_cloud_neighbours;
-  return nearest_neighbours(V, k, options.threads);
+  return neighbourhoods_without(V, options, {});
 }
 
 CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
@@ -137,7 +167,17 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
   // A spacing of 0 (a single point, or all duplicates) would make every |k| "not zero"; 1 keeps
   // the tolerance finite, and such points are undefined anyway (fewer than two rays).
   const double scale = out.spacing > 0.0 ? out.spacing : 1.0;
-  out.curvature = detail::fit_vertices({V, out.N, ok, out.neighbours, scale}, fit);
+  const detail::VertexFitInput input{V, out.N, ok, out.neighbours, scale};
+  out.curvature = detail::fit_vertices(input, fit);
+  if (options.k == 0 && options.radius == 0.0) {
+    // The default, as the mesh default on noisy positions: where rays lie far off the fit
+    // (a neighbour off the surface, or with a normal bent by one), it is repeated without them
+    // (curvature/robust_fit.h; clean fits keep every ray, bit for bit).
+    std::vector<int> all(static_cast<std::size_t>(V.rows()));
+    std::iota(all.begin(), all.end(), 0);
+    detail::robust_fit_vertices({input, {}, 0.0}, all, detail::class_tolerances(fit, scale),
+                                options.threads, true, out.curvature);
+  }
   return out;
 }
 

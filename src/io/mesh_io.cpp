@@ -15,9 +15,9 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::ply;
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".stl") return MeshFormat::stl;
-  if (ext == ".xyz" || ext == ".pts" || ext == ".txt" || ext == ".csv") return MeshFormat::xyz;
+  if (ext == ".xyz" || ext == ".pwn" || ext == ".pts" || ext == ".txt" || ext == ".csv") return MeshFormat::xyz;
   io_detail::fail(path, "unknown mesh format '" + path.extension().string() +
-                            "' (expected .obj, .ply, .off, .stl, or .xyz .pts .txt .csv for "
+                            "' (expected .obj, .ply, .off, .stl, or .xyz .pwn .pts .txt .csv for "
                             "point clouds)");
 }
 

@@ -20,15 +20,18 @@ namespace {
 /// tree's traversal.
 using Candidate = std::pair<double, int>;
 
-/// The finite rows of V, as nanoflann's dataset adaptor reads them.
+/// The finite rows of V copied into one contiguous array, as nanoflann's dataset adaptor reads
+/// them. After the tree is built they are permuted into the tree's leaf order (PointTree), so a
+/// leaf's points are adjacent in memory and tree index j is simply the j-th point.
 struct FinitePoints {
-  PositionsRef V;
-  std::vector<int> rows;  ///< tree index -> row of V
+  std::vector<double> xyz;  ///< 3 per point
+  std::vector<int> rows;    ///< tree index -> row of V
 
   [[nodiscard]] std::size_t kdtree_get_point_count() const { return rows.size(); }
   [[nodiscard]] double kdtree_get_pt(std::size_t i, std::size_t dim) const {
-    return V(rows[i], static_cast<Eigen::Index>(dim));
+    return xyz[3 * i + dim];
   }
+  [[nodiscard]] const double* point(std::size_t i) const { return xyz.data() + 3 * i; }
   template <class Box>
   bool kdtree_get_bbox(Box& /*box*/) const {
     return false;
@@ -38,29 +41,36 @@ struct FinitePoints {
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, FinitePoints>,
                                                  FinitePoints, 3, std::uint32_t>;
 
-/// A tree over the finite points of V. Leaves of 8, 16 and 32 points gave the same kNN time
-/// within noise (1M points, k = 16); 16 kept.
+/// A tree over the finite points of V, their copies stored in the tree's leaf order. Queries
+/// made in that order (tree index 0, 1, ...) walk the leaves their neighbours walked, which stay
+/// in cache, and read the points contiguously: on a randomly ordered 1M-point torus (k = 16),
+/// the permuted copy (with the CSR written by the queries) took the kNN from 2.2 s to 1.8 s CPU,
+/// and querying in leaf order rather than input order had already given 3.1x (docs/POINTS.md).
+/// Leaves of 6 to 32 points gave the same time within noise; 16 kept.
 class PointTree {
  public:
-  explicit PointTree(PositionsRef V) : points_{V, {}} {
+  /// `excluded`: empty, or #V flags of points to leave out as the non-finite ones are.
+  PointTree(PositionsRef V, const std::vector<char>& excluded) {
+    if (!excluded.empty() && excluded.size() != static_cast<std::size_t>(V.rows())) {
+      throw InvalidInput("neighbours: " + std::to_string(excluded.size()) +
+                         " exclusion flags for " + std::to_string(V.rows()) + " points");
+    }
     points_.rows.reserve(static_cast<std::size_t>(V.rows()));
     for (Eigen::Index i = 0; i < V.rows(); ++i) {
-      if (V.row(i).allFinite()) points_.rows.push_back(static_cast<int>(i));
+      const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
+      if (!out && V.row(i).allFinite()) points_.rows.push_back(static_cast<int>(i));
+    }
+    points_.xyz.resize(3 * points_.rows.size());
+    for (std::size_t j = 0; j < points_.rows.size(); ++j) {
+      for (int d = 0; d < 3; ++d) points_.xyz[3 * j + d] = V(points_.rows[j], d);
     }
     tree_ = std::make_unique<Tree>(3, points_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    to_leaf_order();
   }
   [[nodiscard]] const Tree& tree() const { return *tree_; }
   [[nodiscard]] int row(std::uint32_t index) const { return points_.rows[index]; }
   [[nodiscard]] std::size_t size() const { return points_.rows.size(); }
-
-  /// The finite rows in the tree's leaf order: neighbouring queries in this order walk the same
-  /// leaves, which stay in cache (on a randomly ordered 1M-point cloud, 2.3x faster than input
-  /// order; docs/POINTS.md).
-  [[nodiscard]] std::vector<int> leaf_order() const {
-    std::vector<int> order(tree_->vAcc.size());
-    for (std::size_t p = 0; p < order.size(); ++p) order[p] = row(tree_->vAcc[p]);
-    return order;
-  }
+  [[nodiscard]] const double* point(std::size_t index) const { return points_.point(index); }
 
   /// Every point at squared distance <= d2 from q (nanoflann's radius test is strict: d2 is
   /// raised to the next double), appended to `out`.
@@ -75,6 +85,21 @@ class PointTree {
   }
 
  private:
+  /// The points permuted so that the tree's index array becomes the identity: the tree (split
+  /// values, bounding boxes, index ranges of the leaves) is unchanged, its point j is now ours.
+  void to_leaf_order() {
+    std::vector<std::uint32_t>& order = tree_->vAcc;
+    std::vector<double> xyz(points_.xyz.size());
+    std::vector<int> rows(points_.rows.size());
+    for (std::size_t j = 0; j < order.size(); ++j) {
+      std::copy_n(points_.point(order[j]), 3, xyz.data() + 3 * j);
+      rows[j] = points_.rows[order[j]];
+      order[j] = static_cast<std::uint32_t>(j);
+    }
+    points_.xyz.swap(xyz);
+    points_.rows.swap(rows);
+  }
+
   FinitePoints points_;
   std::unique_ptr<Tree> tree_;
 };
@@ -89,14 +114,29 @@ void keep_sorted(std::vector<Candidate>& candidates, int self, std::size_t limit
   }
 }
 
-/// The lists of the points in `order` (the finite rows, in the tree's leaf order), gathered in
-/// parallel per block of that order, then laid out in row order as the CSR. Each list depends on
-/// its point alone, so neither the order nor the thread count changes the result.
+constexpr std::int64_t kBlock = 1024;
+
+/// CSR offsets from per-row list sizes.
+Eigen::VectorXi offsets_of(const std::vector<int>& sizes) {
+  Eigen::VectorXi offsets(static_cast<Eigen::Index>(sizes.size()) + 1);
+  offsets[0] = 0;
+  std::int64_t total = 0;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    total += sizes[i];
+    if (total > std::numeric_limits<int>::max()) {
+      throw InvalidInput("neighbours: the lists would not fit 32-bit offsets");
+    }
+    offsets[static_cast<Eigen::Index>(i) + 1] = static_cast<int>(total);
+  }
+  return offsets;
+}
+
+/// The lists of the tree's points, queried in parallel per block of the tree's order, then laid
+/// out in row order as the CSR. Each list depends on its point alone, so neither the order nor
+/// the thread count changes the result.
 template <class Query>
-Neighbourhoods gather(Eigen::Index n, const std::vector<int>& order, int threads,
-                      const Query& query) {
-  constexpr std::int64_t kBlock = 1024;
-  const auto count = static_cast<std::int64_t>(order.size());
+Neighbourhoods gather(Eigen::Index n, const PointTree& tree, int threads, const Query& query) {
+  const auto count = static_cast<std::int64_t>(tree.size());
   std::vector<std::vector<int>> lists(static_cast<std::size_t>((count + kBlock - 1) / kBlock));
   std::vector<int> sizes(static_cast<std::size_t>(n), 0);
   std::vector<int> start(static_cast<std::size_t>(n), 0);  // in its block's list
@@ -104,28 +144,19 @@ Neighbourhoods gather(Eigen::Index n, const std::vector<int>& order, int threads
     std::vector<int>& list = lists[static_cast<std::size_t>(begin / kBlock)];
     std::vector<Candidate> scratch;
     for (std::int64_t p = begin; p < end; ++p) {
-      const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(p)]);
+      const auto i = static_cast<std::size_t>(tree.row(static_cast<std::uint32_t>(p)));
       start[i] = static_cast<int>(list.size());
-      query(static_cast<int>(i), scratch, list);
+      query(static_cast<std::size_t>(p), scratch, list);
       sizes[i] = static_cast<int>(list.size()) - start[i];
     }
   });
   Neighbourhoods out;
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  std::int64_t total = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    total += sizes[static_cast<std::size_t>(i)];
-    if (total > std::numeric_limits<int>::max()) {
-      throw InvalidInput("neighbours: the lists would not fit 32-bit offsets");
-    }
-    out.offsets[i + 1] = static_cast<int>(total);
-  }
-  out.indices.resize(total);
+  out.offsets = offsets_of(sizes);
+  out.indices.resize(out.offsets[n]);
   detail::parallel_for_blocks(count, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
     const std::vector<int>& list = lists[static_cast<std::size_t>(begin / kBlock)];
     for (std::int64_t p = begin; p < end; ++p) {
-      const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(p)]);
+      const auto i = static_cast<std::size_t>(tree.row(static_cast<std::uint32_t>(p)));
       std::copy_n(list.data() + start[i], sizes[i], out.indices.data() + out.offsets[i]);
     }
   });
@@ -136,61 +167,143 @@ void check_threads(int threads) {
   if (threads < 0) throw InvalidInput("neighbours: threads must be >= 0");
 }
 
+/// The k nearest of the tree's point p (not itself), sorted by (distance, row), into `out`.
+/// k + 1 for the point itself, and one more to see whether the k-th distance is tied with a
+/// farther point: then every point at that distance is gathered and the tie broken by index
+/// rather than by the traversal order (rare on measured data, common on grids).
+class NearestQuery {
+ public:
+  NearestQuery(const PointTree& tree, std::size_t k)
+      : tree_(tree), k_(k), wanted_(std::min(k + 2, tree.size())) {}
+  /// Every finite point gets this many (fewer only when the cloud has fewer other points).
+  [[nodiscard]] std::size_t list_size() const { return std::min(k_, tree_.size() - 1); }
+
+  void operator()(std::size_t p, int* out) {
+    index_.resize(wanted_), distance_.resize(wanted_);
+    const double* q = tree_.point(p);
+    const std::size_t found = tree_.tree().knnSearch(q, wanted_, index_.data(), distance_.data());
+    candidates_.clear();
+    if (found == wanted_ && wanted_ >= 2 && distance_[wanted_ - 1] == distance_[wanted_ - 2]) {
+      tree_.within(q, distance_[wanted_ - 1], candidates_);
+    } else {
+      for (std::size_t j = 0; j < found; ++j)
+        candidates_.emplace_back(distance_[j], tree_.row(index_[j]));
+    }
+    // Sorted by distance already (nanoflann's insertion), so the sort only orders ties.
+    std::sort(candidates_.begin(), candidates_.end());
+    const int self = tree_.row(static_cast<std::uint32_t>(p));
+    std::size_t kept = 0;
+    for (const Candidate& c : candidates_) {
+      if (kept == list_size()) break;
+      if (c.second != self) out[kept++] = c.second;
+    }
+  }
+
+ private:
+  const PointTree& tree_;
+  std::size_t k_, wanted_;
+  std::vector<std::uint32_t> index_;
+  std::vector<double> distance_;
+  std::vector<Candidate> candidates_;
+};
+
 }  // namespace
 
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
+  return nearest_neighbours(V, k, {}, threads);
+}
+
+Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
+                                  int threads) {
   if (k < 1) throw InvalidInput("neighbours: k must be >= 1, got " + std::to_string(k));
   check_threads(threads);
-  const PointTree tree(V);
-  // k + 1 for the point itself, and one more to see whether the k-th distance is tied with a
-  // farther point: then every point at that distance is gathered and the tie broken by index
-  // rather than by the traversal order (rare on measured data, common on grids).
-  const std::size_t wanted = std::min<std::size_t>(static_cast<std::size_t>(k) + 2, tree.size());
-  return gather(V.rows(), tree.leaf_order(), threads,
-                [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
-                  if (wanted == 0) return;
-                  std::uint32_t index[64];
-                  double distance[64];
-                  std::vector<std::uint32_t> big_index;
-                  std::vector<double> big_distance;
-                  std::uint32_t* idx = index;
-                  double* dist = distance;
-                  if (wanted > 64) {
-                    big_index.resize(wanted), big_distance.resize(wanted);
-                    idx = big_index.data(), dist = big_distance.data();
-                  }
-                  const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
-                  const std::size_t found = tree.tree().knnSearch(q, wanted, idx, dist);
-                  c.clear();
-                  if (found == wanted && wanted >= 2 && dist[wanted - 1] == dist[wanted - 2]) {
-                    tree.within(q, dist[wanted - 1], c);
-                  } else {
-                    for (std::size_t j = 0; j < found; ++j)
-                      c.emplace_back(dist[j], tree.row(idx[j]));
-                  }
-                  keep_sorted(c, i, static_cast<std::size_t>(k) + out.size(), out);
-                });
+  const PointTree tree(V, excluded);
+  const auto count = static_cast<std::int64_t>(tree.size());
+  // Every finite point has the same number of neighbours: the CSR is laid out before the
+  // queries, which write into it directly (no per-block lists, no second pass).
+  const std::size_t size =
+      count > 0 ? NearestQuery(tree, static_cast<std::size_t>(k)).list_size() : 0;
+  std::vector<int> sizes(static_cast<std::size_t>(V.rows()), 0);
+  for (std::int64_t p = 0; p < count; ++p) {
+    sizes[static_cast<std::size_t>(tree.row(static_cast<std::uint32_t>(p)))] =
+        static_cast<int>(size);
+  }
+  Neighbourhoods out;
+  out.offsets = offsets_of(sizes);
+  out.indices.resize(out.offsets[V.rows()]);
+  detail::parallel_for_blocks(count, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+    NearestQuery query(tree, static_cast<std::size_t>(k));
+    for (std::int64_t p = begin; p < end; ++p) {
+      const int i = tree.row(static_cast<std::uint32_t>(p));
+      query(static_cast<std::size_t>(p), out.indices.data() + out.offsets[i]);
+    }
+  });
+  return out;
 }
 
 Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, int threads) {
+  return radius_neighbours(V, radius, max_count, {}, threads);
+}
+
+Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
+                                 const std::vector<char>& excluded, int threads) {
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     throw InvalidInput("neighbours: radius must be finite and > 0, got " + std::to_string(radius));
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
   check_threads(threads);
-  const PointTree tree(V);
+  const PointTree tree(V, excluded);
   const std::size_t limit =
       max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
-  return gather(V.rows(), tree.leaf_order(), threads,
-                [&](int i, std::vector<Candidate>& c, std::vector<int>& out) {
-                  const double q[3] = {V(i, 0), V(i, 1), V(i, 2)};
+  return gather(V.rows(), tree, threads,
+                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
                   c.clear();
-                  tree.within(q, radius * radius, c);
+                  tree.within(tree.point(p), radius * radius, c);
                   keep_sorted(
-                      c, i,
+                      c, tree.row(static_cast<std::uint32_t>(p)),
                       limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
                       out);
                 });
+}
+
+std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
+                                 int threads) {
+  if (!(ratio > 1.0) || !std::isfinite(ratio)) {
+    throw InvalidInput("outlier_points: ratio must be finite and > 1, got " +
+                       std::to_string(ratio));
+  }
+  check_threads(threads);
+  const int n = neighbours.vertex_count();
+  if (n != V.rows()) throw InvalidInput("outlier_points: the neighbourhoods are not V's");
+  std::vector<double> reach(static_cast<std::size_t>(n), NAN);
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    const int p = static_cast<int>(i);
+    if (neighbours.size(p) == 0) return;
+    double sum = 0.0;
+    for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+      sum += (V.row(*j) - V.row(p)).norm();
+    }
+    reach[static_cast<std::size_t>(i)] = sum / neighbours.size(p);
+  });
+  std::vector<char> outlier(static_cast<std::size_t>(n), 0);
+  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<double> around;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const int p = static_cast<int>(i);
+      around.clear();
+      for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+        if (std::isfinite(reach[static_cast<std::size_t>(*j)])) {
+          around.push_back(reach[static_cast<std::size_t>(*j)]);
+        }
+      }
+      if (around.empty()) continue;
+      const auto middle = around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2);
+      std::nth_element(around.begin(), middle, around.end());
+      const double r = reach[static_cast<std::size_t>(i)];
+      outlier[static_cast<std::size_t>(i)] = r > ratio * *middle;
+    }
+  });
+  return outlier;
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {

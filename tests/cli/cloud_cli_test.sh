@@ -85,6 +85,8 @@ printf '1 2 3\n4 5 x\n' >word.xyz
 expect_error "a word where a number belongs: line and column named" "line 2: column 3" word.csv curvature word.xyz -o word.csv
 printf '# nothing\n' >empty.xyz
 expect_error "no points" "no points" empty.csv curvature empty.xyz -o empty.csv
+expect_error "--outlier-ratio 1: what is wrong named" "outlier_ratio must be 0 (off) or finite and > 1" \
+  ratio.csv curvature bare.xyz -o ratio.csv --outlier-ratio 1
 printf '1 2\n3 4\n' >two.xyz
 expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two.csv
 printf 'k1,k2,H\n1,2,3\n' >table.csv

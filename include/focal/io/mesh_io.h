@@ -3,7 +3,7 @@
 /// Reading and writing meshes and per-vertex tables.
 ///
 /// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary), and
-/// point-cloud text (.xyz .pts .txt .csv: `x y z [nx ny nz]` per line, see docs/POINTS.md).
+/// point-cloud text (.xyz .pwn .pts .txt .csv: `x y z [nx ny nz]` per line, see docs/POINTS.md).
 /// A file without faces is a point cloud: Mesh::F has 0 rows (Mesh::is_cloud).
 /// Vertex order and count of indexed formats (OBJ, PLY, OFF) are preserved exactly; polygons are
 /// fan-triangulated and Mesh::face_source maps each triangle to its input polygon. STL has no

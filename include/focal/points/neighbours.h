@@ -13,6 +13,8 @@
 /// A kNN neighbourhood adapts to the local density by itself (its radius is the distance to the
 /// k-th neighbour, about sqrt(k / (pi rho)) at density rho), which is why focal's cloud estimators
 /// default to kNN rather than to a fixed radius (docs/POINTS.md).
+#include <vector>
+
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 
@@ -23,12 +25,33 @@ namespace focal {
 /// \throw InvalidInput when k < 1, threads < 0 or the lists would not fit 32-bit offsets.
 [[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads = 0);
 
+/// The same, leaving out the points flagged in `excluded` (#V flags, or empty for none) as
+/// non-finite ones are: their lists are empty and they are in no list.
+/// \throw InvalidInput as above, or when `excluded` is neither empty nor #V long.
+[[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k,
+                                                const std::vector<char>& excluded, int threads = 0);
+
 /// Every other point within Euclidean distance `radius` (inclusive), at most `max_count` of them
 /// (the nearest; 0 = no limit).
 /// \throw InvalidInput when radius is not finite and positive, max_count < 0, threads < 0 or
 /// the lists would not fit 32-bit offsets.
 [[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count = 0,
                                                int threads = 0);
+
+/// The same, leaving out the points flagged in `excluded` (as nearest_neighbours).
+[[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
+                                               const std::vector<char>& excluded, int threads = 0);
+
+/// Statistical outliers (#V flags): points whose mean distance to their neighbours is more than
+/// `ratio` times the median of their neighbours' own mean distances. Measured against the
+/// neighbours rather than the whole cloud (as PCL's and Open3D's statistical outlier removal
+/// are), so that a cloud whose density varies (a scan sparser far from the scanner) loses no
+/// point for being in its sparse part: an isolated point off the surface is far from its
+/// neighbours, which are close to theirs. Points with an empty list are not flagged.
+/// \throw InvalidInput when ratio is not finite and > 1, threads < 0, or the neighbourhoods
+/// are not V's.
+[[nodiscard]] std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
+                                               double ratio, int threads = 0);
 
 /// The mean over finite points of the distance to their nearest other point (0 when no point
 /// has a neighbour): the sampling spacing of a cloud, the scale of its class tolerances as the
