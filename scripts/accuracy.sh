@@ -125,8 +125,8 @@ HEAD
 How to read it: with exact normals the corrected measures converge faster than first order on
 irregular triangulations (docs/ESTIMATOR.md, "Baselines"), where the two-slit fit and the
 per-triangle pass are first order: the default itself uses them on clean positions when it
-trusts the file's normals (docs/ESTIMATOR.md, "The corrected step", a ball of half or one local
-edge length), so on clean irregular meshes its error is close to LRTC20's at one mean edge
+trusts the file's normals (docs/ESTIMATOR.md, "The corrected step", a ball of one local edge
+length on irregular samplings), so on clean irregular meshes its error is close to LRTC20's at one mean edge
 length, and LRTC20 stays close to the default under vertex noise. LRTC20 trusts the file's
 normals, so noisy normals go into it unfiltered (the normal-noise rows), and with normals from
 the faces (Max) the advantage is gone.
@@ -253,20 +253,19 @@ HARD
 
 Where focal default loses on these cases (measured, docs/ESTIMATOR.md "Hard cases"):
 
-- **Strips across the curvature** (saddle 20:1): the cotangent formula (MDSB03) is exact for
-  the symmetric stencils of a strip grid in the long direction; the corrected step's half-edge
-  ball (symmetric stencil) reaches only the neighbours along the short edges fully. Closing it
-  needs anisotropy-aware weights; not built.
+- **Strips across the curvature** (saddle 20:1, helix tube 1:5): the cotangent formula (MDSB03)
+  is exact for the symmetric stencils of a strip grid in the long direction; the two-slit fit and
+  the per-triangle pass see neighbours at very different distances, and their first-order terms
+  do not cancel. Closing it needs anisotropy-aware weights; not built.
 - **Spikes** (0.5% of the vertices 2 edges off): a spike tilts the faces around it past the crease
   angle, so its 2-ring keeps the crease handling (Max's normals, the per-triangle pass) instead
   of the corrected step on the file's normals, which LRTC20 on the file's normals shows to be
   better there; without file normals the jets of its 2-ring are pulled, and the 2-ring
   closed-form fit of Max's normals averages the spike over more rays. Dropping creases that lie
   inside one vertex's 1-ring was measured (docs/ESTIMATOR.md, "The corrected step") and not kept.
-- **Lat-long ellipsoid 1:5, coarse pear and graded pear with file normals**: 1% to 16% behind
-  the per-triangle pass or LRTC20 at one mean edge length on the same normals: the corrected
-  step's ball (half or one local edge, chosen by the stencil's symmetry) is not the best one for
-  every vertex of these meshes.
+- **Coarse pear and graded pear with file normals**: 2% to 6% behind the per-triangle pass or
+  LRTC20 at one mean edge length on the same normals: the corrected step's ball (one local edge
+  length) is not the best one for every vertex of these meshes.
   **Coarse helix tube and torus strips without normals**: behind the per-triangle pass on Max's
   normals; the default's per-vertex roughness test keeps the jets' normals there.
 - **Creases under vertex noise**: crease detection runs on clean positions only (noise folds

@@ -73,11 +73,11 @@ void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods&
   parallel_for(fitted.vertex_count(), options.threads, [&](std::int64_t i) {
     const bool replaceable = !(fit.residual[i] <= exact_residual) &&
                              (keep.empty() || !keep[static_cast<std::size_t>(i)]);
-    // NaN asymmetry (no normal, no neighbour): radius 0, no measure.
-    radius[i] = !replaceable || !std::isfinite(asymmetry[i]) ? 0.0
-                : asymmetry[i] < kSymmetricStencil
-                    ? kSymmetricBall * local_edge_length(fitted.V(), one_ring, static_cast<int>(i))
-                    : kIrregularBall * local_edge_length(fitted.V(), one_ring, static_cast<int>(i));
+    // Radius 0, no measure: symmetric stencils (and NaN asymmetry: no normal, no neighbour).
+    const bool irregular = asymmetry[i] >= kSymmetricStencil;
+    radius[i] = replaceable && irregular
+                    ? kCorrectedBall * local_edge_length(fitted.V(), one_ring, static_cast<int>(i))
+                    : 0.0;
   });
   const CurvatureResult corrected = baselines::detail::corrected_curvature(
       fitted, unit.N, radius, kCorrectedBallRings, options);

@@ -24,30 +24,30 @@ Eigen::VectorXd stencil_asymmetry(PositionsRef V, const RowMatrixX3d& N,
 /// populations do not overlap on the evaluation's meshes: interior vertices of regular, strip
 /// and lat-long grids measure below 0.2 (grid boundaries and pole fans up to 0.35), of random
 /// samplings above 0.26 (minimum; 0.29 at the 1st percentile). A vertex on the wrong side takes
-/// the other ball: errors of the same order, not a failure.
+/// the other estimate (the per-triangle pass or the corrected measures): errors of the same
+/// order, not a failure.
 constexpr double kSymmetricStencil = 0.25;
 
-/// Ball radii of the corrected step, in lengths of the vertex's own edges (their mean): on
-/// symmetric stencils the ball of the 1-ring's faces (each weighted by its fraction inside half
-/// an edge), whose first-order errors cancel as the per-triangle pass's do; elsewhere one edge
-/// length, which reaches into the 2-ring's faces and averages the first-order errors of an
-/// irregular sampling out. Measured on `focal eval --suite hard`, seeds 1 and 2: half an edge
-/// everywhere loses the irregular cases (graded torus 0.0055 vs 0.0045), one edge everywhere
-/// the regular and strip grids (torus strips 0.0051 vs 0.0014), one and a half edges the coarse
-/// meshes; a ball in the mesh's mean edge length instead of the local one loses the graded
-/// meshes (median 0.0073 vs 0.0057).
-constexpr double kSymmetricBall = 0.5;
-constexpr double kIrregularBall = 1.0;
+/// Ball radius of the corrected step, in lengths of the vertex's own edges (their mean): it
+/// reaches into the 2-ring's faces and averages the first-order errors of an irregular sampling
+/// out. Measured on `focal eval --suite hard`, seeds 1 and 2 (in mean edge lengths): half an
+/// edge loses the irregular cases (graded torus 0.0055 vs 0.0045), 1.5 and 2 edges the coarse
+/// meshes (median 0.030 and 0.045 vs 0.017); a ball in the
+/// mesh's mean edge length instead of the local one loses the graded meshes (median 0.0073 vs
+/// 0.0057). Symmetric stencils keep the per-triangle pass (docs/ESTIMATOR.md, "The corrected
+/// step": half an edge there won on strip grids and lost on regular ones).
+constexpr double kCorrectedBall = 1.0;
 
 /// Rings a corrected-step ball reaches at most (ball::gather's cap; recommended_reach).
 constexpr int kCorrectedBallRings = 3;
 
 /// The second-order step of the recommended estimator on trusted normals (file normals that
 /// agree with the positions, on clean positions): LRTC20's interpolated corrected curvature
-/// measures (baselines.h) of the fitted normals `fitted.normals()` over a ball of kSymmetricBall
-/// or kIrregularBall local edge lengths (by stencil_asymmetry), into the rows of `fit` except
-/// where `fit` is exact (residual at rounding), where `keep` is set (crease neighbourhoods) or
-/// where the measures are undefined.
+/// measures (baselines.h) of the fitted normals `fitted.normals()` over a ball of kCorrectedBall
+/// local edge lengths, into the rows of `fit` at vertices whose stencil is not symmetric
+/// (stencil_asymmetry at least kSymmetricStencil), except where `fit` is exact (residual at or
+/// below `exact_residual`), where `keep` is set (crease neighbourhoods) or where the measures are
+/// undefined.
 void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
                                const CurvatureOptions& options, const std::vector<char>& keep,
                                double exact_residual, CurvatureResult& fit);
