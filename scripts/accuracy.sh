@@ -126,8 +126,8 @@ How to read it: with exact normals the corrected measures converge faster than f
 irregular triangulations (docs/ESTIMATOR.md, "Baselines"), where the two-slit fit and the
 per-triangle pass are first order: the default itself uses them on clean positions when it
 trusts the file's normals (docs/ESTIMATOR.md, "The corrected step", a ball of one local edge
-length on irregular samplings), so on clean irregular meshes its error is close to LRTC20's at one mean edge
-length, and LRTC20 stays close to the default under vertex noise. LRTC20 trusts the file's
+length on irregular samplings), so on clean irregular meshes its error is close to LRTC20's at
+one mean edge length, and LRTC20 stays close to the default under vertex noise. LRTC20 trusts the file's
 normals, so noisy normals go into it unfiltered (the normal-noise rows), and with normals from
 the faces (Max) the advantage is gone.
 YLHP06's surface-patch covariance needs wide balls: at 4 edge lengths its H error is mostly the
