@@ -54,7 +54,7 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
   Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
-    write_curvature_csv(f.output, e.curvature);
+    write_curvature_csv(f.output, e.curvature, e.crease);
     return;
   }
   // The mesh as the estimator saw it (input.prepared is not used after this).
@@ -62,7 +62,8 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
   if (e.F) mesh.F = std::move(*e.F);
   if (e.N) mesh.N = std::move(*e.N);
   write_curvature_ply(f.output, mesh, e.curvature,
-                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
+                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads},
+                      e.crease);
 }
 
 /// The focal meshes of a mesh, or the focal point clouds (no faces) of a point cloud.
@@ -101,13 +102,15 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       ->required();
   cmd->add_option("-o,--output", f->output,
                   "OUT.csv (one row per input vertex) or OUT.ply (the mesh with per-vertex "
-                  "properties k1,k2,H,K,d1x..d2z,residual,class)")
+                  "properties k1,k2,H,K,d1x..d2z,residual,class, and crease from the recommended "
+                  "estimator)")
       ->required();
   cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
   f->estimator.add_to(*cmd);
   cmd->footer(
       "Columns: k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class (k1 >= k2; outward normals;\n"
-      "a sphere of radius r has k1 = k2 = +1/r). Examples:\n"
+      "a sphere of radius r has k1 = k2 = +1/r), then crease (1 at a vertex on a sharp edge,\n"
+      "where the curvature does not exist) from the recommended estimator. Examples:\n"
       "  focal curvature bunny.off -o bunny.csv          # the recommended estimator\n"
       "  focal curvature bunny.off -o bunny.csv --paper  # the paper's method as written\n"
       "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v\n"

@@ -122,11 +122,14 @@ From `focal eval --vertices 4000 --seed 1` (accuracy/eval.csv) by `scripts/basel
 HEAD
   cat "$work/baselines.md"
   cat <<'BASELINES'
-How to read it: LRTC20 with the file's normals has the lowest H error on clean irregular meshes
-and is close to the default under vertex noise: with exact normals the corrected measures
-converge at second order on irregular triangulations too (docs/ESTIMATOR.md, "Baselines"), where
-the default's fit is first order. It trusts the file's normals, so noisy normals go into it
-unfiltered (the normal-noise rows), and with normals from the faces (Max) the advantage is gone.
+How to read it: with exact normals the corrected measures converge faster than first order on
+irregular triangulations (docs/ESTIMATOR.md, "Baselines"), where the two-slit fit and the
+per-triangle pass are first order: the default itself uses them on clean positions when it
+trusts the file's normals (docs/ESTIMATOR.md, "The corrected step", a ball of one local edge
+length on irregular samplings), so on clean irregular meshes its error is close to LRTC20's at
+one mean edge length, and LRTC20 stays close to the default under vertex noise. LRTC20 trusts the file's
+normals, so noisy normals go into it unfiltered (the normal-noise rows), and with normals from
+the faces (Max) the advantage is gone.
 YLHP06's surface-patch covariance needs wide balls: at 4 edge lengths its H error is mostly the
 O(h^2 / r^2) discretisation bias, and its directions rest on k1^2 - k2^2, which vanishes on
 saddles. GGRZ06 with mid-edge normals averaged from the faces weights each edge by
@@ -255,14 +258,16 @@ Where focal default loses on these cases (measured, docs/ESTIMATOR.md "Hard case
   the per-triangle pass see neighbours at very different distances, and their first-order terms
   do not cancel. Closing it needs anisotropy-aware weights; not built.
 - **Spikes** (0.5% of the vertices 2 edges off): a spike tilts the faces around it past the crease
-  angle, so its neighbours are fitted by the 1-ring fit without it instead of the per-triangle
-  pass (a little less accurate), and without file normals the jets of its 2-ring are pulled; the
-  2-ring closed-form fit of Max's normals averages the spike over more rays. A spike test of its
-  own (a vertex far off the jet of its neighbours) would be the fix; not built.
-- **Graded pear with file normals**: 1% behind the per-triangle pass on the same normals (not
-  analysed further).
-  **Coarse helix tube and torus strips without normals**: 19% and 43% behind the per-triangle
-  pass on Max's normals; the default's per-vertex roughness test keeps the jets' normals there.
+  angle, so its 2-ring keeps the crease handling (Max's normals, the per-triangle pass) instead
+  of the corrected step on the file's normals, which LRTC20 on the file's normals shows to be
+  better there; without file normals the jets of its 2-ring are pulled, and the 2-ring
+  closed-form fit of Max's normals averages the spike over more rays. Dropping creases that lie
+  inside one vertex's 1-ring was measured (docs/ESTIMATOR.md, "The corrected step") and not kept.
+- **Coarse pear and graded pear with file normals**: 2% to 6% behind the per-triangle pass or
+  LRTC20 at one mean edge length on the same normals: the corrected step's ball (one local edge
+  length) is not the best one for every vertex of these meshes.
+  **Coarse helix tube and torus strips without normals**: behind the per-triangle pass on Max's
+  normals; the default's per-vertex roughness test keeps the jets' normals there.
 - **Creases under vertex noise**: crease detection runs on clean positions only (noise folds
   faces past any angle), so the noisy capped cylinder is fitted across its rims; its error is
   still the lowest of the table.

@@ -6,11 +6,18 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <unistd.h>
+
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <set>
+#include <string>
 
 #include "focal/core/error.h"
+#include "focal/curvature/estimate.h"
 #include "focal/curvature/recommended.h"
+#include "focal/io/fields_io.h"
 #include "focal/evaluation/evaluation.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/surfaces/surfaces.h"
@@ -174,6 +181,41 @@ TEST(HardCases, CreasesAreFlaggedAndNotSmeared) {
   const RecommendedResult smeared =
       estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, off);
   EXPECT_GT(rel_h(s, smeared.curvature), 0.5);  // measured 2.4: the test above can fail
+}
+
+// The crease flags reach the outputs: Estimate::crease (focal curvature, focal.curvature) and
+// the `crease` column of the CSV and PLY writers; the paper's estimator has none.
+TEST(HardCases, CreaseFlagsReachTheOutputs) {
+  const AnalyticSurface s = make_capped_cylinder(1.0, 2.0, 2000);
+  const PreparedMesh mesh(s.mesh.V, s.mesh.F, s.mesh.N);
+  const Estimate e = estimate(mesh);
+  EXPECT_EQ(e.crease, s.crease);
+  EstimateOptions paper;
+  paper.estimator = Estimator::paper;
+  EXPECT_EQ(estimate(mesh, paper).crease.size(), 0);
+  // Noisy positions: no crease test, all 0 (not empty: the column is there for every mesh).
+  AnalyticSurface noisy = s;
+  add_position_noise(noisy.mesh, 0.1, 5);
+  const Estimate n = estimate(PreparedMesh(noisy.mesh.V, noisy.mesh.F, noisy.mesh.N));
+  ASSERT_GT(n.plan.rings, 1);
+  EXPECT_EQ(n.crease, VectorXu8::Zero(s.crease.size()));
+
+  const std::filesystem::path csv =
+      std::filesystem::temp_directory_path() / ("focal_crease_" + std::to_string(::getpid()) + ".csv");
+  write_curvature_csv(csv, e.curvature, e.crease);
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class,crease");
+  Eigen::Index row = 0, mismatched = 0;
+  for (; std::getline(in, line); ++row) {
+    mismatched += line.substr(line.rfind(',') + 1) != (s.crease[row] ? "1" : "0");
+  }
+  EXPECT_EQ(row, s.crease.size());
+  EXPECT_EQ(mismatched, 0);
+  std::filesystem::remove(csv);
+  EXPECT_THROW(write_curvature_csv(csv, e.curvature, VectorXu8::Zero(3)), InvalidInput);
+  EXPECT_FALSE(std::filesystem::exists(csv));
 }
 
 // The position noise (recommended_plan): the jets' truncation error is not noise. The coarse

@@ -207,6 +207,10 @@ class Curvature:
     file_disagreement: float = float("nan")
     #: Whether the recommended estimator used the given normals.
     file_normals_used: bool = False
+    #: (n,) uint8, 1 at crease vertices (the recommended estimator's step 5: a sharp edge at the
+    #: vertex; the curvature does not exist there), all 0 where it did not look (noisy
+    #: positions); None for the paper's estimator.
+    crease: Optional[np.ndarray] = None
 
     @property
     def undefined(self) -> np.ndarray:
@@ -314,7 +318,8 @@ def write_fields(
     """Writes a Curvature as ``focal curvature -o`` does (the same bytes for the same estimate).
 
     ``.csv``: one row per vertex, columns k1,k2,H,K,d1x..d1z,d2x..d2z,residual,class (the class
-    as a word, NaN as ``nan``); V, F, N are not needed. ``.ply``: the mesh V (n, 3), F (m, 3)
+    as a word, NaN as ``nan``), and crease (0/1) when ``curvature.crease`` is not None; V, F, N
+    are not needed. ``.ply``: the mesh V (n, 3), F (m, 3)
     with the fields as per-vertex properties (class as uchar codes), binary unless ``ascii``;
     the faces and normals written are those the estimate used (``curvature.F``,
     ``curvature.N``) where it reports them, else F and N as given. Written to a temporary file
@@ -327,6 +332,8 @@ def write_fields(
         ("k1", np.float64), ("k2", np.float64), ("H", np.float64), ("K", np.float64),
         ("residual", np.float64), ("point_class", np.uint8), ("rays_used", np.int32),
         ("rays_excluded", np.int32))}
+    if curvature.crease is not None:
+        fields["crease"] = _vector(curvature.crease, "crease", n, np.uint8)
     for name in ("d1", "d2"):
         fields[name] = _as_rows(getattr(curvature, name), name, np.float64)
         if fields[name].shape[0] != n:

@@ -163,6 +163,7 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   d["plan"] = plan;
   d["file_disagreement"] = e.file_disagreement;
   d["file_normals_used"] = e.file_normals_used;
+  d["crease"] = e.crease.size() > 0 ? nb::cast(to_numpy(std::move(e.crease))) : nb::none();
   return d;
 }
 
@@ -310,16 +311,20 @@ void write_fields(const std::string& path, const nb::dict& fields,
                   const std::optional<DoubleRows>& V, const std::optional<IntRows>& F,
                   const std::optional<DoubleRows>& N, bool binary, int threads) {
   const focal::CurvatureResult r = curvature_result(fields);
+  const focal::VectorXu8 crease =
+      fields.contains("crease") ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])
+                                : focal::VectorXu8();
   nb::gil_scoped_release release;
   if (!V) {
-    focal::write_curvature_csv(path, r);
+    focal::write_curvature_csv(path, r, crease);
     return;
   }
   focal::Mesh mesh;
   mesh.V = view(*V);
   mesh.F = view(*F);
   if (N) mesh.N = view(*N);
-  focal::write_curvature_ply(path, mesh, r, {.binary = binary, .comments = {}, .threads = threads});
+  focal::write_curvature_ply(path, mesh, r, {.binary = binary, .comments = {}, .threads = threads},
+                             crease);
 }
 
 nb::dict generate_surface(const std::string& kind, const std::string& triangulation,

@@ -152,6 +152,9 @@ Estimate estimate(const PreparedMesh& mesh, PreparedNormals normals,
       out.plan = r.plan;
       out.file_disagreement = r.file_disagreement;
       out.file_normals_used = r.file_normals_used;
+      out.crease = r.crease.size() == fit.vertex_count()
+                       ? std::move(r.crease)
+                       : VectorXu8(VectorXu8::Zero(fit.vertex_count()));
     } else {
       out.curvature = run_paper(fit, options.paper);
     }

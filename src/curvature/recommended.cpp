@@ -10,6 +10,7 @@
 
 #include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "curvature/corrected_step.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "curvature/robust_fit.h"
@@ -423,6 +424,20 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
   robust_refit(c, fitted, 1, false, skip, near_flagged(c, skip, 1), false, fit);
 }
 
+/// Trusted file normals on clean positions: the corrected curvature measures
+/// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
+/// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
+void prefer_corrected(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
+                      CurvatureResult& fit) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
+  if (!keep.empty()) {
+    for (const int v : near_flagged(c, keep, 2)) keep[static_cast<std::size_t>(v)] = 1;
+  }
+  detail::prefer_corrected_measures(fitted, *c.one_ring, paper_options(c), keep,
+                                    kExactFitResidual, fit);
+}
+
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
 /// normals (the mesh's, if any) are used, and the normals to fit, into `out`.
 void choose_normals(const Context& c, RecommendedResult& out) {
@@ -529,9 +544,14 @@ int recommended_reach(const RecommendedPlan& plan) {
   //  - the fit of v reads the fitted normals within plan.rings, the per-triangle pass those at
   //    the corners of v's faces (1 ring), and where v stays undefined the refits over up to
   //    kMaxExtraRings more rings; those read the normals that the previous refit replaced by
-  //    their neighbours' mean, one ring further.
+  //    their neighbours' mean, one ring further;
+  //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
+  //    fitted normals at the corners of the faces of its ball's vertices (at most
+  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings).
   const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
-  return std::max(plan.rings, 1) + kMaxExtraRings + 1 + normal_reach;
+  const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
+                                 plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
+  return fit_reach + normal_reach;
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
@@ -556,6 +576,7 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
     c.one_ring.reset();
     c.max.resize(0, 3);
     prefer_triangles(c, fitted, out.curvature);
+    if (out.file_normals_used) prefer_corrected(c, fitted, out.crease, out.curvature);
     refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.

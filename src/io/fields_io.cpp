@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "focal/core/error.h"
 #include "io/atomic_file.h"
 #include "io/detail.h"
 #include "io/ply.h"
@@ -36,6 +37,14 @@ std::vector<std::pair<std::string, Eigen::VectorXd>> numeric_fields(const Curvat
   return out;
 }
 
+/// Empty, or one flag per vertex of the fields.
+void check_crease(const VectorXu8& crease, const CurvatureResult& fields, const char* what) {
+  if (crease.size() != 0 && crease.size() != fields.k1.size()) {
+    throw InvalidInput(std::string(what) + ": " + std::to_string(crease.size()) +
+                       " crease flags for " + std::to_string(fields.k1.size()) + " vertices");
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& curvature_field_names() {
@@ -44,7 +53,9 @@ const std::vector<std::string>& curvature_field_names() {
   return names;
 }
 
-void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields) {
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         const VectorXu8& crease) {
+  check_crease(crease, fields, "write_curvature_csv");
   std::vector<CsvColumn> columns;
   for (auto& [name, values] : numeric_fields(fields)) columns.push_back({name, std::move(values)});
   std::vector<std::string> words(static_cast<std::size_t>(fields.point_class.size()));
@@ -52,11 +63,14 @@ void write_curvature_csv(const std::filesystem::path& path, const CurvatureResul
     words[i] = std::string(class_name(fields.class_of(static_cast<int>(i))));
   }
   columns.push_back({"class", std::move(words)});
+  if (crease.size() > 0) columns.push_back({"crease", Eigen::VectorXd(crease.cast<double>())});
   write_csv(path, columns);
 }
 
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
-                         const CurvatureResult& fields, const PlyWriteOptions& options) {
+                         const CurvatureResult& fields, const PlyWriteOptions& options,
+                         const VectorXu8& crease) {
+  check_crease(crease, fields, "write_curvature_ply");
   // Columns read in place: copying the eleven fields into VertexProperty vectors would cost
   // more than formatting them.
   const auto& names = curvature_field_names();
@@ -81,6 +95,9 @@ void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
   columns.push_back(column(10, fields.residual.data(), fields.residual.size(), 1));
   columns.push_back({names[11], PropertyType::uint8, nullptr, fields.point_class.data(),
                      fields.point_class.size(), 1});
+  if (crease.size() > 0) {
+    columns.push_back({"crease", PropertyType::uint8, nullptr, crease.data(), crease.size(), 1});
+  }
   PlyWriteOptions o = options;
   o.comments.push_back("focal curvature fields; " + class_codes_comment());
   io_detail::write_ply_columns(path, mesh, columns, o);

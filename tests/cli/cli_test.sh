@@ -106,7 +106,9 @@ check_within() {
 }
 
 # classes FILE: the distinct values of the class column (the last) with their counts.
-classes() { awk -F, 'NR > 1 { c[$NF]++ } END { for (k in c) printf "%s=%d ", k, c[k] }' "$1" 2>/dev/null || true; }
+# The class column by its name (the recommended estimator's CSV ends with `crease`).
+classes() { awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "class") k = i; next }
+  { c[$k]++ } END { for (x in c) printf "%s=%d ", x, c[x] }' "$1" 2>/dev/null || true; }
 
 # data_rows FILE: lines after the header.
 data_rows() { awk 'END { print NR - 1 }' "$1" 2>/dev/null || echo -1; }
@@ -143,7 +145,7 @@ ico() {
   }'
 }
 
-HEADER='k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class'
+HEADER='k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class,crease'
 
 # ---------------------------------------------------------------------------------------------
 # Help and version
@@ -275,7 +277,10 @@ run curvature s.ply -o c.csv
 check "curvature s.ply -o c.csv exits 0 silently" bash -c '[[ $1 -eq 0 && ! -s $2 ]]' _ "$rc" "$ERR"
 check "CSV header is exactly $HEADER" test "$(head -1 c.csv)" = "$HEADER"
 check "CSV has one row per vertex ($NV)" test "$(data_rows c.csv)" -eq "$NV"
-check "CSV rows have 12 fields" bash -c '[[ -s c.csv && -z $(awk -F, "NF != 12" c.csv) ]]'
+check "CSV rows have 13 fields" bash -c '[[ -s c.csv && -z $(awk -F, "NF != 13" c.csv) ]]'
+check "sphere: no crease vertex" test "$(awk -F, 'NR > 1 { s += $13 } END { print s + 0 }' c.csv)" -eq 0
+run curvature s.ply -o cp.csv --paper
+check "--paper CSV has no crease column" test "$(head -1 cp.csv)" = "${HEADER%,crease}"
 # Exact normals: every ray passes through the centre and the closed-form fit is exact.
 check_within "sphere: every k1 and k2 is 1 within 1e-6" "$(max_dev c.csv "1 2" 1)" 1e-6
 check_within "sphere: every H and K is 1 within 1e-6" "$(max_dev c.csv "3 4" 1)" 1e-6
@@ -293,8 +298,8 @@ check "curvature -o ca.ply --ascii exits 0" test "$rc" -eq 0
 check "ascii PLY: format ascii, $NV vertices" \
   bash -c 'h=$(sed "/^end_header/q" ca.ply); grep -qx "format ascii 1.0" <<<"$h" && grep -qx "element vertex $1" <<<"$h"' _ "$NV"
 ply_vertex_lines ca.ply >ca.vertices
-check "ascii PLY: $NV vertex lines of 18 values" \
-  bash -c '[[ $1 -gt 0 && $(wc -l <ca.vertices) -eq $1 && -z $(awk "NF != 18" ca.vertices) ]]' _ "$NV"
+check "ascii PLY: $NV vertex lines of 19 values (the last: crease, 0 on the sphere)" \
+  bash -c '[[ $1 -gt 0 && $(wc -l <ca.vertices) -eq $1 && -z $(awk "NF != 19 || \$19 != 0" ca.vertices) ]]' _ "$NV"
 # Columns: x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class; fields are float32
 # (relative rounding 6e-8), so 1e-6 bounds the rounding of these sums of three products.
 DIR_DEV=$(awk -v re="$NUM" '{
@@ -323,9 +328,9 @@ ply_header c.ply >c.header
 check "PLY: binary little endian with $NV vertices and $NF faces" \
   bash -c 'grep -qx "format binary_little_endian 1.0" c.header && grep -qx "element vertex $1" c.header &&
            grep -qx "element face $2" c.header' _ "$NV" "$NF"
-check "PLY: vertex properties are x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class" \
+check "PLY: vertex properties are x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class crease" \
   test "$(awk '/^element/ { e = $2 } e == "vertex" && $1 == "property" { printf "%s ", $3 }' c.header)" \
-  = "x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class "
+  = "x y z nx ny nz k1 k2 H K d1x d1y d1z d2x d2y d2z residual class crease "
 check "PLY: k1 is float, class is uchar" bash -c 'grep -qx "property float k1" c.header && grep -qx "property uchar class" c.header'
 check "PLY: a comment lists the class codes" \
   grep -q '^comment .*class codes: 0=elliptic 1=hyperbolic 2=parabolic 3=umbilic 4=flat 5=undefined' c.header
@@ -370,8 +375,10 @@ variant "--paper --rings 2" 1e-6 --paper --rings 2
 run generate torus --triangulation irregular --vertices 3000 --normal-noise 0.05 -o tn.ply --truth tn.csv
 run curvature tn.ply -o tn-default.csv
 run curvature tn.ply -o tn-paper.csv --paper
-rel_h() { # ESTIMATE.csv: relative RMS error of H against tn.csv (column 3 of both)
-  paste -d, "$1" tn.csv | awk -F, 'NR > 1 { d = $3 - $15; e += d * d; t += $15 * $15 }
+rel_h() { # ESTIMATE.csv: relative RMS error of H against tn.csv (column 3 of both; the truth
+  # starts after the estimate's columns, 13 with the default's crease column, 12 with --paper)
+  paste -d, "$1" tn.csv | awk -F, -v n="$(head -1 "$1" | awk -F, '{ print NF }')" \
+    'NR > 1 { d = $3 - $(n + 3); e += d * d; t += $(n + 3) * $(n + 3) }
     END { if (t > 0) printf "%.4g\n", sqrt(e / t); else print "nan" }'
 }
 REL_DEFAULT=$(rel_h tn-default.csv)
@@ -447,7 +454,7 @@ ico obj >iso.obj
 run curvature iso.obj -o iso.csv
 check "OBJ with an isolated vertex: exit 0, 13 rows" bash -c '[[ $1 -eq 0 && $(awk "END{print NR-1}" iso.csv) -eq 13 ]]' _ "$rc"
 check "isolated vertex: row 8 is all nan with class undefined" \
-  test "$(sed -n 9p iso.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined"
+  test "$(sed -n 9p iso.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined,0"
 sed 9d iso.csv >iso_others.csv 2>/dev/null || true
 check_within "the other 12 rows: k1, k2 = 1 within 1e-6" "$(max_dev iso_others.csv "1 2" 1)" 1e-6
 check "the other 12 rows are umbilic" test "$(classes iso_others.csv)" = "umbilic=12 "
@@ -473,7 +480,7 @@ check "NaN coordinate: exit 0, 5 rows" bash -c '[[ $1 -eq 0 && $2 -eq 5 ]]' _ "$
 check "NaN coordinate: the warning counts it and the duplicate face" \
   grep -q "^Warning: nan.off: found 1 non-finite vertex, 1 duplicate face" "$ERR"
 check "NaN coordinate: row 2 is all nan with class undefined" \
-  test "$(sed -n 4p nan.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined"
+  test "$(sed -n 4p nan.csv)" = "nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined,0"
 expect_error "NaN coordinate with --strict: exit 2" 2 "1 non-finite vertex" nan2.csv curvature nan.off -o nan2.csv --strict
 
 # File normals that are not unit length are normalised, and counted in the summary.

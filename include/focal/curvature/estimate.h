@@ -135,6 +135,9 @@ struct Estimate {
   RecommendedPlan plan;
   double file_disagreement = NAN;
   bool file_normals_used = false;
+  /// Estimator::recommended: #V flags, 1 at crease vertices (RecommendedResult::crease; all 0
+  /// where it did not look for creases: noisy positions, crease_angle 0). Empty for the paper's.
+  VectorXu8 crease;
 };
 
 /// Step 2: the estimator on `normals` (from prepare_normals for the same mesh and options),

@@ -31,7 +31,13 @@
 ///     each vertex then takes the per-triangle characteristic equation averaged to the vertex
 ///     (Method::triangle; 1.3 to 1.8 times lower H error on irregular meshes), except where the
 ///     fit is exact (residual <= 1e-9: the rays meet two slits, as on spheres and cylinders) or
-///     the triangles give no estimate.
+///     the triangles give no estimate. Where the file's normals are used (trusted, on clean
+///     positions), the interpolated corrected curvature measures of those normals (LRTC20,
+///     baselines.h; faster than first order on irregular triangulations) replace the per-triangle
+///     rows over a ball of the vertex's mean edge length, where its 1-ring is not centrally
+///     symmetric (on grids first-order errors cancel and the per-triangle pass stays), not
+///     within 2 rings of a crease (src/curvature/corrected_step.h; measured in
+///     docs/ESTIMATOR.md, "The corrected step").
 ///  5. Creases (clean positions only): an edge whose faces' normals differ by more than
 ///     RecommendedOptions::crease_angle (60 degrees) is sharp, its corners are crease vertices
 ///     (RecommendedResult::crease). Within 2 rings of them the normals are Max's (each face lies

@@ -13,13 +13,18 @@ namespace focal {
 /// k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class.
 [[nodiscard]] const std::vector<std::string>& curvature_field_names();
 
-/// One CSV row per vertex, in input order; class as a word, NaN as `nan`.
-void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields);
+/// One CSV row per vertex, in input order; class as a word, NaN as `nan`. With `crease` (#V
+/// flags, Estimate::crease) a last column `crease` of 0 and 1; empty: no such column.
+/// \throw InvalidInput when `crease` is neither empty nor of the fields' length.
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         const VectorXu8& crease = {});
 
 /// The mesh with the fields as per-vertex PLY properties (floats; class as a uchar whose codes
-/// are listed in a header comment), so MeshLab and ParaView can colour by them.
+/// are listed in a header comment), so MeshLab and ParaView can colour by them; with `crease`
+/// (as above) a last uchar property `crease`.
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
-                         const CurvatureResult& fields, const PlyWriteOptions& options = {});
+                         const CurvatureResult& fields, const PlyWriteOptions& options = {},
+                         const VectorXu8& crease = {});
 
 /// A focal mesh with its per-vertex `focal_flag` (uchar; codes listed in a header comment).
 void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,

@@ -23,7 +23,8 @@ double radius(const BallOptions& ball, double default_in_edges, double edge_leng
 }
 
 void gather(PositionsRef V, const Neighbourhoods& one_ring,
-            const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s) {
+            const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s,
+            int max_rings) {
   if (s.stamp.size() != static_cast<std::size_t>(V.rows())) {
     s.stamp.assign(static_cast<std::size_t>(V.rows()), 0);
     s.visit = 0;
@@ -32,7 +33,15 @@ void gather(PositionsRef V, const Neighbourhoods& one_ring,
   s.vertices.assign(1, centre);
   s.stamp[static_cast<std::size_t>(centre)] = visit;
   const double r2 = r * r;
-  for (std::size_t k = 0; k < s.vertices.size(); ++k) {  // breadth first, the list grows
+  // Breadth first, the list grows; `ring_end` is where the current ring's vertices end.
+  std::size_t ring_end = 1;
+  int ring = 0;
+  for (std::size_t k = 0; k < s.vertices.size(); ++k) {
+    if (k == ring_end) {
+      ring_end = s.vertices.size();
+      ++ring;
+    }
+    if (ring >= max_rings) break;  // the vertices of ring max_rings are not expanded
     for (const int* j = one_ring.begin(s.vertices[k]); j != one_ring.end(s.vertices[k]); ++j) {
       if (s.stamp[static_cast<std::size_t>(*j)] == visit) continue;
       s.stamp[static_cast<std::size_t>(*j)] = visit;

@@ -1,6 +1,7 @@
 #pragma once
 // The ball neighbourhood B(x_i, r) of the ball-based baselines (LRTC20, YLHP06).
 
+#include <climits>
 #include <cstdint>
 #include <vector>
 
@@ -29,22 +30,32 @@ struct Scratch {
 };
 
 /// Fills s.vertices and s.faces for the ball of radius r around vertex `centre`: the vertices
-/// reached from it along edges without leaving the ball, and their incident faces (a face cut
-/// by the sphere with no corner inside is left out: its part inside is O(h^3 / r) in area).
+/// reached from it along edges without leaving the ball, at most `max_rings` edges away, and
+/// their incident faces (a face cut by the sphere with no corner inside is left out: its part
+/// inside is O(h^3 / r) in area). The ring cap bounds what a vertex reads in rings (tiles).
 void gather(PositionsRef V, const Neighbourhoods& one_ring,
-            const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s);
+            const focal::detail::VertexFaces& incidence, int centre, double r, Scratch& s,
+            int max_rings = INT_MAX);
 
 /// Calls visit(i, faces) for every vertex i of `mesh`, on the pool's threads, with the faces of
-/// its ball of radius r (gather); each thread reuses its scratch.
-template <class Visit>
-void for_each_ball(const PreparedMesh& mesh, double r, int threads, Visit visit) {
+/// its ball of radius radius_of(i) (gather, at most `max_rings` edges from i); each thread
+/// reuses its scratch.
+template <class Radius, class Visit>
+void for_each_ball(const PreparedMesh& mesh, Radius radius_of, int max_rings, int threads,
+                   Visit visit) {
   const auto incidence = focal::detail::incidence(mesh);
   const auto one_ring = focal::detail::one_ring(mesh);
   focal::detail::parallel_for(mesh.vertex_count(), threads, [&](std::int64_t i) {
     thread_local Scratch scratch;
-    gather(mesh.V(), *one_ring, *incidence, static_cast<int>(i), r, scratch);
+    gather(mesh.V(), *one_ring, *incidence, static_cast<int>(i), radius_of(i), scratch, max_rings);
     visit(i, scratch.faces);
   });
+}
+
+/// The same with one radius r for every vertex and no ring cap.
+template <class Visit>
+void for_each_ball(const PreparedMesh& mesh, double r, int threads, Visit visit) {
+  for_each_ball(mesh, [r](std::int64_t) { return r; }, INT_MAX, threads, visit);
 }
 
 }  // namespace focal::baselines::ball

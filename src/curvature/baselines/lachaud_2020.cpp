@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -27,6 +28,7 @@
 
 #include "core/parallel.h"
 #include "curvature/baselines/ball.h"
+#include "curvature/baselines/lachaud_2020_detail.h"
 #include "curvature/detail.h"
 #include "focal/curvature/baselines.h"
 #include "focal/mesh/normals.h"
@@ -111,12 +113,13 @@ RowMatrixX3d corrected_normals(const PreparedMesh& mesh, std::optional<NormalsRe
 
 }  // namespace
 
-CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
-                             const BallOptions& ball, const CurvatureOptions& options) {
-  const PreparedMesh mesh =
-      focal::detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "LRTC20");
-  const double r = ball::radius(ball, 1.0, mesh.mean_edge_length(), "LRTC20");
-  const RowMatrixX3d u = corrected_normals(mesh, N);
+namespace detail {
+
+CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d& u,
+                                    const Eigen::VectorXd& radius, int max_rings,
+                                    const CurvatureOptions& options) {
+  const PositionsRef& V = mesh.V();
+  const FacesRef& F = mesh.F();
   std::vector<Measures> face(static_cast<std::size_t>(F.rows()));
   focal::detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
     std::array<Eigen::Vector3d, 3> x, n;
@@ -129,20 +132,35 @@ CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRe
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  ball::for_each_ball(mesh, r, options.threads, [&](std::int64_t i, const std::vector<int>& faces) {
-    const Eigen::Vector3d normal = u.row(i);
-    const Measures sum = ball_measures(V, F, face, faces, V.row(i), r);
-    if (!(sum.mu0 > 0.0) || !normal.allFinite()) return;
-    const TangentFrame frame = tangent_frame(normal);
-    const focal::detail::Principal2 p = principal_of(sum, frame);
-    const double H = 0.5 * sum.mu1 / sum.mu0;
-    // Residual: how far the anisotropic measure's mean curvature is from mu1's.
-    focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);
-    result.H[i] = H;  // the papers' H and K are mu1 / (2 mu0) and mu2 / mu0 themselves
-    result.K[i] = sum.mu2 / sum.mu0;
-    result.rays_used[i] = static_cast<int>(faces.size());  // faces reached
-  });
+  const auto radius_of = [&](std::int64_t i) { return radius[i]; };
+  ball::for_each_ball(
+      mesh, radius_of, max_rings, options.threads,
+      [&](std::int64_t i, const std::vector<int>& faces) {
+        const Eigen::Vector3d normal = u.row(i);
+        if (!(radius[i] > 0.0) || !normal.allFinite()) return;
+        const Measures sum = ball_measures(V, F, face, faces, V.row(i), radius[i]);
+        if (!(sum.mu0 > 0.0)) return;
+        const TangentFrame frame = tangent_frame(normal);
+        const focal::detail::Principal2 p = principal_of(sum, frame);
+        const double H = 0.5 * sum.mu1 / sum.mu0;
+        // Residual: how far the anisotropic measure's mean curvature is from mu1's.
+        focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);
+        result.H[i] = H;  // the papers' H and K are mu1 / (2 mu0) and mu2 / mu0 themselves
+        result.K[i] = sum.mu2 / sum.mu0;
+        result.rays_used[i] = static_cast<int>(faces.size());  // faces reached
+      });
   return result;
+}
+
+}  // namespace detail
+
+CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
+                             const BallOptions& ball, const CurvatureOptions& options) {
+  const PreparedMesh mesh =
+      focal::detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "LRTC20");
+  const double r = ball::radius(ball, 1.0, mesh.mean_edge_length(), "LRTC20");
+  return detail::corrected_curvature(mesh, corrected_normals(mesh, N),
+                                     Eigen::VectorXd::Constant(V.rows(), r), INT_MAX, options);
 }
 
 }  // namespace focal::baselines
