@@ -46,9 +46,9 @@ void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Input input(f.input, f.estimator, log);
   if (f.tiles > 0) {
-    const CurvatureResult c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
+    const TileEstimate c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
     Stage stage(log, "write");
-    return write_curvature_csv(f.output, c);
+    return write_curvature_csv(f.output, c.curvature, c.crease);
   }
   if (input.cloud) return run_cloud_curvature(f, input, log);
   Estimate e = run_estimate(input, f.input, f.estimator, log);

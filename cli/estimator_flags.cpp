@@ -330,8 +330,8 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
   return e;
 }
 
-CurvatureResult run_tiled_estimate(const Input& input, const std::string& mesh_name,
-                                   const EstimatorFlags& flags, int tiles, const Log& log) {
+TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name,
+                                const EstimatorFlags& flags, int tiles, const Log& log) {
   if (input.cloud) {
     throw InvalidInput(mesh_name + ": is a point cloud (no faces); --tiles cuts meshes only");
   }
@@ -342,12 +342,12 @@ CurvatureResult run_tiled_estimate(const Input& input, const std::string& mesh_n
   }
   const std::int64_t n = mesh.vertex_count();
   const auto per_tile = static_cast<int>(std::max<std::int64_t>(1, (n + tiles - 1) / tiles));
-  CurvatureResult c;
+  TileEstimate c;
   {
     Stage stage(log, "curvature in tiles of " + std::to_string(per_tile) + " vertices");
     c = estimate_tiled(mesh, options, {.tile_vertices = per_tile, .threads = flags.threads});
   }
-  print_summary(c, log);
+  print_summary(c.curvature, log);
   return c;
 }
 

@@ -15,6 +15,7 @@
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/prepared.h"
+#include "focal/tiles/tiles.h"
 #include "log.h"
 
 namespace focal::cli {
@@ -75,12 +76,13 @@ struct Input {
 [[nodiscard]] Estimate run_estimate(const Input& input, const std::string& mesh_name,
                                     const EstimatorFlags& flags, const Log& log);
 
-/// run_estimate's curvature, tile by tile (estimate_tiled, focal/tiles/tiles.h: the same bits,
-/// the memory of the largest tile's estimate in place of the whole mesh's) in `tiles` tiles of
-/// about equal vertex counts. \throw InvalidInput as run_estimate, and for a point cloud.
-[[nodiscard]] CurvatureResult run_tiled_estimate(const Input& input, const std::string& mesh_name,
-                                                 const EstimatorFlags& flags, int tiles,
-                                                 const Log& log);
+/// run_estimate's curvature and crease flags, tile by tile (estimate_tiled, focal/tiles/tiles.h:
+/// the same bits, the memory of the largest tile's estimate in place of the whole mesh's) in
+/// `tiles` tiles of about equal vertex counts. \throw InvalidInput as run_estimate, and for a point
+/// cloud.
+[[nodiscard]] TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name,
+                                              const EstimatorFlags& flags, int tiles,
+                                              const Log& log);
 
 /// The curvature of a point cloud (cloud_curvature.h) with the flags' options, timed in stages,
 /// with -v a summary. \throw InvalidInput as EstimatorFlags::cloud_options.

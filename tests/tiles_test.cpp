@@ -126,9 +126,14 @@ std::vector<Case> all_options() {
 void expect_tiled_identical(const Mesh& m, bool with_normals, const EstimateOptions& options,
                             int tile_vertices, const std::string& what) {
   const PreparedMesh mesh(m.V, m.F, with_normals ? m.normals() : std::nullopt);
-  const CurvatureResult whole = estimate(mesh, options).curvature;
-  const CurvatureResult tiled = estimate_tiled(mesh, options, {.tile_vertices = tile_vertices});
-  expect_identical(whole, tiled, what);
+  const Estimate whole = estimate(mesh, options);
+  const TileEstimate tiled = estimate_tiled(mesh, options, {.tile_vertices = tile_vertices});
+  expect_identical(whole.curvature, tiled.curvature, what);
+  // Crease flags: the recommended estimator's, row for row; none from the paper's.
+  EXPECT_EQ(whole.crease.size(), tiled.crease.size()) << what;
+  if (whole.crease.size() == tiled.crease.size()) {
+    EXPECT_EQ(whole.crease, tiled.crease) << what;
+  }
 }
 
 TEST(Tiles, EveryEstimatorGivesTheWholeMeshBitsOnAwkwardMeshes) {
@@ -164,6 +169,19 @@ TEST(Tiles, RecommendedOnNoisyPositionsPlansWiderRingsAndStaysIdentical) {
             "noise " + std::to_string(fraction) + " seed " + std::to_string(seed));
       }
     }
+  }
+}
+
+TEST(Tiles, CreaseFlagsOfTheRecommendedEstimatorAreTheWholeMeshs) {
+  // The capped cylinder's rims are creases: the tiles must flag the same vertices (tiles of 150
+  // cut through the rims), with the file's normals and without.
+  const AnalyticSurface s = make_capped_cylinder(1.0, 2.0, 1500);
+  for (bool normals : {true, false}) {
+    const PreparedMesh mesh(s.mesh.V, s.mesh.F, normals ? s.mesh.normals() : std::nullopt);
+    const TileEstimate tiled = estimate_tiled(mesh, {}, {.tile_vertices = 150});
+    ASSERT_EQ(tiled.crease.size(), s.mesh.V.rows());
+    EXPECT_GT(tiled.crease.cast<int>().sum(), 0) << "normals " << normals;
+    EXPECT_EQ(tiled.crease, estimate(mesh, EstimateOptions{}).crease) << "normals " << normals;
   }
 }
 
@@ -233,12 +251,12 @@ TEST(Tiles, AHaloOneRingShortOfThePapersReachChangesTheResult) {
     const MeshWideChoices choices = mesh_wide_choices(mesh, c.options);
     const int reach = estimate_reach(options_for_part(c.options, choices));
     const Tiling short_halo = partition_mesh(m.V, m.F, reach - 1, {.tile_vertices = 200});
-    CurvatureResult tiled = whole;
+    TileEstimate tiled{whole, {}};
     for (const Tile& tile : short_halo.tiles) {
       scatter_rows(estimate_tile(extract_tile(m.V, m.F, std::nullopt, tile), choices, c.options),
                    tile.owned, tile.vertices, tiled);
     }
-    EXPECT_FALSE(tiled.k1.cwiseEqual(whole.k1).all()) << c.name << ": reach " << reach;
+    EXPECT_FALSE(tiled.curvature.k1.cwiseEqual(whole.k1).all()) << c.name << ": reach " << reach;
   }
 }
 

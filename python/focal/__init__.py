@@ -219,9 +219,10 @@ class Curvature:
 
     def to_dict(self) -> dict:
         """The per-vertex arrays by name (k1, k2, H, K, d1, d2, residual, point_class,
-        rays_used, rays_excluded), e.g. for ``np.savez`` or a pandas DataFrame."""
+        rays_used, rays_excluded, and crease where it is not None), e.g. for ``np.savez`` or a
+        pandas DataFrame."""
         names = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
-                 "rays_excluded")
+                 "rays_excluded") + (("crease",) if self.crease is not None else ())
         return {n: getattr(self, n) for n in names}
 
 

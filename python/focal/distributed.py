@@ -46,7 +46,10 @@ def _estimate_tile(V: np.ndarray, F: np.ndarray, N: Optional[np.ndarray], owned:
                    options: dict, choices: dict) -> dict:
     """The task: a tile's estimate with the whole mesh's choices, its owned rows only."""
     d = _ext.estimate_tile(V, F, N, options, choices)
-    return {name: d[name][owned] for name in FIELDS}
+    fields = {name: d[name][owned] for name in FIELDS}
+    if d["crease"] is not None:  # the recommended estimator's crease flags
+        fields["crease"] = d["crease"][owned]
+    return fields
 
 
 def _mesh_of(path_or_arrays: Any):
@@ -162,6 +165,8 @@ def curvature(
             ids = tiles[i]["vertices"][tiles[i]["owned"]]
             for name in FIELDS:
                 out[name][ids] = fields[name]
+            if "crease" in fields:
+                out.setdefault("crease", np.zeros(Va.shape[0], np.uint8))[ids] = fields["crease"]
             if on_tile is not None:
                 on_tile(i, ids, fields)
             fut.release()
@@ -283,16 +288,7 @@ def _write_fields(path: str, c: focal.Curvature) -> None:
 
         _write_atomically(path, write_npz)
     elif path.endswith(".csv"):
-        columns = np.column_stack([c.k1, c.k2, c.H, c.K, c.d1, c.d2, c.residual])
-        header = "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class"
-
-        def write(tmp: str) -> None:
-            with open(tmp, "w") as f:
-                f.write(header + "\n")
-                for row, cls in zip(columns, c.point_class):
-                    f.write(",".join(repr(float(x)) for x in row) + f",{int(cls)}\n")
-
-        _write_atomically(path, write)
+        focal.write_fields(path, c)  # the bytes of `focal curvature -o fields.csv`
     else:
         raise focal.InvalidInputError(f"{path}: the output must end in .npz or .csv")
 

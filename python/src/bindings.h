@@ -60,6 +60,12 @@ nb::object optional_to_numpy(std::optional<Matrix>&& m) {
   return nb::cast(to_numpy(std::move(*m)));
 }
 
+/// Crease flags (Estimate::crease) as an array, None when the estimator gives none (empty).
+inline nb::object crease_or_none(focal::VectorXu8&& crease) {
+  if (crease.size() == 0) return nb::none();
+  return nb::cast(to_numpy(std::move(crease)));
+}
+
 template <class Enum, size_t n>
 Enum parse_enum(const std::string& value, const char* argument,
                 const std::pair<const char*, Enum> (&names)[n]) {

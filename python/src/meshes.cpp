@@ -163,7 +163,7 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   d["plan"] = plan;
   d["file_disagreement"] = e.file_disagreement;
   d["file_normals_used"] = e.file_normals_used;
-  d["crease"] = e.crease.size() > 0 ? nb::cast(to_numpy(std::move(e.crease))) : nb::none();
+  d["crease"] = crease_or_none(std::move(e.crease));
   return d;
 }
 
@@ -311,9 +311,9 @@ void write_fields(const std::string& path, const nb::dict& fields,
                   const std::optional<DoubleRows>& V, const std::optional<IntRows>& F,
                   const std::optional<DoubleRows>& N, bool binary, int threads) {
   const focal::CurvatureResult r = curvature_result(fields);
-  const focal::VectorXu8 crease =
-      fields.contains("crease") ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])
-                                : focal::VectorXu8();
+  const focal::VectorXu8 crease = fields.contains("crease")
+                                      ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])
+                                      : focal::VectorXu8();
   nb::gil_scoped_release release;
   if (!V) {
     focal::write_curvature_csv(path, r, crease);

@@ -108,14 +108,16 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
   const focal::EstimateOptions o = estimate_options(options);
   const focal::MeshWideChoices c = choices_from(choices);
   const int threads = nb::cast<int>(options["threads"]);
-  focal::CurvatureResult r;
+  focal::TileEstimate r;
   {
     nb::gil_scoped_release release;
     focal::TileMesh tile{view(V), view(F), std::nullopt};
     if (N) tile.N = focal::RowMatrixX3d(view(*N));
     r = focal::estimate_tile(tile, c, o, threads);
   }
-  return curvature_dict(std::move(r));
+  nb::dict d = curvature_dict(std::move(r.curvature));
+  d["crease"] = crease_or_none(std::move(r.crease));
+  return d;
 }
 
 /// mean_edge_length's partial sums of a run of whole blocks of faces (focal/core/mesh.h), for

@@ -21,7 +21,11 @@ import focal.distributed as fd
 
 
 def same_fields(a, b):
-    return all(getattr(a, n).tobytes() == getattr(b, n).tobytes() for n in fd.FIELDS)
+    """Every field and the crease flags (None for the paper's estimator) bit for bit."""
+    if (a.crease is None) != (b.crease is None):
+        return False
+    names = fd.FIELDS + (("crease",) if a.crease is not None else ())
+    return all(getattr(a, n).tobytes() == getattr(b, n).tobytes() for n in names)
 
 
 @pytest.fixture(scope="module")
@@ -154,9 +158,12 @@ def test_command_line_writes_the_whole_mesh_fields(tmp_path, client, awkward):
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
     csv = tmp_path / "fields.csv"
     assert run_cli(str(mesh), "-o", str(csv), "--scheduler", address).returncode == 0
-    lines = csv.read_text().splitlines()
-    assert lines[0] == "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class"
-    assert len(lines) == len(V) + 1
+    # The recommended estimator (the default), written as `focal curvature -o x.csv` writes it:
+    # its crease flags as the last column.
+    expected = tmp_path / "whole.csv"
+    focal.write_fields(expected, focal.curvature(V, F, N))
+    assert csv.read_bytes() == expected.read_bytes()
+    assert csv.read_text().splitlines()[0].endswith(",class,crease")
 
 
 def test_command_line_errors(tmp_path, client):

@@ -223,30 +223,38 @@ TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, c
   return out;
 }
 
-CurvatureResult estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
-                              const EstimateOptions& options, int threads) {
+TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
+                           const EstimateOptions& options, int threads) {
   const std::optional<NormalsRef> N =
       tile.N ? std::optional<NormalsRef>(*tile.N) : std::optional<NormalsRef>();
   const PreparedMesh mesh(tile.V, tile.F, N,
                           {.threads = threads, .mean_edge_length = choices.mean_edge_length});
-  return estimate(mesh, options_for_part(options, choices)).curvature;
+  Estimate e = estimate(mesh, options_for_part(options, choices));
+  return {std::move(e.curvature), std::move(e.crease)};
 }
 
-void scatter_rows(const CurvatureResult& part, const std::vector<int>& rows,
-                  const std::vector<int>& ids, CurvatureResult& whole) {
-  for (const int r : rows) detail::copy_row(part, r, whole, ids[static_cast<std::size_t>(r)]);
+void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
+                  const std::vector<int>& ids, TileEstimate& whole) {
+  if (part.crease.size() != 0 && whole.crease.size() == 0) {
+    whole.crease = VectorXu8::Zero(whole.curvature.k1.size());
+  }
+  for (const int r : rows) {
+    const int id = ids[static_cast<std::size_t>(r)];
+    detail::copy_row(part.curvature, r, whole.curvature, id);
+    if (part.crease.size() != 0) whole.crease[id] = part.crease[r];
+  }
 }
 
-CurvatureResult estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& options,
-                               const TileOptions& tiles) {
+TileEstimate estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& options,
+                            const TileOptions& tiles) {
   const MeshWideChoices choices = mesh_wide_choices(mesh, options);
   const FacesRef F = choices.F ? FacesRef(*choices.F) : mesh.F();
   const Tiling tiling =
       partition_mesh(mesh.V(), F, estimate_reach(options_for_part(options, choices)), tiles);
-  CurvatureResult out = detail::unwritten_result(mesh.vertex_count());
+  TileEstimate out{detail::unwritten_result(mesh.vertex_count()), {}};
   for (const Tile& tile : tiling.tiles) {
-    const CurvatureResult part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
-                                               choices, options, tiles.threads);
+    const TileEstimate part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
+                                            choices, options, tiles.threads);
     scatter_rows(part, tile.owned, tile.vertices, out);
   }
   return out;

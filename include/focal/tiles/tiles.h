@@ -63,20 +63,28 @@ struct TileMesh {
 [[nodiscard]] TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
                                     const Tile& tile);
 
+/// A tile's estimate, or the tiled whole's: the fields and the crease flags (Estimate::crease:
+/// one per row for the recommended estimator, empty for the paper's).
+struct TileEstimate {
+  CurvatureResult curvature;
+  VectorXu8 crease;
+};
+
 /// estimate() of a tile's arrays with the whole mesh's choices: `options` as given to the whole
 /// mesh (options_for_part is applied here). Rows of every tile vertex; those of its owned
 /// vertices are the whole mesh's.
-[[nodiscard]] CurvatureResult estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
-                                            const EstimateOptions& options, int threads = 0);
+[[nodiscard]] TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
+                                         const EstimateOptions& options, int threads = 0);
 
 /// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
-/// .curvature, with the memory of the largest tile in place of the whole mesh's estimate.
-[[nodiscard]] CurvatureResult estimate_tiled(const PreparedMesh& mesh,
-                                             const EstimateOptions& options = {},
-                                             const TileOptions& tiles = {});
+/// .curvature and .crease, with the memory of the largest tile in place of the whole mesh's.
+[[nodiscard]] TileEstimate estimate_tiled(const PreparedMesh& mesh,
+                                          const EstimateOptions& options = {},
+                                          const TileOptions& tiles = {});
 
-/// Writes the rows `rows` of `part` into the rows `ids[rows]` of `whole` (sized #V).
-void scatter_rows(const CurvatureResult& part, const std::vector<int>& rows,
-                  const std::vector<int>& ids, CurvatureResult& whole);
+/// Writes the rows `rows` of `part` into the rows `ids[rows]` of `whole` (fields sized #V; its
+/// crease flags sized #V, zero, on the first part that has any).
+void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
+                  const std::vector<int>& ids, TileEstimate& whole);
 
 }  // namespace focal
