@@ -94,6 +94,41 @@ TEST(SimdKernels, FitIsBitIdenticalForEveryInstructionSetAndThreadCount) {
   }
 }
 
+// The roughness-only fit (detail::fit_roughness, the recommended estimator's rating of normal
+// fields): the full fit's residual bit for bit where it made a ray of every neighbour, NaN
+// elsewhere, for every instruction set and thread count. The awkward mesh has vertices of each
+// kind (excluded rays, invalid normals, too few rays).
+TEST(SimdKernels, RoughnessIsTheFullFitsResidualWhereNoRayWasExcluded) {
+  const Mesh m = awkward_mesh();
+  for (const FitCase c : {FitCase{1, RayWeighting::uniform}, FitCase{2, RayWeighting::gaussian}}) {
+    const CurvatureResult full = fit(m, c, 1, SimdIsa::baseline);
+    Eigen::VectorXd expected = full.residual;
+    int excluded = 0, finite = 0;
+    for (Eigen::Index i = 0; i < expected.size(); ++i) {
+      if (full.rays_excluded[i] > 0) expected[i] = NAN, ++excluded;
+      finite += std::isfinite(expected[i]);
+    }
+    ASSERT_GT(excluded, 0);
+    ASSERT_GT(finite, expected.size() / 2);
+    CurvatureOptions o;
+    o.rings = c.rings;
+    o.weighting = c.weighting;
+    std::vector<char> ok;
+    const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+    const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+    const Neighbourhoods rings = c.rings == 1 ? one : k_ring(one, c.rings);
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        o.threads = threads;
+        const Eigen::VectorXd r =
+            detail::fit_roughness({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, isa);
+        EXPECT_TRUE(identical(r, expected))
+            << "rings " << c.rings << " isa " << static_cast<int>(isa) << " threads " << threads;
+      }
+    }
+  }
+}
+
 // The scalar formulas (tangent_frame, normal_ray, fit_two_slits_closed_form) vertex by vertex:
 // the lane kernel solves the same normal equations by cofactors, so values agree to rounding.
 TEST(SimdKernels, FitMatchesTheScalarClosedFormVertexByVertex) {

@@ -85,21 +85,16 @@ CurvatureResult two_slit_fit(const Context& c, const PreparedMesh& normals, int 
   return detail::fit_vertices({V, unit.N, unit.ok, ring, c.edge_length}, o);
 }
 
-/// two_slit_fit of another normal field: its unit rows live only as long as the fit needs them.
-CurvatureResult two_slit_fit(const Context& c, NormalsRef normals, int rings, bool gaussian) {
-  return two_slit_fit(c, c.mesh.with_normals(normals), rings, gaussian);
-}
-
 /// How rough a normal field is at each vertex: the RMS misfit (residual, slope units) of its
 /// 1-ring two-slit fit, NaN (no usable fit) where the fit had to leave out a neighbour's ray —
 /// a normal more than 90 degrees from the vertex's, as a flipped or wild normal makes it; the
-/// residual of the few rays left says nothing then.
-Eigen::VectorXd roughness_of(const CurvatureResult& fit) {
-  Eigen::VectorXd r = fit.residual;
-  for (Eigen::Index i = 0; i < r.size(); ++i) {
-    if (fit.rays_excluded[i] > 0) r[i] = NAN;
-  }
-  return r;
+/// residual of the few rays left says nothing then. Only the residual is computed and stored
+/// (detail::fit_roughness): the bits of the full fit's, at a fraction of its time and memory.
+Eigen::VectorXd roughness_of(const Context& c, NormalsRef normals) {
+  const PreparedMesh with = c.mesh.with_normals(normals);
+  const detail::UnitNormals& unit = detail::unit_normals(with);
+  return detail::fit_roughness({c.mesh.V(), unit.N, unit.ok, *c.one_ring, c.edge_length},
+                               paper_options(c));
 }
 
 /// select_normals: how much smoother (two-slit residual) the secondary normals must be.
@@ -448,9 +443,7 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   } else {
     // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
     // first-order (rough) on irregular meshes.
-    const CurvatureResult with_max = two_slit_fit(c, c.max, 1, false);
-    const CurvatureResult with_jets = two_slit_fit(c, jets.N, 1, false);
-    out.N = select_normals(jets.N, roughness_of(with_jets), c.max, roughness_of(with_max),
+    out.N = select_normals(jets.N, roughness_of(c, jets.N), c.max, roughness_of(c, c.max),
                            c.threads, roughness, [](std::int64_t) { return true; });
   }
   // Where the chosen jets have no fit (too few points, degenerate), Max's normal if any.
@@ -460,8 +453,7 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
   if (out.file_normals_used) {
     // The file's normals, except outliers where the positions' choice is clearly smoother.
-    const CurvatureResult with_file = two_slit_fit(c, *file, 1, false);
-    out.N = replace_outliers(*file, roughness_of(with_file), disagreement, out.N, roughness,
+    out.N = replace_outliers(*file, roughness_of(c, *file), disagreement, out.N, roughness,
                              c.options.outlier_disagreement * out.plan.noise, c.threads);
   }
   if (out.plan.rings == 1 && c.options.crease_angle > 0.0) {
