@@ -13,6 +13,7 @@
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "curvature/robust_fit.h"
+#include "curvature/triangle_curvature_detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -255,12 +256,11 @@ constexpr double kExactFitResidual = 1e-9;
 void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureResult& fit) {
   CurvatureOptions o = paper_options(c);
   o.method = Method::triangle;
-  const CurvatureResult triangles = estimate_curvature(fitted, o);
+  std::vector<char> inexact(static_cast<std::size_t>(fitted.vertex_count()));
   detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
-    const bool exact_fit = fit.residual[i] <= kExactFitResidual;
-    const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) detail::copy_row(triangles, i, fit, i);
+    inexact[static_cast<std::size_t>(i)] = !(fit.residual[i] <= kExactFitResidual);
   });
+  detail::replace_with_triangles(fitted, o, inexact, fit);
 }
 
 /// The file's normals compared with the jet normals: the side they point to, and per vertex the
