@@ -124,6 +124,19 @@ TEST(SimdKernels, RoughnessIsTheFullFitsResidualWhereNoRayWasExcluded) {
             detail::fit_roughness({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, isa);
         EXPECT_TRUE(identical(r, expected))
             << "rings " << c.rings << " isa " << static_cast<int>(isa) << " threads " << threads;
+        // At listed vertices only (every third, in reverse, so that each group holds vertices
+        // of other groups' neighbourhoods): the same bits in list order.
+        std::vector<int> some;
+        for (int i = static_cast<int>(m.V.rows()) - 1; i >= 0; i -= 3) some.push_back(i);
+        const Eigen::VectorXd at = detail::fit_roughness_at(
+            {m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, some.data(),
+            static_cast<Eigen::Index>(some.size()), isa);
+        Eigen::VectorXd expected_at(static_cast<Eigen::Index>(some.size()));
+        for (std::size_t k = 0; k < some.size(); ++k) {
+          expected_at[static_cast<Eigen::Index>(k)] = expected[some[k]];
+        }
+        EXPECT_TRUE(identical(at, expected_at))
+            << "listed, rings " << c.rings << " isa " << static_cast<int>(isa);
       }
     }
   }

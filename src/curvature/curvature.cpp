@@ -44,6 +44,8 @@ struct FitContext {
   const CurvatureOptions& options;
   double inverse_two_width_squared;  // Gaussian weights: exp(-d^2 * this)
   detail::ClassTolerances tolerances;
+  /// When set, the k-th vertex fitted is vertices[k] (and its output goes to slot k), else k.
+  const int* vertices = nullptr;
 };
 
 /// One vertex's rays and weights. Owned by a block of vertices, so that the loop over vertices
@@ -170,13 +172,14 @@ template <class L>
 }
 
 template <class L>
-[[gnu::always_inline]] inline void load_group(const VertexFitInput& in, std::int64_t first,
-                                              int active, VertexGroup<L>& g) {
+[[gnu::always_inline]] inline void load_group(const VertexFitInput& in, const int* vertices,
+                                              std::int64_t first, int active, VertexGroup<L>& g) {
   g.first = first;
   g.active = active;
   g.slots = 0;
   for (int l = 0; l < g.kWidth; ++l) {
-    const auto i = static_cast<int>(first + std::min(l, active - 1));
+    const std::int64_t k = first + std::min(l, active - 1);
+    const int i = vertices ? vertices[k] : static_cast<int>(k);
     g.self[l] = i;
     g.ring[l] = in.rings.begin(i);
     g.size[l] = l < active ? in.rings.size(i) : 0;
@@ -283,7 +286,7 @@ template <class L, class Out>
 [[gnu::always_inline]] inline void fit_group(const FitContext& c, std::int64_t first, int active,
                                              std::vector<RaySlot<L>>& slots, Out& r) {
   VertexGroup<L> g;
-  load_group(c.in, first, active, g);
+  load_group(c.in, c.vertices, first, active, g);
   if (slots.size() < static_cast<std::size_t>(g.slots)) slots.resize(g.slots);
   SlotSums<L> sums;
   for (int k = 0; k < g.slots; ++k) make_slot(c, g, k, slots[k], sums);
@@ -365,7 +368,7 @@ FitBlock<Out> fit_block_for(detail::SimdIsa isa) {
 FitContext fit_context(const detail::VertexFitInput& in, const CurvatureOptions& options) {
   const double h = in.mean_edge_length;
   const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
-  return {in, options, 0.5 / (width * width), detail::class_tolerances(options, h)};
+  return {in, options, 0.5 / (width * width), detail::class_tolerances(options, h), nullptr};
 }
 
 }  // namespace
@@ -426,14 +429,20 @@ CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& o
 
 Eigen::VectorXd fit_roughness(const VertexFitInput& in, const CurvatureOptions& options,
                               SimdIsa isa) {
+  return fit_roughness_at(in, options, nullptr, in.V.rows(), isa);
+}
+
+Eigen::VectorXd fit_roughness_at(const VertexFitInput& in, const CurvatureOptions& options,
+                                 const int* vertices, Eigen::Index count, SimdIsa isa) {
   if (options.solver != Solver::closed_form) {
     throw InvalidInput("fit_roughness: only the closed-form solver");
   }
-  const FitContext context = fit_context(in, options);
-  Eigen::VectorXd roughness(in.V.rows());
+  FitContext context = fit_context(in, options);
+  context.vertices = vertices;
+  Eigen::VectorXd roughness(count);
   Roughness out{roughness.data()};
   const FitBlock<Roughness> fit_block = fit_block_for<Roughness>(isa);
-  parallel_for_blocks(in.V.rows(), 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+  parallel_for_blocks(count, 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
     fit_block(context, begin, end, out);
   });
   return roughness;

@@ -36,6 +36,12 @@ CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& o
 Eigen::VectorXd fit_roughness(const VertexFitInput& in, const CurvatureOptions& options,
                               SimdIsa isa = SimdIsa::best);
 
+/// fit_roughness of the `count` listed vertices only (entry k: vertex vertices[k]), the same
+/// bits: a lane's sums do not depend on the other vertices of its group.
+Eigen::VectorXd fit_roughness_at(const VertexFitInput& in, const CurvatureOptions& options,
+                                 const int* vertices, Eigen::Index count,
+                                 SimdIsa isa = SimdIsa::best);
+
 /// Throws InvalidInput for CurvatureOptions out of range (estimate_curvature's check).
 void validate_curvature_options(const CurvatureOptions& options);
 
