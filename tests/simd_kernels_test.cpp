@@ -1,5 +1,5 @@
-// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h): the
-// same bits for every instruction set they are compiled for and every thread count, and the
+// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h):
+// the same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
 // (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).
 
@@ -128,9 +128,9 @@ TEST(SimdKernels, RoughnessIsTheFullFitsResidualWhereNoRayWasExcluded) {
         // of other groups' neighbourhoods): the same bits in list order.
         std::vector<int> some;
         for (int i = static_cast<int>(m.V.rows()) - 1; i >= 0; i -= 3) some.push_back(i);
-        const Eigen::VectorXd at = detail::fit_roughness_at(
-            {m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, some.data(),
-            static_cast<Eigen::Index>(some.size()), isa);
+        const Eigen::VectorXd at =
+            detail::fit_roughness_at({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o,
+                                     some.data(), static_cast<Eigen::Index>(some.size()), isa);
         Eigen::VectorXd expected_at(static_cast<Eigen::Index>(some.size()));
         for (std::size_t k = 0; k < some.size(); ++k) {
           expected_at[static_cast<Eigen::Index>(k)] = expected[some[k]];

@@ -180,9 +180,9 @@ RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions&
 /// and the primary is kept; 10% vertex noise makes jets 5 to 10 times rougher than exact
 /// normals. Only where `may_replace` holds is the secondary considered. Returns the chosen unit
 /// normal and its residual.
-std::pair<Eigen::Vector3d, double> select_normal(const Eigen::Vector3d& primary, double ra,
-                                                 const Eigen::Vector3d& secondary, double rb,
-                                                 bool may_replace) {
+[[gnu::always_inline]] inline std::pair<Eigen::Vector3d, double> select_normal(
+    const Eigen::Vector3d& primary, double ra, const Eigen::Vector3d& secondary, double rb,
+    bool may_replace) {
   const Eigen::Vector3d a = primary.normalized(), b = secondary.normalized();
   // A field without a fit at i (too few rays, invalid normal) never wins over one with a fit.
   const bool b_fits = std::isfinite(rb), a_fits = std::isfinite(ra);
@@ -497,15 +497,16 @@ void choose_normals(const Context& c, RecommendedResult& out) {
       // Noisy positions: normals from wider, lower-degree jets that average the noise.
       JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
       o.iterations = out.plan.jet_iterations;
-      out.N = turned_with_neighbours(
-          c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
+      out.N =
+          turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
     } else {
       // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
       // first-order (rough) on irregular meshes.
-      out.N = select_normals(jets.N, roughness_of(c, jets.N), c.max, roughness_of(c, c.max),
-                             c.threads);
+      out.N =
+          select_normals(jets.N, roughness_of(c, jets.N), c.max, roughness_of(c, c.max), c.threads);
     }
     for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+      if (side > 0.0 && out.N.row(i).allFinite()) continue;  // nothing to change
       out.N.row(i) = with_max_fallback(c, out.N.row(i).transpose(), i, side).transpose();
     }
   }
