@@ -377,11 +377,15 @@ std::vector<int> all_vertices(const Context& c) {
 /// normal field of the fit; the rows of the refitted vertices are replaced by that mean.
 void fill_undefined(const Context& c, const RecommendedPlan& plan, const std::vector<char>& skip,
                     RowMatrixX3d& N, CurvatureResult& fit) {
-  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   for (int extra = 1; extra <= kMaxExtraRings; ++extra) {
-    std::vector<int> undefined;
+    std::vector<int> candidates, undefined;
     for (int i = 0; i < c.mesh.vertex_count(); ++i) {
-      if (fit.class_of(i) != PointClass::undefined) continue;
+      if (fit.class_of(i) == PointClass::undefined) candidates.push_back(i);
+    }
+    if (candidates.empty()) return;
+    // The 1-ring, dropped for the per-triangle pass, is rebuilt only when a vertex needs it.
+    if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+    for (const int i : candidates) {
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (const int* j = c.one_ring->begin(i); j != c.one_ring->end(i); ++j) {
         if (N.row(*j).allFinite()) mean += N.row(*j).transpose();
