@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <memory>
+#include <cstring>
 #include <vector>
 
 #include "core/parallel.h"
@@ -102,12 +102,14 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
   const bool statistics = detail == TopologyDetail::statistics;
   const std::int64_t vertex_count = inc.vertex_count();
   // The 1-ring as in vertex_adjacency_from: vertex v's list first goes to the slot at
-  // 2 * inc.begin(v) of a scratch buffer (each incident face adds at most two), then compacted.
-  std::unique_ptr<int[]> ring_buffer;
-  std::vector<int> ring_counts;
+  // 2 * inc.begin(v) of its own index array (each incident face adds at most two), then the
+  // lists are moved down in place and the array shrunk: no second array of the 1-ring's size.
+  // Each list's length goes to offsets[v + 1] first, summed into offsets afterwards.
+  int* ring_buffer = nullptr;
   if (one_ring) {
-    ring_buffer = std::make_unique_for_overwrite<int[]>(2 * inc.faces.size());
-    ring_counts.resize(static_cast<std::size_t>(vertex_count));
+    one_ring->indices.resize(static_cast<Eigen::Index>(2 * inc.faces.size()));
+    one_ring->offsets.resize(vertex_count + 1);
+    ring_buffer = one_ring->indices.data();
   }
   MeshTopology t;
   t.components = face_components(vertex_count, F, threads);
@@ -123,9 +125,9 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
         std::array<std::int64_t, 6> sum{};
         for (auto v = begin; v < end; ++v) {
           int* const ring =
-              one_ring ? ring_buffer.get() + 2 * static_cast<std::size_t>(inc.begin(v)) : nullptr;
+              one_ring ? ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)) : nullptr;
           const VertexCounts c = vertex_counts(F, inc, v, statistics, s, ring);
-          if (one_ring) ring_counts[static_cast<std::size_t>(v)] = c.neighbours;
+          if (one_ring) one_ring->offsets[v + 1] = c.neighbours;
           t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
           sum[0] += c.edges;
           sum[1] += c.boundary_edges;
@@ -146,20 +148,18 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
   }
   if (one_ring) {
     Neighbourhoods& ring = *one_ring;
-    ring.offsets.resize(vertex_count + 1);
-    std::int64_t total = 0;
+    int total = 0;  // at most 2 * inc.faces.size() entries, whose offsets fit an int already
     ring.offsets[0] = 0;
     for (std::int64_t v = 0; v < vertex_count; ++v) {
-      total += ring_counts[static_cast<std::size_t>(v)];
-      // Cannot exceed 2 * inc.faces.size() entries, whose offsets fit an int already.
-      ring.offsets[v + 1] = static_cast<int>(total);
+      const int count = ring.offsets[v + 1];
+      // Serial and in increasing v: each list moves down (total <= 2 * inc.begin(v)), never onto
+      // a list not yet moved.
+      std::memmove(ring_buffer + total, ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)),
+                   static_cast<std::size_t>(count) * sizeof(int));
+      total += count;
+      ring.offsets[v + 1] = total;
     }
-    ring.indices.resize(static_cast<Eigen::Index>(total));
-    parallel_for(vertex_count, threads, [&](std::int64_t v) {
-      const int* first = ring_buffer.get() + 2 * static_cast<std::size_t>(inc.begin(v));
-      std::copy(first, first + ring_counts[static_cast<std::size_t>(v)],
-                ring.indices.data() + ring.offsets[v]);
-    });
+    ring.indices.conservativeResize(total);
   }
   return t;
 }
