@@ -296,14 +296,19 @@ FaceBlock solve_face_block_for(detail::SimdIsa isa) {
                             solve_face_block_baseline);
 }
 
-/// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
-/// both normals lie in each other's hemisphere here).
-Eigen::Vector3d rotate_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& w) {
-  const Eigen::Vector3d axis = a.cross(b);
-  const double c = a.dot(b);
-  return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
-}
+/// The minimal rotation taking unit a to unit b (Rodrigues; a.b > -1 holds since both normals
+/// lie in each other's hemisphere here): its axis a x b and cosine a.b, computed once for the
+/// two face axes it turns.
+struct Rotation {
+  Eigen::Vector3d axis;
+  double c;
+
+  Rotation(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : axis(a.cross(b)), c(a.dot(b)) {}
+  /// The rotation applied to w.
+  [[nodiscard]] Eigen::Vector3d operator()(const Eigen::Vector3d& w) const {
+    return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+  }
+};
 
 /// The face's symmetrised shape operator in a vertex's tangent frame: the face frame is rotated
 /// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
@@ -313,8 +318,9 @@ Eigen::Matrix2d operator_in_frame(const TriangleCurvatureResult& t, int f, const
   const auto& m = t.shape_operator.row(f);
   Eigen::Matrix2d sym;
   sym << m[0], 0.5 * (m[1] + m[2]), 0.5 * (m[1] + m[2]), m[3];
-  const Eigen::Vector3d x = rotate_between(from.n, to.n, from.x);
-  const Eigen::Vector3d y = rotate_between(from.n, to.n, from.y);
+  const Rotation rotate(from.n, to.n);
+  const Eigen::Vector3d x = rotate(from.x);
+  const Eigen::Vector3d y = rotate(from.y);
   Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
   q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
   return q * sym * q.transpose();
