@@ -44,7 +44,8 @@ const std::vector<std::string>& curvature_field_names() {
   return names;
 }
 
-void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields) {
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         int threads) {
   std::vector<CsvColumn> columns;
   for (auto& [name, values] : numeric_fields(fields)) columns.push_back({name, std::move(values)});
   std::vector<std::string> words(static_cast<std::size_t>(fields.point_class.size()));
@@ -52,7 +53,7 @@ void write_curvature_csv(const std::filesystem::path& path, const CurvatureResul
     words[i] = std::string(class_name(fields.class_of(static_cast<int>(i))));
   }
   columns.push_back({"class", std::move(words)});
-  write_csv(path, columns);
+  write_csv(path, columns, threads);
 }
 
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,

@@ -13,8 +13,10 @@ namespace focal {
 /// k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class.
 [[nodiscard]] const std::vector<std::string>& curvature_field_names();
 
-/// One CSV row per vertex, in input order; class as a word, NaN as `nan`.
-void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields);
+/// One CSV row per vertex, in input order; class as a word, NaN as `nan`. The rows are formatted
+/// on `threads` threads (0: the default), the same bytes for any count.
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         int threads = 0);
 
 /// The mesh with the fields as per-vertex PLY properties (floats; class as a uchar whose codes
 /// are listed in a header comment), so MeshLab and ParaView can colour by them.
