@@ -45,7 +45,7 @@ demo: deps-demo build
 
 # Benchmarks (bench/, docs/PERFORMANCE.md): the stages with Google Benchmark, then whole runs
 # of the focal command from 10K to 10M vertices, and the peers, then 1 vs 2 threads on a quiet
-# and a loaded machine (bench/threads_under_load.sh, issue 20). About 20 minutes on 2 cores.
+# and a loaded machine (bench/threads_under_load.sh, issue 20). About 25 minutes on 2 cores.
 bench:
 	@bash scripts/install-deps.sh bench
 	@cmake --preset bench >/dev/null

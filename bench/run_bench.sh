@@ -113,13 +113,30 @@ mesh=$(bunny 0)
 for t in 1 2; do report "bunny/0" "$mesh" "$t" ""; done
 
 # Peers (libigl, pymeshlab, trimesh, VTK) on the bunny as ratios to focal, from their own venv
-# made by bench/peers/setup.sh; skipped, with a line saying so, when it is not there.
+# made by bench/peers/setup.sh; skipped, with a line saying so, when it is not there. Then the
+# side-by-side table of issue 19 on the 1M-vertex torus: focal default and --paper (compute and
+# whole process), trueform, libigl, pymeshlab, VTK and CGAL 5.5's jets (bench/points/cgal_peer,
+# built from Debian's libcgal-dev), median of FOCAL_BENCH_PEER_REPS (default 3) runs: about 4
+# minutes on 2 cores. The peers that take minutes at 1M (trimesh's ball measures, pymeshlab's
+# APSS and normal cycles) are left out there.
 echo
 peers=$(dirname "$0")/peers
 if [[ -x $peers/.venv/bin/python ]]; then
   bunny 0 >/dev/null  # extracts bunny.off into the cache
   "$peers/.venv/bin/python" "$peers/peers.py" timing "$data/bunny.off" --focal "$focal" ||
     echo "Peers failed (exit $?); see the messages above."
+  if ((max >= 1000000)); then
+    cgal=$build/../points/cgal_peer
+    [[ -x $cgal ]] || bash "$(dirname "$0")/points/build_peers.sh" "$(dirname "$cgal")" >&2
+    # trueform at its pin in bench/python/requirements.txt (not the rest: Open3D is large).
+    "$peers/.venv/bin/pip" install --quiet \
+      "$(grep '^trueform==' "$(dirname "$0")/python/requirements.txt")" >&2
+    echo
+    "$peers/.venv/bin/python" "$peers/peers.py" timing "$(torus 1000000)" --focal "$focal" \
+      --runs "${FOCAL_BENCH_PEER_REPS:-3}" --threads 2 --trueform --cgal "$cgal" \
+      --only libigl "pymeshlab Taubin" "pymeshlab quadric" VTK trueform ||
+      echo "Peers at 1M failed (exit $?); see the messages above."
+  fi
 else
   echo "Peers skipped: no $peers/.venv (bench/peers/setup.sh creates it)."
 fi

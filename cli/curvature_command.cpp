@@ -37,7 +37,8 @@ struct FocalMeshFlags {
 void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
   CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
   Stage stage(log, "write");
-  if (lower_extension(f.output) == ".csv") return write_curvature_csv(f.output, c.curvature);
+  if (lower_extension(f.output) == ".csv")
+    return write_curvature_csv(f.output, c.curvature, {}, f.estimator.threads);
   input.mesh.N = std::move(c.N);
   write_curvature_ply(f.output, input.mesh, c.curvature,
                       {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
@@ -48,13 +49,13 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
   if (f.tiles > 0) {
     const TileEstimate c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
     Stage stage(log, "write");
-    return write_curvature_csv(f.output, c.curvature, c.crease);
+    return write_curvature_csv(f.output, c.curvature, c.crease, f.estimator.threads);
   }
   if (input.cloud) return run_cloud_curvature(f, input, log);
   Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
-    write_curvature_csv(f.output, e.curvature, e.crease);
+    write_curvature_csv(f.output, e.curvature, e.crease, f.estimator.threads);
     return;
   }
   // The mesh as the estimator saw it (input.prepared is not used after this).

@@ -1092,6 +1092,28 @@ TEST_F(MeshIo, CsvFormatsNumbersShortestWithNanAndInf) {
   EXPECT_EQ(slurp(file("e.csv")), "\n");
 }
 
+// The rows are formatted in parallel blocks (2048 rows, 16 to a batch): the same bytes for any
+// thread count, across block and batch edges, as the rows written one by one.
+TEST_F(MeshIo, CsvIsTheSameForAnyThreadCount) {
+  const Eigen::Index n = 2048 * 16 * 2 + 777;
+  Eigen::VectorXd x(n);
+  std::vector<std::string> words(static_cast<std::size_t>(n));
+  std::string expected = "x,w\n";
+  for (Eigen::Index i = 0; i < n; ++i) {
+    x[i] = i % 7 == 0 ? kNaN : static_cast<double>(i);
+    words[static_cast<std::size_t>(i)] = i % 5 == 0 ? "a,b" : "w";
+    expected += (i % 7 == 0 ? std::string("nan") : std::to_string(i)) +
+                (i % 5 == 0 ? ",\"a,b\"\n" : ",w\n");
+  }
+  const std::vector<focal::CsvColumn> cols{{"x", x}, {"w", words}};
+  for (const int threads : {1, 2, 3}) {
+    focal::write_csv(file("p.csv"), cols, threads);
+    EXPECT_EQ(slurp(file("p.csv")), expected) << threads << " threads";
+  }
+  expect_error<focal::InvalidInput>([&] { focal::write_csv(file("p.csv"), cols, -1); },
+                                    {"threads"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Robustness: mutated and truncated files must give a valid mesh or an IoError, never a crash,
 // a different exception or indices out of range. (A cheap, deterministic stand-in for fuzzing.)

@@ -156,5 +156,29 @@ TEST(PreparedMesh, KeepsTheFindingsOfItsNormals) {
   EXPECT_EQ(check_mesh(p).zero_normal_count, 1);
 }
 
+// check_mesh builds the 1-ring in its topology pass and hands it on: the lists are those of
+// vertex_adjacency, also with repeated indices, a bowtie vertex, an unreferenced vertex and an
+// edge of three faces.
+TEST(PreparedMesh, TheRingOfTheCheckIsTheOneRing) {
+  RowMatrixX3d V(9, 3);
+  for (int i = 0; i < 9; ++i) V.row(i) << i % 3, i / 3, (i * i) % 5;
+  RowMatrixX3i F(9, 3);
+  F << 0, 1, 2, 0, 2, 3, 0, 4, 5, 0, 5, 6, 1, 1, 2, 3, 2, 3, 0, 0, 0, 1, 2, 7, 1, 2, 4;
+  Mesh odd;
+  odd.V = V;
+  odd.F = F;
+  for (const Mesh& m : {odd, noisy_torus()}) {
+    const Neighbourhoods expected =
+        vertex_adjacency(static_cast<int>(m.V.rows()), m.F, /*threads=*/1);
+    for (const int threads : {1, 2}) {
+      const PreparedMesh p(m.V, m.F, std::nullopt, {.threads = threads});
+      (void)check_mesh(p);
+      const Neighbourhoods& ring = p.one_ring();
+      EXPECT_EQ(ring.offsets, expected.offsets);
+      EXPECT_EQ(ring.indices, expected.indices);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace focal

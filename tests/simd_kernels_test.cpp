@@ -1,5 +1,5 @@
-// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h): the
-// same bits for every instruction set they are compiled for and every thread count, and the
+// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h):
+// the same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
 // (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).
 
@@ -89,6 +89,54 @@ TEST(SimdKernels, FitIsBitIdenticalForEveryInstructionSetAndThreadCount) {
       for (int threads : {1, 2, 3}) {
         EXPECT_TRUE(identical(fit(m, c, threads, isa), reference))
             << "rings " << c.rings << " isa " << static_cast<int>(isa) << " threads " << threads;
+      }
+    }
+  }
+}
+
+// The roughness-only fit (detail::fit_roughness, the recommended estimator's rating of normal
+// fields): the full fit's residual bit for bit where it made a ray of every neighbour, NaN
+// elsewhere, for every instruction set and thread count. The awkward mesh has vertices of each
+// kind (excluded rays, invalid normals, too few rays).
+TEST(SimdKernels, RoughnessIsTheFullFitsResidualWhereNoRayWasExcluded) {
+  const Mesh m = awkward_mesh();
+  for (const FitCase c : {FitCase{1, RayWeighting::uniform}, FitCase{2, RayWeighting::gaussian}}) {
+    const CurvatureResult full = fit(m, c, 1, SimdIsa::baseline);
+    Eigen::VectorXd expected = full.residual;
+    int excluded = 0, finite = 0;
+    for (Eigen::Index i = 0; i < expected.size(); ++i) {
+      if (full.rays_excluded[i] > 0) expected[i] = NAN, ++excluded;
+      finite += std::isfinite(expected[i]);
+    }
+    ASSERT_GT(excluded, 0);
+    ASSERT_GT(finite, expected.size() / 2);
+    CurvatureOptions o;
+    o.rings = c.rings;
+    o.weighting = c.weighting;
+    std::vector<char> ok;
+    const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+    const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+    const Neighbourhoods rings = c.rings == 1 ? one : k_ring(one, c.rings);
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        o.threads = threads;
+        const Eigen::VectorXd r =
+            detail::fit_roughness({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, isa);
+        EXPECT_TRUE(identical(r, expected))
+            << "rings " << c.rings << " isa " << static_cast<int>(isa) << " threads " << threads;
+        // At listed vertices only (every third, in reverse, so that each group holds vertices
+        // of other groups' neighbourhoods): the same bits in list order.
+        std::vector<int> some;
+        for (int i = static_cast<int>(m.V.rows()) - 1; i >= 0; i -= 3) some.push_back(i);
+        const Eigen::VectorXd at =
+            detail::fit_roughness_at({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o,
+                                     some.data(), static_cast<Eigen::Index>(some.size()), isa);
+        Eigen::VectorXd expected_at(static_cast<Eigen::Index>(some.size()));
+        for (std::size_t k = 0; k < some.size(); ++k) {
+          expected_at[static_cast<Eigen::Index>(k)] = expected[some[k]];
+        }
+        EXPECT_TRUE(identical(at, expected_at))
+            << "listed, rings " << c.rings << " isa " << static_cast<int>(isa);
       }
     }
   }

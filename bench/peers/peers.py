@@ -7,7 +7,9 @@
                                      metrics and CSV columns as focal eval's
   peers.py scan MESH... --csv OUT [--fields DIR]
                                      smoothness of H on scanned meshes as `focal eval --scan`
-  peers.py timing MESH --focal BIN   median of 5 runs per peer, ratio to focal's normals + curvature
+  peers.py timing MESH --focal BIN [--trueform] [--cgal CGAL_PEER] [--only NAME...]
+                                     median of 5 runs per peer, ratio to focal's normals +
+                                     curvature; focal's whole process too
 
 report.py merges the CSVs into the tables of docs/ACCURACY.md and draws the plots.
 
@@ -375,41 +377,88 @@ def slug(name):
 # Timing (issue 5)
 
 
-def focal_ms(focal, mesh, *flags):
-    """focal's normals + curvature stage times from `focal -v curvature [flags]` (ms)."""
+def focal_run(focal, mesh, *flags):
+    """focal's compute (the normals + curvature stage times of `focal -v curvature [flags]`, ms)
+    and its whole process (wall ms: read, check, compute, write)."""
+    start = time.perf_counter()
     out = subprocess.run([focal, "-v", "curvature", mesh, "-o", "/tmp/focal-peers-timing.ply",
                           *flags], capture_output=True, text=True, check=True).stderr
+    whole = 1000 * (time.perf_counter() - start)
     stages = dict(re.findall(r"^\s+(normals|curvature):\s+([0-9.]+) ms", out, re.M))
     if set(stages) != {"normals", "curvature"}:
         raise SystemExit("focal -v printed no normals/curvature stage lines:\n" + out)
-    return float(stages["normals"]) + float(stages["curvature"])
+    return float(stages["normals"]) + float(stages["curvature"]), whole
+
+
+def trueform_curvatures(V, F, N):
+    """trueform's principal curvatures over the k = 2 ring (bench/python/bench.py checks its
+    accuracy and sign; timed here only)."""
+    import trueform as tf
+    mesh = tf.Mesh(np.ascontiguousarray(F, dtype=np.int32), np.ascontiguousarray(V))
+    return tf.principal_curvatures(mesh, k=2)
+
+
+def cgal_jets_ms(cgal_peer, V, N, k=16):
+    """CGAL 5.5 Monge_via_jet_fitting (bench/points/cgal_peer: kd-tree, k nearest neighbours,
+    degree-2 jet) on the vertices with the file's normals: its fit seconds (ms), and the whole
+    process (ms), which reads the points as text."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        xyz = os.path.join(d, "points.xyz")
+        np.savetxt(xyz, np.column_stack([V, N]), fmt="%.17g")
+        start = time.perf_counter()
+        out = subprocess.run([cgal_peer, xyz, str(k), os.path.join(d, "out.csv")],
+                             capture_output=True, text=True, check=True).stdout
+        whole = 1000 * (time.perf_counter() - start)
+    return 1000 * float(out.split()[1]), whole
 
 
 def cmd_timing(args):
     V, F = read_scan(args.mesh)
     N = np.zeros_like(V)
-    # The paper's fit (--paper: closed form, 1-ring, Max normals here) is the fast path; the
-    # recommended estimator (the default) rates jet and Max normals and adds the triangle pass.
-    focal = statistics.median(focal_ms(args.focal, args.mesh, "--paper") for _ in range(args.runs))
-    default = statistics.median(focal_ms(args.focal, args.mesh) for _ in range(args.runs))
+    runs = range(args.runs)
+    # The paper's fit (--paper: closed form, 1-ring) is the fast path; the recommended estimator
+    # (the default) rates jet, Max and file normals and adds the triangle pass.
+    threads = ["--threads", str(args.threads)] if args.threads else []
+    paper = [focal_run(args.focal, args.mesh, "--paper", *threads) for _ in runs]
+    default = [focal_run(args.focal, args.mesh, *threads) for _ in runs]
+    focal = statistics.median(t for t, _ in paper)
+    focal_default = statistics.median(t for t, _ in default)
     print(f"Curvature of {os.path.basename(args.mesh)} ({len(V)} vertices), median of {args.runs} "
-          f"runs, mesh in memory. focal: the `normals:` + `curvature:` stage times printed by "
-          f"`focal -v curvature` (all {os.cpu_count()} hardware threads; the peers run as "
-          f"their libraries do, mostly on one thread).\n")
-    print("| method | median ms | ratio to focal --paper | ratio to focal default |\n"
-          "|---|---|---|---|")
-    print(f"| focal curvature --paper (normals + curvature) | {focal:.1f} | 1 | "
-          f"{focal / default:.2f} |")
-    print(f"| focal curvature, default: recommended (normals + curvature) | {default:.1f} | "
-          f"{default / focal:.2f} | 1 |")
-    for name, peer in PEERS.items():
+          f"runs. Compute: mesh in memory (focal: the `normals:` + `curvature:` stage times of "
+          f"`focal -v curvature`, {args.threads or os.cpu_count()} threads; the peers as their "
+          f"libraries run, in one Python process on NumPy arrays). Whole process: focal's "
+          f"command end to end (read, check, compute, write binary PLY).\n")
+    print("| method | compute ms | ratio to focal --paper | ratio to focal default | "
+          "whole process ms |\n|---|---|---|---|---|")
+
+    def row(name, t, whole="-"):
+        print(f"| {name} | {t:.1f} | {t / focal:.2f} | {t / focal_default:.2f} | {whole} |",
+              flush=True)
+
+    row("focal curvature --paper (normals + curvature)", focal,
+        f"{statistics.median(w for _, w in paper):.0f}")
+    row("focal curvature, default: recommended (normals + curvature)", focal_default,
+        f"{statistics.median(w for _, w in default):.0f}")
+    peers = dict(PEERS)
+    if args.trueform:
+        peers["trueform principal_curvatures (k = 2)"] = trueform_curvatures
+    for name, peer in peers.items():
+        if args.only and not any(word in name for word in args.only):
+            continue
         times = []
-        for _ in range(args.runs):
+        for _ in runs:
             start = time.perf_counter()
             peer(V, F, N)
             times.append(1000 * (time.perf_counter() - start))
-        t = statistics.median(times)
-        print(f"| {name} | {t:.1f} | {t / focal:.2f} | {t / default:.2f} |", flush=True)
+        row(name, statistics.median(times))
+    if args.cgal:
+        props, _ = read_ply(args.mesh)
+        normals = np.column_stack([props["nx"], props["ny"], props["nz"]])
+        results = [cgal_jets_ms(args.cgal, V, normals) for _ in runs]
+        row("CGAL 5.5 Monge_via_jet_fitting (k = 16, file normals)",
+            statistics.median(t for t, _ in results),
+            f"{statistics.median(w for _, w in results):.0f} (reads text)")
 
 
 # --------------------------------------------------------------------------------------------
@@ -431,6 +480,10 @@ def main():
     t.add_argument("mesh")
     t.add_argument("--focal", default="build/release/cli/focal")
     t.add_argument("--runs", type=int, default=5)
+    t.add_argument("--threads", type=int, default=0, help="focal's --threads (0: all)")
+    t.add_argument("--only", nargs="+", help="only the peers whose name contains one of these")
+    t.add_argument("--trueform", action="store_true", help="also trueform (bench/python)")
+    t.add_argument("--cgal", help="also CGAL 5.5 jets: bench/points/cgal_peer (build_peers.sh)")
     args = p.parse_args()
     {"accuracy": cmd_accuracy, "signs": cmd_signs, "scan": cmd_scan,
      "timing": cmd_timing}[args.command](args)

@@ -316,7 +316,7 @@ void write_fields(const std::string& path, const nb::dict& fields,
                                       : focal::VectorXu8();
   nb::gil_scoped_release release;
   if (!V) {
-    focal::write_curvature_csv(path, r, crease);
+    focal::write_curvature_csv(path, r, crease, threads);
     return;
   }
   focal::Mesh mesh;

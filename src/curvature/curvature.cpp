@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/parallel.h"
@@ -43,6 +44,8 @@ struct FitContext {
   const CurvatureOptions& options;
   double inverse_two_width_squared;  // Gaussian weights: exp(-d^2 * this)
   detail::ClassTolerances tolerances;
+  /// When set, the k-th vertex fitted is vertices[k] (and its output goes to slot k), else k.
+  const int* vertices = nullptr;
 };
 
 /// One vertex's rays and weights. Owned by a block of vertices, so that the loop over vertices
@@ -169,13 +172,14 @@ template <class L>
 }
 
 template <class L>
-[[gnu::always_inline]] inline void load_group(const VertexFitInput& in, std::int64_t first,
-                                              int active, VertexGroup<L>& g) {
+[[gnu::always_inline]] inline void load_group(const VertexFitInput& in, const int* vertices,
+                                              std::int64_t first, int active, VertexGroup<L>& g) {
   g.first = first;
   g.active = active;
   g.slots = 0;
   for (int l = 0; l < g.kWidth; ++l) {
-    const auto i = static_cast<int>(first + std::min(l, active - 1));
+    const std::int64_t k = first + std::min(l, active - 1);
+    const int i = vertices ? vertices[k] : static_cast<int>(k);
     g.self[l] = i;
     g.ring[l] = in.rings.begin(i);
     g.size[l] = l < active ? in.rings.size(i) : 0;
@@ -262,12 +266,27 @@ template <class L>
   }
 }
 
-/// The closed-form fit of one group (kernels/two_slit.h), one vertex per lane.
+/// The output of the roughness-only fit (detail::fit_roughness): one double per vertex.
+struct Roughness {
+  double* data;
+};
+
+/// Roughness of a group: the residual where the fit is valid and made a ray of every neighbour.
 template <class L>
+[[gnu::always_inline]] inline void store_roughness(const VertexGroup<L>& g, L roughness,
+                                                   Roughness& out) {
+  if (g.active == g.kWidth) return detail::store_lanes(out.data + g.first, roughness);
+  for (int l = 0; l < g.active; ++l) out.data[g.first + l] = roughness[l];
+}
+
+/// The closed-form fit of one group (kernels/two_slit.h), one vertex per lane, into every field
+/// of `r` (a CurvatureResult), or only its roughness (a Roughness: no principal axes, classes or
+/// directions computed, no other array written).
+template <class L, class Out>
 [[gnu::always_inline]] inline void fit_group(const FitContext& c, std::int64_t first, int active,
-                                             std::vector<RaySlot<L>>& slots, CurvatureResult& r) {
+                                             std::vector<RaySlot<L>>& slots, Out& r) {
   VertexGroup<L> g;
-  load_group(c.in, first, active, g);
+  load_group(c.in, c.vertices, first, active, g);
   if (slots.size() < static_cast<std::size_t>(g.slots)) slots.resize(g.slots);
   SlotSums<L> sums;
   for (int k = 0; k < g.slots; ++k) make_slot(c, g, k, slots[k], sums);
@@ -275,9 +294,6 @@ template <class L>
       kernels::solve_slits(sums.equations, detail::kMinRelativeDeterminant);
   const auto used = -sums.used;
   const auto valid = g.ok & (-sums.positive >= 2) & w.valid;
-  // Both divisions by one reciprocal, for the divider's sake as in make_slot.
-  const kernels::Principal<L> p =
-      kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w.a, w.b, w.c);
   L energy{};
   for (int k = 0; k < g.slots; ++k) {
     const RaySlot<L>& ray = slots[k];
@@ -287,27 +303,36 @@ template <class L>
                            ? sums.weight
                            : __builtin_convertvector(used, L);
   const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
-  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
-  GroupResult<L> x;
-  x.k1 = or_nan(p.k1), x.k2 = or_nan(p.k2);
-  x.H = or_nan(0.5 * (p.k1 + p.k2)), x.K = or_nan(p.k1 * p.k2);
-  x.residual = or_nan(detail::lane_sqrt(energy / weight_sum));
-  // d2 = d1 turned by +90 degrees.
-  const Vec3<L> d1 = g.frame.from_plane(p.d1x, p.d1y), d2 = g.frame.from_plane(-p.d1y, p.d1x);
-  x.d1x = or_nan(d1.x), x.d1y = or_nan(d1.y), x.d1z = or_nan(d1.z);
-  x.d2x = or_nan(d2.x), x.d2y = or_nan(d2.y), x.d2z = or_nan(d2.z);
+  const L residual = detail::lane_sqrt(energy / weight_sum);
   const MaskOf<L> none{};
-  x.point_class = valid ? kernels::classify(x.k1, x.k2, c.tolerances.zero, c.tolerances.umbilic)
-                        : kernels::class_code<L>(PointClass::undefined);
-  x.used = g.ok ? used : none;
-  x.excluded = g.ok ? __builtin_convertvector(g.count, MaskOf<L>) - used : none;
-  store_group(g, x, r);
+  const auto excluded = g.ok ? __builtin_convertvector(g.count, MaskOf<L>) - used : none;
+  if constexpr (std::is_same_v<Out, Roughness>) {
+    return store_roughness(g, valid & (excluded == 0) ? residual : nan, r);
+  } else {
+    // Both divisions by one reciprocal, for the divider's sake as in make_slot.
+    const kernels::Principal<L> p =
+        kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w.a, w.b, w.c);
+    const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
+    GroupResult<L> x;
+    x.k1 = or_nan(p.k1), x.k2 = or_nan(p.k2);
+    x.H = or_nan(0.5 * (p.k1 + p.k2)), x.K = or_nan(p.k1 * p.k2);
+    x.residual = or_nan(residual);
+    // d2 = d1 turned by +90 degrees.
+    const Vec3<L> d1 = g.frame.from_plane(p.d1x, p.d1y), d2 = g.frame.from_plane(-p.d1y, p.d1x);
+    x.d1x = or_nan(d1.x), x.d1y = or_nan(d1.y), x.d1z = or_nan(d1.z);
+    x.d2x = or_nan(d2.x), x.d2y = or_nan(d2.y), x.d2z = or_nan(d2.z);
+    x.point_class = valid ? kernels::classify(x.k1, x.k2, c.tolerances.zero, c.tolerances.umbilic)
+                          : kernels::class_code<L>(PointClass::undefined);
+    x.used = g.ok ? used : none;
+    x.excluded = excluded;
+    store_group(g, x, r);
+  }
 }
 
 /// The closed-form fit of vertices [begin, end), one group after the other.
-template <class L>
+template <class L, class Out>
 [[gnu::always_inline]] inline void fit_block_lanes(const FitContext& c, std::int64_t begin,
-                                                   std::int64_t end, CurvatureResult& r) {
+                                                   std::int64_t end, Out& r) {
   constexpr int kWidth = lane_count<L>;
   std::vector<RaySlot<L>> slots(8);
   for (std::int64_t first = begin; first < end; first += kWidth) {
@@ -315,23 +340,35 @@ template <class L>
   }
 }
 
+template <class Out>
 FOCAL_TARGET_AVX512 void fit_block_avx512(const FitContext& c, std::int64_t begin, std::int64_t end,
-                                          CurvatureResult& r) {
+                                          Out& r) {
   fit_block_lanes<detail::Lanes8>(c, begin, end, r);
 }
+template <class Out>
 FOCAL_TARGET_AVX2 void fit_block_avx2(const FitContext& c, std::int64_t begin, std::int64_t end,
-                                      CurvatureResult& r) {
+                                      Out& r) {
   fit_block_lanes<detail::Lanes4>(c, begin, end, r);
 }
-void fit_block_baseline(const FitContext& c, std::int64_t begin, std::int64_t end,
-                        CurvatureResult& r) {
+template <class Out>
+void fit_block_baseline(const FitContext& c, std::int64_t begin, std::int64_t end, Out& r) {
   fit_block_lanes<detail::Lanes2>(c, begin, end, r);
 }
 
-using FitBlock = void (*)(const FitContext&, std::int64_t, std::int64_t, CurvatureResult&);
+template <class Out>
+using FitBlock = void (*)(const FitContext&, std::int64_t, std::int64_t, Out&);
 
-FitBlock fit_block_for(detail::SimdIsa isa) {
-  return detail::kernel_for(isa, fit_block_avx512, fit_block_avx2, fit_block_baseline);
+template <class Out>
+FitBlock<Out> fit_block_for(detail::SimdIsa isa) {
+  return detail::kernel_for<FitBlock<Out>>(isa, fit_block_avx512<Out>, fit_block_avx2<Out>,
+                                           fit_block_baseline<Out>);
+}
+
+/// The fit's context: Gaussian width and class tolerances from the options.
+FitContext fit_context(const detail::VertexFitInput& in, const CurvatureOptions& options) {
+  const double h = in.mean_edge_length;
+  const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
+  return {in, options, 0.5 / (width * width), detail::class_tolerances(options, h), nullptr};
 }
 
 }  // namespace
@@ -376,11 +413,9 @@ namespace detail {
 
 CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
                              SimdIsa isa) {
-  const double h = in.mean_edge_length;
-  const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
-  const FitContext context{in, options, 0.5 / (width * width), class_tolerances(options, h)};
+  const FitContext context = fit_context(in, options);
   CurvatureResult result = unwritten_result(in.V.rows());
-  const FitBlock fit_block = fit_block_for(isa);
+  const FitBlock<CurvatureResult> fit_block = fit_block_for<CurvatureResult>(isa);
   // Blocks of vertices share one scratch; 256 vertices amortise its allocation and still give
   // each thread many blocks (static schedule, so the same split for any run). Blocks are whole
   // groups of any lane width, so a group never straddles two threads' output.
@@ -390,6 +425,27 @@ CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& o
     for (auto i = begin; i < end; ++i) fit_vertex(context, static_cast<int>(i), scratch, result);
   });
   return result;
+}
+
+Eigen::VectorXd fit_roughness(const VertexFitInput& in, const CurvatureOptions& options,
+                              SimdIsa isa) {
+  return fit_roughness_at(in, options, nullptr, in.V.rows(), isa);
+}
+
+Eigen::VectorXd fit_roughness_at(const VertexFitInput& in, const CurvatureOptions& options,
+                                 const int* vertices, Eigen::Index count, SimdIsa isa) {
+  if (options.solver != Solver::closed_form) {
+    throw InvalidInput("fit_roughness: only the closed-form solver");
+  }
+  FitContext context = fit_context(in, options);
+  context.vertices = vertices;
+  Eigen::VectorXd roughness(count);
+  Roughness out{roughness.data()};
+  const FitBlock<Roughness> fit_block = fit_block_for<Roughness>(isa);
+  parallel_for_blocks(count, 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    fit_block(context, begin, end, out);
+  });
+  return roughness;
 }
 
 }  // namespace detail

@@ -28,6 +28,20 @@ struct VertexFitInput {
 CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& options,
                              SimdIsa isa = SimdIsa::best);
 
+/// The roughness of the closed-form fit of every vertex: its residual (RMS ray misfit, slope
+/// units, the bits of fit_vertices' residual) where the fit is valid and every neighbour gave a
+/// ray, NaN elsewhere (a normal more than 90 degrees from the vertex's, as a flipped or wild
+/// normal makes it, leaves a ray out; the residual of the few left says nothing then). Writes
+/// one array, not fit_vertices' ten: the recommended estimator rates normal fields by it.
+Eigen::VectorXd fit_roughness(const VertexFitInput& in, const CurvatureOptions& options,
+                              SimdIsa isa = SimdIsa::best);
+
+/// fit_roughness of the `count` listed vertices only (entry k: vertex vertices[k]), the same
+/// bits: a lane's sums do not depend on the other vertices of its group.
+Eigen::VectorXd fit_roughness_at(const VertexFitInput& in, const CurvatureOptions& options,
+                                 const int* vertices, Eigen::Index count,
+                                 SimdIsa isa = SimdIsa::best);
+
 /// Throws InvalidInput for CurvatureOptions out of range (estimate_curvature's check).
 void validate_curvature_options(const CurvatureOptions& options);
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/fields_detail.h"
@@ -14,6 +15,7 @@
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "curvature/robust_fit.h"
+#include "curvature/triangle_curvature_detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -86,24 +88,29 @@ CurvatureResult two_slit_fit(const Context& c, const PreparedMesh& normals, int 
   return detail::fit_vertices({V, unit.N, unit.ok, ring, c.edge_length}, o);
 }
 
-/// two_slit_fit of another normal field: its unit rows live only as long as the fit needs them.
-CurvatureResult two_slit_fit(const Context& c, NormalsRef normals, int rings, bool gaussian) {
-  return two_slit_fit(c, c.mesh.with_normals(normals), rings, gaussian);
-}
-
 /// How rough a normal field is at each vertex: the RMS misfit (residual, slope units) of its
 /// 1-ring two-slit fit, NaN (no usable fit) where the fit had to leave out a neighbour's ray —
 /// a normal more than 90 degrees from the vertex's, as a flipped or wild normal makes it; the
-/// residual of the few rays left says nothing then.
-Eigen::VectorXd roughness_of(const CurvatureResult& fit) {
-  Eigen::VectorXd r = fit.residual;
-  for (Eigen::Index i = 0; i < r.size(); ++i) {
-    if (fit.rays_excluded[i] > 0) r[i] = NAN;
-  }
-  return r;
+/// residual of the few rays left says nothing then. Only the residual is computed and stored
+/// (detail::fit_roughness): the bits of the full fit's, at a fraction of its time and memory.
+Eigen::VectorXd roughness_of(const Context& c, NormalsRef normals) {
+  const PreparedMesh with = c.mesh.with_normals(normals);
+  const detail::UnitNormals& unit = detail::unit_normals(with);
+  return detail::fit_roughness({c.mesh.V(), unit.N, unit.ok, *c.one_ring, c.edge_length},
+                               paper_options(c));
 }
 
-/// select_normals: how much smoother (two-slit residual) the secondary normals must be.
+/// roughness_of at the listed vertices only (entry k: vertex vertices[k]; the same bits).
+Eigen::VectorXd roughness_at(const Context& c, NormalsRef normals,
+                             const std::vector<int>& vertices) {
+  const PreparedMesh with = c.mesh.with_normals(normals);
+  const detail::UnitNormals& unit = detail::unit_normals(with);
+  return detail::fit_roughness_at({c.mesh.V(), unit.N, unit.ok, *c.one_ring, c.edge_length},
+                                  paper_options(c), vertices.data(),
+                                  static_cast<Eigen::Index>(vertices.size()));
+}
+
+/// select_normal: how much smoother (two-slit residual) the secondary normal must be.
 constexpr double kSmootherRatio = 0.5;
 
 /// Median of the finite entries; NaN when there are none.
@@ -168,45 +175,89 @@ RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions&
   return plan;
 }
 
-/// Per vertex, the primary normal unless the secondary field is clearly smoother there: its
-/// 1-ring two-slit residual (RMS misfit of the rays, slope units) below kSmootherRatio times the
-/// primary's. On clean data the two residuals measure the same truncation error and the primary
-/// is kept; 10% vertex noise makes jets 5 to 10 times rougher than exact normals. Only vertices
-/// where `may_replace(i)` holds are considered. `roughness` receives the chosen field's residual.
-template <class MayReplace>
+/// A vertex's normal: the primary `a` unless the secondary `b` is clearly smoother there: its
+/// 1-ring two-slit residual `rb` (RMS misfit of the rays, slope units) below kSmootherRatio
+/// times the primary's `ra`. On clean data the two residuals measure the same truncation error
+/// and the primary is kept; 10% vertex noise makes jets 5 to 10 times rougher than exact
+/// normals. Only where `may_replace` holds is the secondary considered. Returns the chosen unit
+/// normal and its residual.
+[[gnu::always_inline]] inline std::pair<Eigen::Vector3d, double> select_normal(
+    const Eigen::Vector3d& primary, double ra, const Eigen::Vector3d& secondary, double rb,
+    bool may_replace) {
+  const Eigen::Vector3d a = primary.normalized(), b = secondary.normalized();
+  // A field without a fit at i (too few rays, invalid normal) never wins over one with a fit.
+  const bool b_fits = std::isfinite(rb), a_fits = std::isfinite(ra);
+  const bool smoother = b_fits && (!a_fits || rb < kSmootherRatio * ra);
+  const bool take_b = b.allFinite() && (!a.allFinite() || (smoother && may_replace));
+  return take_b ? std::pair{b, rb} : std::pair{a, ra};
+}
+
+/// select_normal at every vertex.
 RowMatrixX3d select_normals(NormalsRef primary, const Eigen::VectorXd& primary_roughness,
                             NormalsRef secondary, const Eigen::VectorXd& secondary_roughness,
-                            int threads, Eigen::VectorXd& roughness, MayReplace may_replace) {
+                            int threads) {
   RowMatrixX3d out(primary.rows(), 3);
-  roughness.resize(primary.rows());
   detail::parallel_for(primary.rows(), threads, [&](std::int64_t i) {
-    const Eigen::Vector3d a = primary.row(i).normalized().transpose();
-    const Eigen::Vector3d b = secondary.row(i).normalized().transpose();
-    const double ra = primary_roughness[i], rb = secondary_roughness[i];
-    // A field without a fit at i (too few rays, invalid normal) never wins over one with a fit.
-    const bool b_fits = std::isfinite(rb), a_fits = std::isfinite(ra);
-    const bool smoother = b_fits && (!a_fits || rb < kSmootherRatio * ra);
-    const bool take_b = b.allFinite() && (!a.allFinite() || (smoother && may_replace(i)));
-    out.row(i) = (take_b ? b : a).transpose();
-    roughness[i] = take_b ? rb : ra;
+    out.row(i) = select_normal(primary.row(i).transpose(), primary_roughness[i],
+                               secondary.row(i).transpose(), secondary_roughness[i], true)
+                     .first.transpose();
   });
   return out;
 }
 
-/// The file's normals, replaced by the positions' (`from_positions`, rated `its_roughness`) only
-/// at outliers: where a file normal is unusable or gives no fit, or where it is more than `limit`
-/// radians from the jet normal and the positions' normal is clearly smoother. On a file whose
-/// normals agree with the positions, such vertices are isolated bad normals; elsewhere the exact
-/// normals stay exact (replacing them where two truncation-level residuals happen to differ by 2x
-/// cost up to 0.5% of H error on clean irregular meshes).
-RowMatrixX3d replace_outliers(NormalsRef file, const Eigen::VectorXd& file_roughness,
-                              const Eigen::VectorXd& disagreement, NormalsRef from_positions,
-                              const Eigen::VectorXd& its_roughness, double limit, int threads) {
-  Eigen::VectorXd unused;
-  return select_normals(file, file_roughness, from_positions, its_roughness, threads, unused,
-                        [&](std::int64_t i) {
-                          return !(disagreement[i] <= limit) || !std::isfinite(file_roughness[i]);
-                        });
+/// Where the chosen normal has none (the jets had too few points, a degenerate fit): Max's
+/// normal if any; turned to the file's side (`side`, -1 or +1; the fit's residuals do not
+/// change: the rays are the same lines).
+Eigen::Vector3d with_max_fallback(const Context& c, Eigen::Vector3d n, Eigen::Index i,
+                                  double side) {
+  if (!n.allFinite()) n = c.max.row(i).transpose();
+  return side < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+/// The positions' normal at vertex i on clean positions (the jets' or Max's, by select_normal
+/// on their roughness `rj`, `rm` there), as choose_normals picks it, and its roughness.
+std::pair<Eigen::Vector3d, double> positions_normal(const Context& c, const JetNormals& jets,
+                                                    double rj, double rm, Eigen::Index i,
+                                                    double side) {
+  const auto [n, r] =
+      select_normal(jets.N.row(i).transpose(), rj, c.max.row(i).transpose(), rm, true);
+  return {with_max_fallback(c, n, i, side), r};
+}
+
+/// The file's normals, replaced by the positions' only at outliers: where a file normal is
+/// unusable or gives no fit, or where it is more than `limit` radians from the jet normal and the
+/// positions' normal (positions_normal) is clearly smoother. On a file whose normals agree with
+/// the positions, such vertices are isolated bad normals; elsewhere the exact normals stay exact
+/// (replacing them where two truncation-level residuals happen to differ by 2x cost up to 0.5%
+/// of H error on clean irregular meshes). The positions' normals are rated only at those
+/// vertices: elsewhere the file's normal is kept whatever they are.
+RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormals& jets,
+                              const Eigen::VectorXd& disagreement, double side, double limit) {
+  const Eigen::VectorXd file_roughness = roughness_of(c, file);
+  const auto may_replace = [&](Eigen::Index i) {
+    return !(disagreement[i] <= limit) || !std::isfinite(file_roughness[i]);
+  };
+  RowMatrixX3d out(file.rows(), 3);
+  std::vector<char> candidate(static_cast<std::size_t>(file.rows()));
+  detail::parallel_for(file.rows(), c.threads, [&](std::int64_t i) {
+    const Eigen::Vector3d a = file.row(i).transpose().normalized();
+    out.row(i) = a.transpose();
+    candidate[static_cast<std::size_t>(i)] = !a.allFinite() || may_replace(i);
+  });
+  std::vector<int> at;
+  for (std::size_t i = 0; i < candidate.size(); ++i) {
+    if (candidate[i]) at.push_back(static_cast<int>(i));
+  }
+  if (at.empty()) return out;
+  const Eigen::VectorXd jets_roughness = roughness_at(c, jets.N, at);
+  const Eigen::VectorXd max_roughness = roughness_at(c, c.max, at);
+  detail::parallel_for(static_cast<std::int64_t>(at.size()), c.threads, [&](std::int64_t k) {
+    const int i = at[static_cast<std::size_t>(k)];
+    const auto [b, rb] = positions_normal(c, jets, jets_roughness[k], max_roughness[k], i, side);
+    out.row(i) = select_normal(file.row(i).transpose(), file_roughness[i], b, rb, may_replace(i))
+                     .first.transpose();
+  });
+  return out;
 }
 
 /// +1 when most usable rows of `file` point to the side of `estimated`, -1 when most point
@@ -261,12 +312,11 @@ constexpr double kExactFitResidual = 1e-9;
 void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureResult& fit) {
   CurvatureOptions o = paper_options(c);
   o.method = Method::triangle;
-  const CurvatureResult triangles = estimate_curvature(fitted, o);
+  std::vector<char> inexact(static_cast<std::size_t>(fitted.vertex_count()));
   detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
-    const bool exact_fit = fit.residual[i] <= kExactFitResidual;
-    const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) detail::copy_row(triangles, i, fit, i);
+    inexact[static_cast<std::size_t>(i)] = !(fit.residual[i] <= kExactFitResidual);
   });
+  detail::replace_with_triangles(fitted, o, inexact, fit);
 }
 
 /// The file's normals compared with the jet normals: the side they point to, and per vertex the
@@ -328,11 +378,15 @@ std::vector<int> all_vertices(const Context& c) {
 /// normal field of the fit; the rows of the refitted vertices are replaced by that mean.
 void fill_undefined(const Context& c, const RecommendedPlan& plan, const std::vector<char>& skip,
                     RowMatrixX3d& N, CurvatureResult& fit) {
-  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   for (int extra = 1; extra <= kMaxExtraRings; ++extra) {
-    std::vector<int> undefined;
+    std::vector<int> candidates, undefined;
     for (int i = 0; i < c.mesh.vertex_count(); ++i) {
-      if (fit.class_of(i) != PointClass::undefined) continue;
+      if (fit.class_of(i) == PointClass::undefined) candidates.push_back(i);
+    }
+    if (candidates.empty()) return;
+    // The 1-ring, dropped for the per-triangle pass, is rebuilt only when a vertex needs it.
+    if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+    for (const int i : candidates) {
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (const int* j = c.one_ring->begin(i); j != c.one_ring->end(i); ++j) {
         if (N.row(*j).allFinite()) mean += N.row(*j).transpose();
@@ -453,31 +507,27 @@ void choose_normals(const Context& c, RecommendedResult& out) {
   out.file_disagreement = mesh_wide.file_disagreement;
   out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise,
                                                             c.options.file_agreement);
-  Eigen::VectorXd roughness;
-  if (!out.file_normals_used && out.plan.rings > 1) {
-    // Noisy positions: normals from wider, lower-degree jets that average the noise.
-    JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
-    o.iterations = out.plan.jet_iterations;
-    out.N =
-        turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
-  } else {
-    // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
-    // first-order (rough) on irregular meshes.
-    const CurvatureResult with_max = two_slit_fit(c, c.max, 1, false);
-    const CurvatureResult with_jets = two_slit_fit(c, jets.N, 1, false);
-    out.N = select_normals(jets.N, roughness_of(with_jets), c.max, roughness_of(with_max),
-                           c.threads, roughness, [](std::int64_t) { return true; });
-  }
-  // Where the chosen jets have no fit (too few points, degenerate), Max's normal if any.
-  for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
-    if (!out.N.row(i).allFinite()) out.N.row(i) = c.max.row(i);
-  }
-  if (side < 0.0) out.N = -out.N;  // the fit's residuals do not change: rays are the same lines
   if (out.file_normals_used) {
     // The file's normals, except outliers where the positions' choice is clearly smoother.
-    const CurvatureResult with_file = two_slit_fit(c, *file, 1, false);
-    out.N = replace_outliers(*file, roughness_of(with_file), disagreement, out.N, roughness,
-                             c.options.outlier_disagreement * out.plan.noise, c.threads);
+    out.N = replace_outliers(c, *file, jets, disagreement, side,
+                             c.options.outlier_disagreement * out.plan.noise);
+  } else {
+    if (out.plan.rings > 1) {
+      // Noisy positions: normals from wider, lower-degree jets that average the noise.
+      JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
+      o.iterations = out.plan.jet_iterations;
+      out.N =
+          turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
+    } else {
+      // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
+      // first-order (rough) on irregular meshes.
+      out.N =
+          select_normals(jets.N, roughness_of(c, jets.N), c.max, roughness_of(c, c.max), c.threads);
+    }
+    for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+      if (side > 0.0 && out.N.row(i).allFinite()) continue;  // nothing to change
+      out.N.row(i) = with_max_fallback(c, out.N.row(i).transpose(), i, side).transpose();
+    }
   }
   if (out.plan.rings == 1 && c.options.crease_angle > 0.0) {
     // Creases on clean positions: jets over the 2-ring mix the pieces' normals; each face lies

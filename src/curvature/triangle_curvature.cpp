@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -295,14 +296,19 @@ FaceBlock solve_face_block_for(detail::SimdIsa isa) {
                             solve_face_block_baseline);
 }
 
-/// The minimal rotation taking unit a to unit b applied to w (Rodrigues; a.b > -1 holds since
-/// both normals lie in each other's hemisphere here).
-Eigen::Vector3d rotate_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& w) {
-  const Eigen::Vector3d axis = a.cross(b);
-  const double c = a.dot(b);
-  return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
-}
+/// The minimal rotation taking unit a to unit b (Rodrigues; a.b > -1 holds since both normals
+/// lie in each other's hemisphere here): its axis a x b and cosine a.b, computed once for the
+/// two face axes it turns.
+struct Rotation {
+  Eigen::Vector3d axis;
+  double c;
+
+  Rotation(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : axis(a.cross(b)), c(a.dot(b)) {}
+  /// The rotation applied to w.
+  [[nodiscard]] Eigen::Vector3d operator()(const Eigen::Vector3d& w) const {
+    return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+  }
+};
 
 /// The face's symmetrised shape operator in a vertex's tangent frame: the face frame is rotated
 /// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
@@ -312,8 +318,9 @@ Eigen::Matrix2d operator_in_frame(const TriangleCurvatureResult& t, int f, const
   const auto& m = t.shape_operator.row(f);
   Eigen::Matrix2d sym;
   sym << m[0], 0.5 * (m[1] + m[2]), 0.5 * (m[1] + m[2]), m[3];
-  const Eigen::Vector3d x = rotate_between(from.n, to.n, from.x);
-  const Eigen::Vector3d y = rotate_between(from.n, to.n, from.y);
+  const Rotation rotate(from.n, to.n);
+  const Eigen::Vector3d x = rotate(from.x);
+  const Eigen::Vector3d y = rotate(from.y);
   Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
   q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
   return q * sym * q.transpose();
@@ -376,12 +383,23 @@ struct FacePart {
   Eigen::Matrix2d op;
 };
 
+/// Vertex i's estimate from its faces: the principal curvatures of the area-weighted mean of
+/// its usable faces' operators, their spread about it, and how many faces were used and left out.
+struct VertexAverage {
+  TangentFrame frame;
+  detail::Principal2 principal;
+  double spread = 0.0;
+  int used = 0, excluded = 0;
+  bool defined = false;
+};
+
 /// Area-weighted mean of the operators of vertex i's usable faces, and their spread about it.
-void average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult& faces,
-                       const detail::VertexFaces& inc, const RowMatrixX3d& unit,
-                       const detail::ClassTolerances& tol, Eigen::Index i,
-                       std::vector<FacePart>& parts, CurvatureResult& r) {
-  const TangentFrame frame = detail::frame_of(unit.row(i).transpose());
+VertexAverage average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult& faces,
+                                const detail::VertexFaces& inc, const RowMatrixX3d& unit,
+                                Eigen::Index i, std::vector<FacePart>& parts) {
+  VertexAverage out;
+  out.frame = detail::frame_of(unit.row(i).transpose());
+  const TangentFrame& frame = out.frame;
   parts.clear();
   Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
   double area = 0.0;
@@ -395,49 +413,83 @@ void average_at_vertex(PositionsRef V, FacesRef F, const TriangleCurvatureResult
     mean += parts.back().area * parts.back().op;
     area += parts.back().area;
   }
-  r.rays_used[i] = static_cast<int>(parts.size());
-  r.rays_excluded[i] = inc.size(i) - r.rays_used[i];
-  if (!(area > 0.0)) return detail::store_undefined(r, i);
+  out.used = static_cast<int>(parts.size());
+  out.excluded = inc.size(i) - out.used;
+  if (!(area > 0.0)) return out;
   mean /= area;
   double spread = 0.0;
   for (const auto& [a, m] : parts) spread += a * (m - mean).squaredNorm();
-  const auto p =
+  out.principal =
       detail::principal_from_symmetric(mean(0, 0), 0.5 * (mean(0, 1) + mean(1, 0)), mean(1, 1));
-  detail::store_vertex(r, i, frame, p, std::sqrt(spread / area), tol);
+  out.spread = std::sqrt(spread / area);
+  out.defined = true;
+  return out;
+}
+
+/// Row i of `r` from vertex i's estimate (undefined where it has none).
+void store_average(const VertexAverage& a, const detail::ClassTolerances& tol, Eigen::Index i,
+                   CurvatureResult& r) {
+  r.rays_used[i] = a.used;
+  r.rays_excluded[i] = a.excluded;
+  if (!a.defined) return detail::store_undefined(r, i);
+  detail::store_vertex(r, i, a.frame, a.principal, a.spread, tol);
+}
+
+/// Runs body(i, average) for every vertex with a valid normal, body(i, nullopt) for the others,
+/// in parallel blocks (each row visited by one thread).
+template <class Body>
+void for_each_average(const PreparedMesh& mesh, const CurvatureOptions& options, Body&& body) {
+  // Only what the averaging reads: the face operators, their normals and classes.
+  TriangleFields needed;
+  needed.coefficients = needed.curvatures = needed.focal_depths = false;
+  needed.directions = needed.slits = false;
+  const TriangleCurvatureResult faces =
+      detail::triangle_curvature(mesh, options, needed, detail::SimdIsa::best);
+  const PositionsRef& V = mesh.V();
+  const FacesRef& F = mesh.F();
+  const int threads = detail::threads_for(mesh, options.threads);
+  const detail::UnitNormals& unit_normals = detail::unit_normals(mesh);
+  const RowMatrixX3d& unit = unit_normals.N;
+  const std::vector<char>& ok = unit_normals.ok;
+  const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
+  const detail::VertexFaces& inc = *incidence;
+  // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
+  detail::parallel_for_blocks(V.rows(), 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<FacePart> parts;
+    for (auto i = begin; i < end; ++i) {
+      if (ok[static_cast<std::size_t>(i)]) {
+        body(i, std::optional<VertexAverage>(average_at_vertex(V, F, faces, inc, unit, i, parts)));
+      } else {
+        body(i, std::optional<VertexAverage>());
+      }
+    }
+  });
 }
 
 }  // namespace
 
 CurvatureResult detail::vertex_curvature_from_triangles(const PreparedMesh& mesh,
                                                         const CurvatureOptions& options) {
-  // Only what the averaging reads: the face operators, their normals and classes.
-  TriangleFields needed;
-  needed.coefficients = needed.curvatures = needed.focal_depths = false;
-  needed.directions = needed.slits = false;
-  const TriangleCurvatureResult faces = triangle_curvature(mesh, options, needed, SimdIsa::best);
-  const PositionsRef& V = mesh.V();
-  const FacesRef& F = mesh.F();
-  const int threads = threads_for(mesh, options.threads);
-  const UnitNormals& unit_normals = detail::unit_normals(mesh);
-  const RowMatrixX3d& unit = unit_normals.N;
-  const std::vector<char>& ok = unit_normals.ok;
-  const std::shared_ptr<const VertexFaces> incidence = detail::incidence(mesh);
-  const VertexFaces& inc = *incidence;
   const ClassTolerances tol = class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult r = detail::unwritten_result(V.rows());
-  // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
-  detail::parallel_for_blocks(V.rows(), 256, threads, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<FacePart> parts;
-    for (auto i = begin; i < end; ++i) {
-      if (ok[static_cast<std::size_t>(i)]) {
-        average_at_vertex(V, F, faces, inc, unit, tol, i, parts, r);
-      } else {
-        detail::store_undefined(r, i);
-        r.rays_used[i] = r.rays_excluded[i] = 0;
-      }
-    }
+  CurvatureResult r = detail::unwritten_result(mesh.vertex_count());
+  for_each_average(mesh, options, [&](Eigen::Index i, const std::optional<VertexAverage>& a) {
+    if (a) return store_average(*a, tol, i, r);
+    detail::store_undefined(r, i);
+    r.rays_used[i] = r.rays_excluded[i] = 0;
   });
   return r;
+}
+
+void detail::replace_with_triangles(const PreparedMesh& mesh, const CurvatureOptions& options,
+                                    const std::vector<char>& replace, CurvatureResult& r) {
+  const ClassTolerances tol = class_tolerances(options, mesh.mean_edge_length());
+  for_each_average(mesh, options, [&](Eigen::Index i, const std::optional<VertexAverage>& a) {
+    // As a copied row: only where the class the row would get is not undefined (NaN curvatures).
+    if (!a || !a->defined || !replace[static_cast<std::size_t>(i)]) return;
+    const Principal2& p = a->principal;
+    if (classify(p.k1, p.k2, tol.zero, tol.umbilic) == PointClass::undefined) return;
+    store_average(*a, tol, i, r);
+  });
 }
 
 }  // namespace focal

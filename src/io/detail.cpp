@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <system_error>
 
 #include "focal/core/error.h"
@@ -26,7 +27,7 @@ void fail_at_offset(const std::filesystem::path& path, std::size_t offset,
   throw IoError(path.string() + ": byte offset " + std::to_string(offset) + ": " + what);
 }
 
-std::string read_whole_file(const std::filesystem::path& path) {
+FileBytes read_whole_file(const std::filesystem::path& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) fail(path, "no such file");
@@ -46,20 +47,22 @@ std::string read_whole_file(const std::filesystem::path& path) {
   if (file == nullptr) fail(path, std::string("cannot open for reading: ") + std::strerror(errno));
   // Read into a buffer one byte larger than the reported size, so that a file that grew (or a
   // size query that is wrong, as for pipes) is noticed and the buffer extended.
-  std::string data;
   const auto size_hint = std::filesystem::file_size(path, ec);
-  data.resize(ec ? std::size_t{1} << 20 : static_cast<std::size_t>(size_hint) + 1);
+  std::size_t capacity = ec ? std::size_t{1} << 20 : static_cast<std::size_t>(size_hint) + 1;
+  auto data = std::make_unique_for_overwrite<char[]>(capacity);
   std::size_t used = 0;
   for (;;) {
-    used += std::fread(data.data() + used, 1, data.size() - used, file);
-    if (used < data.size()) break;
-    data.resize(2 * data.size());
+    used += std::fread(data.get() + used, 1, capacity - used, file);
+    if (used < capacity) break;
+    auto larger = std::make_unique_for_overwrite<char[]>(2 * capacity);
+    std::memcpy(larger.get(), data.get(), used);
+    data = std::move(larger);
+    capacity *= 2;
   }
   const bool failed = std::ferror(file) != 0;
   std::fclose(file);
   if (failed) fail(path, "read error");
-  data.resize(used);
-  return data;
+  return {std::move(data), used};
 }
 
 void check_count_fits(const std::filesystem::path& path, std::string_view where,

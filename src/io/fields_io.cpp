@@ -54,7 +54,7 @@ const std::vector<std::string>& curvature_field_names() {
 }
 
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
-                         const VectorXu8& crease) {
+                         const VectorXu8& crease, int threads) {
   check_crease(crease, fields, "write_curvature_csv");
   std::vector<CsvColumn> columns;
   for (auto& [name, values] : numeric_fields(fields)) columns.push_back({name, std::move(values)});
@@ -64,7 +64,7 @@ void write_curvature_csv(const std::filesystem::path& path, const CurvatureResul
   }
   columns.push_back({"class", std::move(words)});
   if (crease.size() > 0) columns.push_back({"crease", Eigen::VectorXd(crease.cast<double>())});
-  write_csv(path, columns);
+  write_csv(path, columns, threads);
 }
 
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,

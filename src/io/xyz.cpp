@@ -167,8 +167,8 @@ class XyzReader {
 namespace io_detail {
 
 Mesh read_xyz(const std::filesystem::path& path) {
-  const std::string text = read_whole_file(path);
-  return XyzReader(path, text).read();
+  const FileBytes text = read_whole_file(path);
+  return XyzReader(path, text.view()).read();
 }
 
 }  // namespace io_detail

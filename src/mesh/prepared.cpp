@@ -20,7 +20,8 @@ struct PreparedMesh::Geometry {
   int threads;
   std::recursive_mutex mutex;
   std::shared_ptr<const detail::VertexFaces> incidence;
-  std::shared_ptr<const Neighbourhoods> one_ring;  ///< kept once one_ring() was called
+  std::shared_ptr<const Neighbourhoods> one_ring;      ///< kept once one_ring() was called
+  std::shared_ptr<const Neighbourhoods> offered_ring;  ///< offer_one_ring's, until first asked for
   std::optional<double> mean_edge_length;
 
   Geometry(PositionsRef v, FacesRef f, int t) : V(std::move(v)), F(std::move(f)), threads(t) {}
@@ -128,8 +129,15 @@ std::shared_ptr<const Neighbourhoods> PreparedAccess::one_ring(const PreparedMes
   PreparedMesh::Geometry& g = *mesh.geometry_;
   const std::lock_guard lock(g.mutex);
   if (g.one_ring) return g.one_ring;
+  if (g.offered_ring) return std::exchange(g.offered_ring, nullptr);
   return std::make_shared<const Neighbourhoods>(
       vertex_adjacency_from(*incidence(mesh), g.F, g.threads));
+}
+
+void PreparedAccess::offer_one_ring(const PreparedMesh& mesh, Neighbourhoods&& ring) {
+  PreparedMesh::Geometry& g = *mesh.geometry_;
+  const std::lock_guard lock(g.mutex);
+  if (!g.one_ring) g.offered_ring = std::make_shared<const Neighbourhoods>(std::move(ring));
 }
 
 const UnitNormals& PreparedAccess::unit_normals(const PreparedMesh& mesh) {

@@ -51,6 +51,9 @@ struct PreparedAccess {
   static void release_incidence(const PreparedMesh& mesh);
   /// The kept 1-ring if one_ring() was called, else one built for the caller and not kept.
   static std::shared_ptr<const Neighbourhoods> one_ring(const PreparedMesh& mesh);
+  /// Hands a 1-ring built by another pass (check_mesh's topology pass) to the next one_ring()
+  /// call, which takes it (it is not kept after that, as one_ring()'s own is not).
+  static void offer_one_ring(const PreparedMesh& mesh, Neighbourhoods&& ring);
   /// The mesh's normals made unit, on first call. \throw InvalidInput without normals.
   static const UnitNormals& unit_normals(const PreparedMesh& mesh);
   /// The findings kept for this mesh, computed by `compute` on first call.

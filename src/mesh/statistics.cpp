@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "core/parallel.h"
@@ -23,6 +24,7 @@ struct VertexCounts {
   int duplicate_faces = 0;
   bool non_manifold_vertex = false;
   std::uint8_t edge_flags = 0;
+  int neighbours = 0;  // distinct other ends of v's edges (written to `ring` when asked for)
 };
 
 struct Scratch {
@@ -52,14 +54,18 @@ int duplicate_faces_at(FacesRef F, const VertexFaces& inc, std::int64_t v,
 // All of v's findings from one sorted list of its edge sides. Fans: v's faces without a
 // repeated index (direction != 0), joined whenever they share an edge at v; their number is the
 // faces less the joins that merged two fans.
+// With `ring`, also writes the other ends of v's edges there, ascending (its 1-ring: the same
+// list as vertex_adjacency_from's).
 VertexCounts vertex_counts(FacesRef F, const VertexFaces& inc, std::int64_t v, bool statistics,
-                           Scratch& s) {
+                           Scratch& s, int* ring) {
   VertexCounts counts;
   const int proper_faces = collect_edge_sides(F, inc, v, s.sides);
   s.fan_parent.resize(statistics ? static_cast<std::size_t>(inc.size(v)) : 0);
   for (std::size_t i = 0; i < s.fan_parent.size(); ++i) s.fan_parent[i] = static_cast<int>(i);
   int joins = 0;
   for_each_edge(s.sides, [&](int other, const EdgeSide* first, const EdgeSide* last) {
+    if (ring) ring[counts.neighbours] = other;
+    ++counts.neighbours;
     const EdgeSide* anchor = nullptr;
     for (const auto* side = first; statistics && side < last; ++side) {
       if (side->direction == 0) continue;
@@ -91,9 +97,20 @@ VertexCounts vertex_counts(FacesRef F, const VertexFaces& inc, std::int64_t v, b
 
 }  // namespace
 
-MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads) {
+MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads,
+                           Neighbourhoods* one_ring) {
   const bool statistics = detail == TopologyDetail::statistics;
   const std::int64_t vertex_count = inc.vertex_count();
+  // The 1-ring as in vertex_adjacency_from: vertex v's list first goes to the slot at
+  // 2 * inc.begin(v) of its own index array (each incident face adds at most two), then the
+  // lists are moved down in place and the array shrunk: no second array of the 1-ring's size.
+  // Each list's length goes to offsets[v + 1] first, summed into offsets afterwards.
+  int* ring_buffer = nullptr;
+  if (one_ring) {
+    one_ring->indices.resize(static_cast<Eigen::Index>(2 * inc.faces.size()));
+    one_ring->offsets.resize(vertex_count + 1);
+    ring_buffer = one_ring->indices.data();
+  }
   MeshTopology t;
   t.components = face_components(vertex_count, F, threads);
   t.edge_flags.resize(static_cast<std::size_t>(vertex_count));
@@ -102,22 +119,25 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
   const std::int64_t blocks = (vertex_count + kBlock - 1) / kBlock;
   std::vector<std::array<std::int64_t, 6>> sums(static_cast<std::size_t>(blocks));
   PerThread<Scratch> scratch(threads);
-  parallel_blocks(vertex_count, kBlock, threads,
-                  [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-                    Scratch& s = scratch.local();
-                    std::array<std::int64_t, 6> sum{};
-                    for (auto v = begin; v < end; ++v) {
-                      const VertexCounts c = vertex_counts(F, inc, v, statistics, s);
-                      t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
-                      sum[0] += c.edges;
-                      sum[1] += c.boundary_edges;
-                      sum[2] += c.non_manifold_edges;
-                      sum[3] += c.non_manifold_vertex ? 1 : 0;
-                      sum[4] += c.duplicate_faces;
-                      sum[5] += inc.size(v) == 0 ? 1 : 0;
-                    }
-                    sums[static_cast<std::size_t>(b)] = sum;
-                  });
+  parallel_blocks(
+      vertex_count, kBlock, threads, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
+        Scratch& s = scratch.local();
+        std::array<std::int64_t, 6> sum{};
+        for (auto v = begin; v < end; ++v) {
+          int* const ring =
+              one_ring ? ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)) : nullptr;
+          const VertexCounts c = vertex_counts(F, inc, v, statistics, s, ring);
+          if (one_ring) one_ring->offsets[v + 1] = c.neighbours;
+          t.edge_flags[static_cast<std::size_t>(v)] = c.edge_flags;
+          sum[0] += c.edges;
+          sum[1] += c.boundary_edges;
+          sum[2] += c.non_manifold_edges;
+          sum[3] += c.non_manifold_vertex ? 1 : 0;
+          sum[4] += c.duplicate_faces;
+          sum[5] += inc.size(v) == 0 ? 1 : 0;
+        }
+        sums[static_cast<std::size_t>(b)] = sum;
+      });
   for (const auto& sum : sums) {
     t.edge_count += sum[0];
     t.boundary_edge_count += sum[1];
@@ -125,6 +145,21 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
     t.non_manifold_vertex_count += sum[3];
     t.duplicate_face_count += sum[4];
     t.unreferenced_vertex_count += sum[5];
+  }
+  if (one_ring) {
+    Neighbourhoods& ring = *one_ring;
+    int total = 0;  // at most 2 * inc.faces.size() entries, whose offsets fit an int already
+    ring.offsets[0] = 0;
+    for (std::int64_t v = 0; v < vertex_count; ++v) {
+      const int count = ring.offsets[v + 1];
+      // Serial and in increasing v: each list moves down (total <= 2 * inc.begin(v)), never onto
+      // a list not yet moved.
+      std::memmove(ring_buffer + total, ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)),
+                   static_cast<std::size_t>(count) * sizeof(int));
+      total += count;
+      ring.offsets[v + 1] = total;
+    }
+    ring.indices.conservativeResize(total);
   }
   return t;
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
 #include "mesh/topology.h"
 
 namespace focal::detail {
@@ -35,8 +36,10 @@ struct MeshTopology {
 enum class TopologyDetail { orientation, statistics };
 
 /// The topology of F from its incidence `inc` (vertex_face_incidence of F, whose vertex count is
-/// the mesh's).
-MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads);
+/// the mesh's). With `one_ring`, also writes the 1-ring there (vertex_adjacency_from's lists,
+/// from the same sorted edge sides).
+MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads,
+                           Neighbourhoods* one_ring = nullptr);
 
 /// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
 /// F must already be validated against V.

@@ -14,10 +14,11 @@ namespace focal {
 [[nodiscard]] const std::vector<std::string>& curvature_field_names();
 
 /// One CSV row per vertex, in input order; class as a word, NaN as `nan`. With `crease` (#V
-/// flags, Estimate::crease) a last column `crease` of 0 and 1; empty: no such column.
+/// flags, Estimate::crease) a last column `crease` of 0 and 1; empty: no such column. The rows
+/// are formatted on `threads` threads (0: the default), the same bytes for any count.
 /// \throw InvalidInput when `crease` is neither empty nor of the fields' length.
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
-                         const VectorXu8& crease = {});
+                         const VectorXu8& crease = {}, int threads = 0);
 
 /// The mesh with the fields as per-vertex PLY properties (floats; class as a uchar whose codes
 /// are listed in a header comment), so MeshLab and ParaView can colour by them; with `crease`

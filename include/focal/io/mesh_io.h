@@ -118,9 +118,11 @@ struct CsvColumn {
   std::variant<Eigen::VectorXd, std::vector<std::string>> values;
 };
 
-/// Writes a header line with the column names, then one row per element.
-/// \throw InvalidInput when the columns differ in length; IoError on write failure.
-void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns);
+/// Writes a header line with the column names, then one row per element, the rows formatted on
+/// `threads` threads (0: the default; the bytes are the same for any count).
+/// \throw InvalidInput when the columns differ in length or threads < 0; IoError on write failure.
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
+               int threads = 0);
 
 /// Writes a text file (a report, a Markdown table) through the same temporary-file-and-rename
 /// path as the other writers. \throw IoError on write failure.
