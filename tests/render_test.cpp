@@ -464,9 +464,10 @@ TEST(Picture, CloudSplatsCoverTheSphereAndNothingElse) {
   const Rgb expected = map_colour(ColourMap::diverging, 1.0, *o.range);
   for (const bool with_normals : {true, false}) {
     SCOPED_TRACE(with_normals ? "normals" : "no normals");
-    const RowMatrixX3d N = with_normals
-                               ? V
-                               : RowMatrixX3d::Constant(V.rows(), 3, std::numeric_limits<double>::quiet_NaN());
+    const RowMatrixX3d N =
+        with_normals
+            ? V
+            : RowMatrixX3d::Constant(V.rows(), 3, std::numeric_limits<double>::quiet_NaN());
     const Image im = render_field_picture(V, no_faces, N, field, o);
     const auto [left, right] = first_run(im, o.height / 2);
     ASSERT_LT(left, right);
@@ -508,8 +509,8 @@ TEST(Picture, CloudSplatsAreDepthTested) {
       field[row] = layer == 0 ? -1.0 : 1.0;
     }
   }
-  const RowMatrixX3d N = RowMatrixX3d::Constant(V.rows(), 3, 0.0).rowwise() +
-                         Eigen::RowVector3d(0.0, 0.0, 1.0);
+  const RowMatrixX3d N =
+      RowMatrixX3d::Constant(V.rows(), 3, 0.0).rowwise() + Eigen::RowVector3d(0.0, 0.0, 1.0);
   FieldPictureOptions o = head_on_plane_options();
   o.range = ColourRange{-1.0, 1.0};
   const Image im = render_field_picture(V, RowMatrixX3i(0, 3), N, field, o);

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "render/bitmap_font.h"
 #include "focal/curvature/curvature.h"
 #include "focal/points/neighbours.h"
 #include "focal/render/render.h"
+#include "render/bitmap_font.h"
 #include "render/gl_context.h"
 #include "render/gl_mesh.h"
 
@@ -80,8 +80,9 @@ void check_options(PositionsRef V, FacesRef F, NormalsRef N,
   }
   if (o.glyph_count < 1) throw InvalidInput("render_field_picture: glyph_count must be >= 1");
   if (!(std::isfinite(o.splat_radius) && o.splat_radius >= 0.0)) {
-    throw InvalidInput("render_field_picture: splat_radius must be finite and >= 0 (0: from the "
-                       "spacing)");
+    throw InvalidInput(
+        "render_field_picture: splat_radius must be finite and >= 0 (0: from the "
+        "spacing)");
   }
   if (o.focal_meshes) {
     for (const FocalMesh* g : {&o.focal_meshes->gamma1, &o.focal_meshes->gamma2}) {
@@ -196,7 +197,8 @@ constexpr double kSplatRadiusPerMeanDistance = 0.7;
 
 /// Mean distance of each point to its 8 nearest (NaN for points with no neighbour).
 Eigen::VectorXd mean_neighbour_distances(PositionsRef V, int threads) {
-  Eigen::VectorXd mean = Eigen::VectorXd::Constant(V.rows(), std::numeric_limits<double>::quiet_NaN());
+  Eigen::VectorXd mean =
+      Eigen::VectorXd::Constant(V.rows(), std::numeric_limits<double>::quiet_NaN());
   const Neighbourhoods knn = nearest_neighbours(V, kSplatNeighbours, threads);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     const auto begin = knn.offsets[i], end = knn.offsets[i + 1];
@@ -216,9 +218,8 @@ std::vector<float> splat_radii(PositionsRef V, double radius, int threads) {
   const Eigen::VectorXd mean = mean_neighbour_distances(V, threads);
   const double fallback = 0.01 * bounding_box_diagonal(V);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const double r = std::isfinite(mean[i]) && mean[i] > 0.0
-                         ? kSplatRadiusPerMeanDistance * mean[i]
-                         : fallback;
+    const double r =
+        std::isfinite(mean[i]) && mean[i] > 0.0 ? kSplatRadiusPerMeanDistance * mean[i] : fallback;
     out[static_cast<std::size_t>(i)] = static_cast<float>(r);
   }
   return out;
@@ -240,7 +241,8 @@ std::vector<float> splat_normals(NormalsRef N, Eigen::Index count) {
   if (N.rows() != count) return out;
   for (Eigen::Index i = 0; i < count; ++i) {
     if (!N.row(i).allFinite()) continue;
-    for (int c = 0; c < 3; ++c) out[3 * static_cast<std::size_t>(i) + c] = static_cast<float>(N(i, c));
+    for (int c = 0; c < 3; ++c)
+      out[3 * static_cast<std::size_t>(i) + c] = static_cast<float>(N(i, c));
   }
   return out;
 }

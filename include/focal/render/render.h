@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/mesh.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/image_space/image_space.h"
-#include "focal/core/mesh.h"
 
 namespace focal {
 
