@@ -50,6 +50,11 @@ run curvature sphere.xyz -o sphere.csv
 check "curvature on a cloud: exit 0, no warning" bash -c '[[ $1 -eq 0 && ! -s $2 ]]' _ "$rc" "$ERR"
 check "sphere cloud with exact normals: k1 = 1 to 1e-9" below "$(max_dev sphere.csv 1 1)" 1e-9
 check "sphere cloud with exact normals: k2 = 1 to 1e-9" below "$(max_dev sphere.csv 2 1)" 1e-9
+run curvature sphere.xyz -o adaptive.csv --adaptive-radius 1.2
+check "--adaptive-radius 1.2 with exact normals: H = 1 to 1e-9" below "$(max_dev adaptive.csv 3 1)" 1e-9
+expect_error "--adaptive-radius with --rings: applies to meshes" "applies to meshes" ar.csv curvature sphere.xyz -o ar.csv --adaptive-radius 1 --rings 2
+run curvature sphere.xyz -o ar0.csv --adaptive-radius 0
+check "--adaptive-radius 0: exit 1 (must be positive)" bash -c '[[ $1 -eq 1 && ! -e ar0.csv ]]' _ "$rc"
 
 # Without normals (estimated, MST-oriented), and the same points as PLY and OBJ without faces.
 cut -d' ' -f1-3 sphere.xyz >bare.xyz
