@@ -207,6 +207,27 @@ class NearestQuery {
   std::vector<Candidate> candidates_;
 };
 
+/// Every other point within radius_of(row) of each point (none where that is not > 0), at most
+/// max_count (0 = no limit), the nearest, sorted: radius_neighbours and the adaptive ones.
+template <class RadiusOf>
+Neighbourhoods within_radii(PositionsRef V, const std::vector<char>& excluded, int max_count,
+                            int threads, const RadiusOf& radius_of) {
+  const PointTree tree(V, excluded);
+  const std::size_t limit =
+      max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
+  return gather(V.rows(), tree, threads,
+                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
+                  c.clear();
+                  const int row = tree.row(static_cast<std::uint32_t>(p));
+                  const double r = radius_of(row);
+                  if (r > 0.0) tree.within(tree.point(p), r * r, c);
+                  keep_sorted(
+                      c, row,
+                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
+                      out);
+                });
+}
+
 }  // namespace
 
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
@@ -252,18 +273,7 @@ Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
   check_threads(threads);
-  const PointTree tree(V, excluded);
-  const std::size_t limit =
-      max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
-  return gather(V.rows(), tree, threads,
-                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
-                  c.clear();
-                  tree.within(tree.point(p), radius * radius, c);
-                  keep_sorted(
-                      c, tree.row(static_cast<std::uint32_t>(p)),
-                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
-                      out);
-                });
+  return within_radii(V, excluded, max_count, threads, [radius](int) { return radius; });
 }
 
 Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, int max_count,
@@ -294,20 +304,8 @@ Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, i
       radius[static_cast<std::size_t>(i)] = scale * *middle;
     }
   });
-  const PointTree tree(V, excluded);
-  const std::size_t limit =
-      max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
-  return gather(V.rows(), tree, threads,
-                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
-                  c.clear();
-                  const int row = tree.row(static_cast<std::uint32_t>(p));
-                  const double r = radius[static_cast<std::size_t>(row)];
-                  if (r > 0.0) tree.within(tree.point(p), r * r, c);
-                  keep_sorted(
-                      c, row,
-                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
-                      out);
-                });
+  return within_radii(V, excluded, max_count, threads,
+                      [&radius](int row) { return radius[static_cast<std::size_t>(row)]; });
 }
 
 std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
