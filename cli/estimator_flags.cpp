@@ -224,6 +224,12 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
                   "point clouds: neighbours within this distance instead of the k nearest")
       ->check(CLI::PositiveNumber);
   command
+      .add_option("--adaptive-radius", cloud.adaptive_radius,
+                  "point clouds: neighbours within C x the local spacing (the median over each "
+                  "point's k nearest of their distance to their k-th nearest; k = --k or 16) "
+                  "instead of the k nearest")
+      ->check(CLI::PositiveNumber);
+  command
       .add_option("--outlier-ratio", cloud.outlier_ratio,
                   "point clouds: leave out points farther from their 16 nearest than this many "
                   "times their neighbours' median (0 = keep every point; docs/POINTS.md)")

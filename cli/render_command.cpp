@@ -106,13 +106,12 @@ Eigen::VectorXd field_values(const CurvatureResult& c, const std::string& field)
   return c.point_class.cast<double>();
 }
 
-void run_render(RenderFlags& f, const Log& log) {
-  const Input input(f.input, f.estimator, log);
+/// The picture of a mesh, with the focal meshes and glyphs the flags ask for.
+Image render_mesh(RenderFlags& f, const Input& input, const Log& log) {
   const Estimate e = run_estimate(input, f.input, f.estimator, log);
   const PreparedMesh mesh = estimated_mesh(input, e);
   const CurvatureResult& fields = e.curvature;
   FieldPictureOptions& p = f.picture;
-  p.threads = f.estimator.threads;
   if (f.focal_meshes) {
     Stage stage(log, "focal meshes");
     // Faces reaching a focal point at infinity would only draw long slivers across the view.
@@ -122,13 +121,39 @@ void run_render(RenderFlags& f, const Log& log) {
   }
   if (f.directions == "d1") p.directions = fields.d1;
   if (f.directions == "d2") p.directions = fields.d2;
+  Stage stage(log, "render");
+  return render_field_picture(mesh.V(), mesh.F(), mesh.N(), field_values(fields, f.field), p);
+}
+
+/// The picture of a point cloud: splats of its points (with the normals used) and, with
+/// --focal-meshes, of its focal points.
+Image render_cloud(RenderFlags& f, const Input& input, const Log& log) {
+  const CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
+  FieldPictureOptions& p = f.picture;
+  const RowMatrixX3i no_faces(0, 3);
+  if (f.focal_meshes) {
+    Stage stage(log, "focal points");
+    p.focal_meshes = focal_meshes(input.mesh.V, no_faces, c.N, c.curvature,
+                                  {.max_distance = 0.0, .threads = f.estimator.threads});
+  }
+  if (f.directions == "d1") p.directions = c.curvature.d1;
+  if (f.directions == "d2") p.directions = c.curvature.d2;
+  Stage stage(log, "render");
+  return render_field_picture(input.mesh.V, no_faces, c.N, field_values(c.curvature, f.field), p);
+}
+
+void run_render(RenderFlags& f, const Log& log) {
+  const Input input(f.input, f.estimator, log);
+  FieldPictureOptions& p = f.picture;
+  p.threads = f.estimator.threads;
   p.title = f.title.empty() ? std::filesystem::path(f.input).filename().string() + ": " +
                                   field_description(f.field)
                             : f.title;
   Image image;
-  {
-    Stage stage(log, "render");
-    image = render_field_picture(mesh.V(), mesh.F(), mesh.N(), field_values(fields, f.field), p);
+  if (input.cloud) {
+    image = render_cloud(f, input, log);
+  } else {
+    image = render_mesh(f, input, log);
   }
   Stage stage(log, "write");
   write_png(f.output, image);
@@ -140,7 +165,9 @@ void run_render(RenderFlags& f, const Log& log) {
 void add_render_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("render", "A PNG picture of a curvature field on the mesh");
   auto f = std::make_shared<RenderFlags>();
-  cmd->add_option("input", f->input, "mesh file (.obj .ply .off .stl)")->required();
+  cmd->add_option("input", f->input,
+                  "mesh file (.obj .ply .off .stl) or point cloud (no faces; drawn as splats)")
+      ->required();
   cmd->add_option("-o,--output", f->output, "OUT.png")->required();
   cmd->add_option("--field", f->field, "the field to colour by: H, K, k1, k2 or class")
       ->check(CLI::IsMember({"H", "K", "k1", "k2", "class"}))
@@ -158,6 +185,11 @@ void add_render_command(CLI::App& app, const Log& log) {
   cmd->add_flag("--focal-meshes", f->focal_meshes,
                 "two more panels: the focal meshes Gamma_1 and Gamma_2, same camera and colours");
   cmd->add_flag("--orthographic", f->orthographic, "orthographic instead of perspective view");
+  cmd->add_option("--splat-radius", f->picture.splat_radius,
+                  "point clouds: radius of each point's disc (0 = 0.7 x the mean distance to its "
+                  "8 nearest)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--title", f->title, "title above the picture (default: file name and field)");
   f->estimator.add_to(*cmd);
   cmd->footer(

@@ -8,6 +8,7 @@
 
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
+#include "focal/surfaces/cloud_samples.h"
 #include "test_clouds.h"
 
 namespace focal {
@@ -54,6 +55,36 @@ TEST(OrientNormals, NoFlippedNormalOnClosedSurfaces) {
         EXPECT_EQ(flipped(pca, s.mesh.N), 0) << surface_name(kind) << " n=" << n;
         const RowMatrixX3d jet = cloud_normals(s.mesh.V, nb);
         EXPECT_EQ(flipped(jet, s.mesh.N), 0) << surface_name(kind) << " n=" << n;
+      }
+    }
+  }
+}
+
+// No flipped component on any analytic surface, clean, with position noise 0.1 and with 2%
+// outliers, seeds 1 and 2 (3000 points, k = 16, no outlier test). Before the extreme-point vote
+// the MST seeded at the highest point (an outlier, or a cylinder rim point with a horizontal
+// normal) turned 5 of these 48 clouds inside out (cylinder seed 1 noisy and with outliers,
+// ellipsoid, cylinder and saddle seed 2 with outliers); after it at most 1 point is flipped
+// (cylinder seed 2 with outliers). Asserted: under 1% of the points with truth.
+TEST(OrientNormals, NoFlippedComponentWithNoiseOrOutliers) {
+  for (SurfaceKind kind : {SurfaceKind::sphere, SurfaceKind::ellipsoid, SurfaceKind::torus,
+                           SurfaceKind::cylinder, SurfaceKind::saddle, SurfaceKind::monkey_saddle,
+                           SurfaceKind::helix_tube, SurfaceKind::pear}) {
+    for (std::uint64_t seed : {1, 2}) {
+      for (int c = 0; c < 3; ++c) {
+        const AnalyticSurface s =
+            sample_cloud({.surface = {.kind = kind, .target_vertices = 3000, .seed = seed},
+                          .position_noise = c == 1 ? 0.1 : 0.0,
+                          .outliers = c == 2 ? 0.02 : 0.0,
+                          .normals = true});  // the truth; not used
+        const RowMatrixX3d N = cloud_normals(s.mesh.V, nearest_neighbours(s.mesh.V, 16));
+        int bad = 0, scored = 0;
+        for (Eigen::Index i = 0; i < N.rows(); ++i) {
+          if (!std::isfinite(s.k1[i])) continue;  // an outlier
+          ++scored;
+          bad += N.row(i).dot(s.mesh.N.row(i)) < 0.0 ? 1 : 0;
+        }
+        EXPECT_LT(bad, scored / 100) << surface_name(kind) << " seed " << seed << " case " << c;
       }
     }
   }

@@ -103,6 +103,63 @@ TEST(RadiusNeighbours, MatchBruteForceAndLimit) {
   expect_lists(radius_neighbours(grid, 1.0, 0, 2), grid, 0, 1.0);
 }
 
+// Each point's list is exactly the brute-force list within its own radius, scale x the median
+// over the point and its k nearest of their k-th distances; the same for any thread count.
+TEST(AdaptiveRadiusNeighbours, MatchBruteForceWithTheLocalRadius) {
+  const RowMatrixX3d V = random_cloud(1500, 12);
+  const int k = 10;
+  const double scale = 1.2;
+  const Neighbourhoods knn = nearest_neighbours(V, k, 1);
+  std::vector<double> reach(static_cast<std::size_t>(V.rows()));
+  for (int i = 0; i < V.rows(); ++i) reach[i] = (V.row(*(knn.end(i) - 1)) - V.row(i)).norm();
+  const Neighbourhoods nb = adaptive_radius_neighbours(V, k, scale, 0, {}, 1);
+  for (int i = 0; i < V.rows(); ++i) {
+    std::vector<double> around{reach[i]};
+    for (const int* j = knn.begin(i); j != knn.end(i); ++j) around.push_back(reach[*j]);
+    std::sort(around.begin(), around.end());
+    const double radius = scale * around[around.size() / 2];
+    const std::vector<int> got(nb.begin(i), nb.end(i));
+    ASSERT_EQ(got, brute_force(V, i, 0, radius)) << "point " << i;
+  }
+  const Neighbourhoods two = adaptive_radius_neighbours(V, k, scale, 0, {}, 2);
+  EXPECT_EQ(two.offsets, nb.offsets);
+  EXPECT_EQ(two.indices, nb.indices);
+}
+
+// On a cloud whose density falls 10-fold along x, a fixed radius gives the dense end 10x the
+// neighbours of the sparse end; the adaptive radius gives both about the same count.
+TEST(AdaptiveRadiusNeighbours, FollowTheDensity) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  RowMatrixX3d V(20000, 3);
+  for (int i = 0; i < V.rows(); ++i) {
+    // Density proportional to 1 - 0.9 x on [0, 1]: inverse transform sampling.
+    const double t = u(rng);
+    const double x = (1.0 - std::sqrt(1.0 - 1.8 * t + 0.81 * t)) / 0.9;
+    V.row(i) << x, u(rng), 0.0;
+  }
+  const auto mean_count = [&](const Neighbourhoods& nb, double lo, double hi) {
+    double sum = 0.0;
+    int n = 0;
+    for (int i = 0; i < V.rows(); ++i) {
+      if (V(i, 0) < lo || V(i, 0) > hi || V(i, 1) < 0.1 || V(i, 1) > 0.9) continue;
+      sum += nb.size(i);
+      ++n;
+    }
+    return sum / n;
+  };
+  const Neighbourhoods fixed = radius_neighbours(V, 0.02, 0);
+  const Neighbourhoods adaptive = adaptive_radius_neighbours(V, 16, 1.0, 0);
+  const double fixed_ratio = mean_count(fixed, 0.05, 0.15) / mean_count(fixed, 0.85, 0.95);
+  const double adaptive_ratio = mean_count(adaptive, 0.05, 0.15) / mean_count(adaptive, 0.85, 0.95);
+  EXPECT_GT(fixed_ratio, 3.0);
+  EXPECT_NEAR(adaptive_ratio, 1.0, 0.2);
+  EXPECT_THROW((void)adaptive_radius_neighbours(V, 16, 0.0, 0), InvalidInput);
+  EXPECT_THROW((void)adaptive_radius_neighbours(V, 16, NAN, 0), InvalidInput);
+  EXPECT_THROW((void)adaptive_radius_neighbours(V, 0, 1.0, 0), InvalidInput);
+  EXPECT_THROW((void)adaptive_radius_neighbours(V, 16, 1.0, -1), InvalidInput);
+}
+
 TEST(Neighbours, MeanSpacingOfALattice) {
   const RowMatrixX3d grid = lattice() * 0.5;
   EXPECT_DOUBLE_EQ(mean_spacing(grid, nearest_neighbours(grid, 3)), 0.5);

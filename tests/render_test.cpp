@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -425,6 +426,126 @@ TEST(Picture, BadArgumentsAreInvalidInput) {
   o = {};
   o.directions = RowMatrixX3d::Zero(2, 3);
   EXPECT_THROW((void)render_field_picture(plane.V, plane.F, plane.N, f, o), InvalidInput);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Point clouds: splats
+
+namespace {
+
+/// n points on the unit sphere (Fibonacci spiral: near-uniform spacing); normals = positions.
+RowMatrixX3d fibonacci_sphere(int n) {
+  RowMatrixX3d V(n, 3);
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n;
+    const double r = std::sqrt(1.0 - z * z);
+    V.row(i) << r * std::cos(golden * i), z, r * std::sin(golden * i);
+  }
+  return V;
+}
+
+}  // namespace
+
+// The cloud, seen head-on by an orthographic camera, covers the disc the sphere projects to and
+// nothing outside it: no gaps between splats, none reaching out (oriented discs tangent to the
+// sphere stay within 1 + r^2/2 of the centre). Without normals the discs face the eye and may
+// reach out by their radius (0.7 x 1.18 x spacing = 3 pixels here): margin 5.
+TEST(Picture, CloudSplatsCoverTheSphereAndNothingElse) {
+  const RowMatrixX3d V = fibonacci_sphere(20000);
+  const RowMatrixX3i no_faces(0, 3);
+  FieldPictureOptions o;
+  o.width = 400;
+  o.height = 300;
+  o.view.projection = Projection::orthographic;
+  o.range = ColourRange{-2.0, 2.0};
+  const Eigen::VectorXd field = Eigen::VectorXd::Constant(V.rows(), 1.0);
+  const double R = silhouette_radius_pixels(fit_camera(V, o.view), 1.0, o.height);
+  const Rgb expected = map_colour(ColourMap::diverging, 1.0, *o.range);
+  for (const bool with_normals : {true, false}) {
+    SCOPED_TRACE(with_normals ? "normals" : "no normals");
+    const RowMatrixX3d N =
+        with_normals
+            ? V
+            : RowMatrixX3d::Constant(V.rows(), 3, std::numeric_limits<double>::quiet_NaN());
+    const Image im = render_field_picture(V, no_faces, N, field, o);
+    const auto [left, right] = first_run(im, o.height / 2);
+    ASSERT_LT(left, right);
+    EXPECT_NEAR(right - left + 1, 2.0 * R, with_normals ? 3.0 : 10.0);
+    const double cx = (left + right + 1) / 2.0, cy = o.height / 2.0;
+    const double outer = with_normals ? 2.0 : 5.0;
+    int inside = 0, holes = 0, stray = 0;
+    for (int y = 0; y < o.height; ++y) {
+      for (int x = 0; x < right + 20; ++x) {
+        const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
+        const bool covered = im.pixel(x, y) != kWhite;
+        if (d < R - 2.0) {
+          ++inside;
+          holes += covered ? 0 : 1;
+        } else if (d > R + outer) {
+          stray += covered ? 1 : 0;
+        }
+      }
+    }
+    EXPECT_GT(inside, 50000);
+    EXPECT_EQ(holes, 0);
+    EXPECT_EQ(stray, 0);
+    // The point facing the eye is fully lit and has the map's colour.
+    const Rgb centre = im.pixel(static_cast<int>(cx), static_cast<int>(cy));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre[c], expected[c], 3.0);
+  }
+}
+
+// Splats are depth-tested: a plane of red points in front of a plane of blue points hides it.
+TEST(Picture, CloudSplatsAreDepthTested) {
+  const int n = 60;
+  RowMatrixX3d V(2 * n * n, 3);
+  Eigen::VectorXd field(V.rows());
+  for (int layer = 0; layer < 2; ++layer) {
+    for (int i = 0; i < n * n; ++i) {
+      const int row = layer * n * n + i;
+      // The far (blue) layer first in the arrays, so that drawing order alone would show it.
+      V.row(row) << (i % n) / double(n - 1), (i / n) / double(n - 1), layer == 0 ? -0.5 : 0.0;
+      field[row] = layer == 0 ? -1.0 : 1.0;
+    }
+  }
+  const RowMatrixX3d N =
+      RowMatrixX3d::Constant(V.rows(), 3, 0.0).rowwise() + Eigen::RowVector3d(0.0, 0.0, 1.0);
+  FieldPictureOptions o = head_on_plane_options();
+  o.range = ColourRange{-1.0, 1.0};
+  const Image im = render_field_picture(V, RowMatrixX3i(0, 3), N, field, o);
+  const auto [left, right] = first_run(im, o.height / 2);
+  ASSERT_LT(left, right);
+  const Rgb red = map_colour(ColourMap::diverging, 1.0, *o.range);
+  EXPECT_EQ(im.pixel((left + right) / 2, o.height / 2), red);
+}
+
+TEST(Picture, CloudFocalPointsGlyphsAndBadSplatRadius) {
+  const RowMatrixX3d V = fibonacci_sphere(2000);
+  const RowMatrixX3i no_faces(0, 3);
+  CurvatureResult c;
+  c.k1 = c.k2 = c.H = c.K = Eigen::VectorXd::Ones(V.rows());
+  c.d1 = c.d2 = RowMatrixX3d::Zero(V.rows(), 3);
+  c.d1.col(1).setOnes();
+  c.residual = Eigen::VectorXd::Zero(V.rows());
+  c.point_class = VectorXu8::Constant(V.rows(), 3);
+  FieldPictureOptions o;
+  o.width = 600;
+  o.height = 200;
+  o.directions = c.d1;
+  o.focal_meshes = focal_meshes(V, no_faces, V, c);
+  const Image im = render_field_picture(V, no_faces, V, c.H, o);
+  EXPECT_EQ(im.width, 600);
+  EXPECT_EQ(im.height, 200);
+  o = {};
+  o.splat_radius = -1.0;
+  EXPECT_THROW((void)render_field_picture(V, no_faces, V, c.H, o), InvalidInput);
+  o.splat_radius = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)render_field_picture(V, no_faces, V, c.H, o), InvalidInput);
+  o.splat_radius = 0.05;
+  EXPECT_THROW((void)render_field_picture(V, no_faces, V.topRows(5), c.H, o), InvalidInput);
+  const Image fixed = render_field_picture(V, no_faces, V, c.H, o);
+  EXPECT_EQ(fixed.width, o.width);
 }
 
 // ---------------------------------------------------------------------------------------------

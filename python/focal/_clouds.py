@@ -17,14 +17,25 @@ from . import Curvature, InvalidInputError, _as_rows, _shape_error, _threads
 from . import _focal_ext as _ext
 
 
-def _cloud_arguments(points: Any, k: int, radius: Optional[float], threads: Optional[int]):
+def _cloud_arguments(
+    points: Any,
+    k: int,
+    radius: Optional[float],
+    adaptive_radius: Optional[float],
+    threads: Optional[int],
+):
     P = _as_rows(points, "points", np.float64)
     if int(k) < 0:
         raise InvalidInputError(f"k must be >= 0 (0: the default), got {k}")
     r = 0.0 if radius is None else float(radius)
     if radius is not None and not r > 0.0:
         raise InvalidInputError(f"radius must be None or > 0, got {radius}")
-    return P, int(k), r, _threads(threads)
+    a = 0.0 if adaptive_radius is None else float(adaptive_radius)
+    if adaptive_radius is not None and not (a > 0.0 and np.isfinite(a)):
+        raise InvalidInputError(
+            f"adaptive_radius must be None or finite and > 0, got {adaptive_radius}"
+        )
+    return P, int(k), r, a, _threads(threads)
 
 
 def _viewpoint(viewpoint: Optional[Sequence[float]]):
@@ -37,6 +48,7 @@ def cloud_curvature(
     *,
     k: int = 16,
     radius: Optional[float] = None,
+    adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
     solver: str = "closed-form",
@@ -53,6 +65,8 @@ def cloud_curvature(
         quadratic jet; ``normal_method="pca"`` stops after PCA).
     k : neighbours per point (the k nearest; 0 = the library default, 16). radius : the
         neighbours within this distance instead (at most 1024, the nearest).
+    adaptive_radius : c: the neighbours within c times the local spacing instead (the median,
+        over the point and its k nearest, of their distances to their k-th nearest; docs/POINTS.md).
     viewpoint : (x, y, z) the scanner position: estimated normals face it.
     solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
     outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
@@ -67,14 +81,14 @@ def cloud_curvature(
     outward normals has k1 = k2 = +1/r. NaN and ``undefined`` where a point has no normal or
     fewer than two usable neighbours.
     """
-    P, k, r, t = _cloud_arguments(points, k, radius, threads)
+    P, k, r, a, t = _cloud_arguments(points, k, radius, adaptive_radius, threads)
     N = None
     if normals is not None:
         N = _as_rows(normals, "normals", np.float64)
         if N.shape[0] != P.shape[0]:
             raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
     d = _ext.cloud_curvature(
-        P, N, k, r, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio), t
+        P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio), t
     )
     return Curvature(**d)
 
@@ -84,6 +98,7 @@ def cloud_normals(
     *,
     k: int = 16,
     radius: Optional[float] = None,
+    adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
     threads: Optional[int] = None,
@@ -91,5 +106,5 @@ def cloud_normals(
     """(n, 3) unit normals of a point cloud, estimated and consistently oriented (as
     cloud_curvature estimates them; include/focal/normals/cloud_normals.h). NaN rows where a
     point has fewer than two neighbours."""
-    P, k, r, t = _cloud_arguments(points, k, radius, threads)
-    return _ext.cloud_normals(P, k, r, normal_method, _viewpoint(viewpoint), t)
+    P, k, r, a, t = _cloud_arguments(points, k, radius, adaptive_radius, threads)
+    return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), t)

@@ -26,12 +26,14 @@ namespace {
 
 using namespace nb::literals;
 
-focal::CloudOptions cloud_options(int k, double radius, const std::string& normal_method,
+focal::CloudOptions cloud_options(int k, double radius, double adaptive_radius,
+                                  const std::string& normal_method,
                                   const std::optional<std::vector<double>>& viewpoint,
                                   const std::string& solver, int threads) {
   focal::CloudOptions o;
   o.k = k;
   o.radius = radius;
+  o.adaptive_radius = adaptive_radius;
   o.threads = threads;
   if (normal_method == "jet") {
     o.normals.method = focal::CloudNormalMethod::jet;
@@ -56,10 +58,11 @@ focal::CloudOptions cloud_options(int k, double radius, const std::string& norma
 }
 
 nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N, int k,
-                         double radius, const std::string& normal_method,
+                         double radius, double adaptive_radius, const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint,
                          const std::string& solver, double outlier_ratio, int threads) {
-  focal::CloudOptions o = cloud_options(k, radius, normal_method, viewpoint, solver, threads);
+  focal::CloudOptions o =
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver, threads);
   o.outlier_ratio = outlier_ratio;
   focal::CloudCurvature c;
   {
@@ -72,11 +75,11 @@ nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N
   return d;
 }
 
-nb::object cloud_normals(const DoubleRows& V, int k, double radius,
+nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adaptive_radius,
                          const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint, int threads) {
   const focal::CloudOptions o =
-      cloud_options(k, radius, normal_method, viewpoint, "closed-form", threads);
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, "closed-form", threads);
   focal::RowMatrixX3d N;
   {
     nb::gil_scoped_release release;
@@ -91,10 +94,10 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius,
 
 void bind_clouds(nb::module_& m) {
   m.def("cloud_curvature", &cloud_curvature, "V"_a.noconvert(), "N"_a.none().noconvert(), "k"_a,
-        "radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a, "outlier_ratio"_a,
-        "threads"_a);
-  m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "normal_method"_a,
-        "viewpoint"_a.none(), "threads"_a);
+        "radius"_a, "adaptive_radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a,
+        "outlier_ratio"_a, "threads"_a);
+  m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "adaptive_radius"_a,
+        "normal_method"_a, "viewpoint"_a.none(), "threads"_a);
 }
 
 }  // namespace focal_python

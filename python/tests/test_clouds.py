@@ -83,3 +83,15 @@ def test_read_mesh_of_a_cloud_has_no_faces(tmp_path):
     np.testing.assert_allclose(mesh.V, P, rtol=1e-15)
     c = focal.cloud_curvature(mesh.V, mesh.N)
     np.testing.assert_allclose(c.H, 0.5, atol=1e-9)
+
+
+def test_adaptive_radius():
+    P, N = sphere_points(n=2000, seed=6)
+    c = focal.cloud_curvature(P, N, adaptive_radius=1.2)
+    np.testing.assert_allclose(c.H, 0.5, atol=1e-12)  # exact normals: exact, as with k
+    n = focal.cloud_normals(P, adaptive_radius=1.2)
+    assert (np.einsum("ij,ij->i", n, N) > 0.9).all()
+    with pytest.raises(focal.InvalidInputError, match="adaptive_radius"):
+        focal.cloud_curvature(P, adaptive_radius=-1.0)
+    with pytest.raises(focal.InvalidInputError, match="adaptive_radius"):
+        focal.cloud_normals(P, adaptive_radius=float("nan"))

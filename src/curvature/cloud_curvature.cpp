@@ -31,9 +31,17 @@ constexpr int kNoisyNeighbourFactor = 4;
 /// this many times the noise.
 constexpr double kFileAgreement = 2.5;
 
+/// The default's plan runs when no neighbourhood is given.
+bool uses_plan(const CloudOptions& o) {
+  return o.k == 0 && o.radius == 0.0 && o.adaptive_radius == 0.0;
+}
+
 void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o) {
   if (o.k < 0) throw InvalidInput("cloud curvature: k must be >= 0, got " + std::to_string(o.k));
   if (!(o.radius >= 0.0)) throw InvalidInput("cloud curvature: radius must be >= 0");
+  if (!(o.adaptive_radius >= 0.0) || !std::isfinite(o.adaptive_radius)) {
+    throw InvalidInput("cloud curvature: adaptive_radius must be finite and >= 0");
+  }
   if (o.threads < 0) throw InvalidInput("cloud curvature: threads must be >= 0");
   if (!(o.outlier_ratio == 0.0 || (o.outlier_ratio > 1.0 && std::isfinite(o.outlier_ratio)))) {
     throw InvalidInput("cloud curvature: outlier_ratio must be 0 (off) or finite and > 1, got " +
@@ -55,6 +63,10 @@ Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& option
     return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, excluded, options.threads);
   }
   const int k = options.k > 0 ? options.k : default_cloud_neighbours;
+  if (options.adaptive_radius > 0.0) {
+    return adaptive_radius_neighbours(V, k, options.adaptive_radius, kMaxRadiusNeighbours, excluded,
+                                      options.threads);
+  }
   return nearest_neighbours(V, k, excluded, options.threads);
 }
 
@@ -72,7 +84,8 @@ CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
   if (options.outlier_ratio > 0.0) {
     // The test is over the 16 nearest (where its ratio was measured): the lists at hand when
     // they are those, else a query of their own.
-    const bool sixteen = options.radius == 0.0 && options.k == default_cloud_neighbours;
+    const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
+                         options.k == default_cloud_neighbours;
     out.outlier = outlier_points(
         V,
         sixteen ? out.neighbours : nearest_neighbours(V, default_cloud_neighbours, options.threads),
@@ -82,7 +95,7 @@ CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
     }
   }
   out.spacing = mean_spacing(V, out.neighbours);
-  out.k = options.radius > 0.0 ? 0 : options.k;
+  out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
   out.file_normals_used = N.has_value();
   out.normals_estimated = !N;
   out.N = N ? RowMatrixX3d(*N) : cloud_normals(V, out.neighbours, normal_options(options));
@@ -153,8 +166,8 @@ Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options)
 CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
                                         const CloudOptions& options) {
   validate(V, N, options);
-  CloudCurvature out = options.k == 0 && options.radius == 0.0 ? adaptive_plan(V, N, options)
-                                                               : given_neighbours(V, N, options);
+  CloudCurvature out =
+      uses_plan(options) ? adaptive_plan(V, N, options) : given_neighbours(V, N, options);
   std::vector<char> ok;
   out.N = detail::unit_rows(out.N, ok, options.threads);
   CurvatureOptions fit;
@@ -169,7 +182,7 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
   const double scale = out.spacing > 0.0 ? out.spacing : 1.0;
   const detail::VertexFitInput input{V, out.N, ok, out.neighbours, scale};
   out.curvature = detail::fit_vertices(input, fit);
-  if (options.k == 0 && options.radius == 0.0) {
+  if (uses_plan(options)) {
     // The default, as the mesh default on noisy positions: where rays lie far off the fit
     // (a neighbour off the surface, or with a normal bent by one), it is repeated without them
     // (curvature/robust_fit.h; clean fits keep every ray, bit for bit).

@@ -20,6 +20,12 @@
 namespace focal {
 namespace {
 
+// The extreme-point vote of orient_normals_mst: the share of a component's points that vote per
+// direction (at most kExtremeMost), and how decisive the vote must be to overrule the seed.
+constexpr double kExtremeShare = 0.01;
+constexpr double kExtremeMost = 50.0;
+constexpr double kDecisiveVote = 0.5;
+
 void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* what) {
   if (neighbours.vertex_count() != V.rows()) {
     throw InvalidInput(std::string(what) + ": the neighbourhoods have " +
@@ -60,6 +66,43 @@ Neighbourhoods symmetric(const Neighbourhoods& nb) {
   }
   out.indices = Eigen::Map<const Eigen::VectorXi>(both.data(), static_cast<Eigen::Index>(kept));
   return out;
+}
+
+/// The extreme points' vote on a component's side (see orient_normals_mst): for each of the six
+/// axis directions d, the `count` points of `members` farthest along d (ties by index) add
+/// n . d. Returns (sum, sum of |n . d|).
+std::pair<double, double> extreme_vote(PositionsRef V, const RowMatrixX3d& N,
+                                       std::vector<int> members, std::size_t count) {
+  double vote = 0.0, weight = 0.0;
+  count = std::min(count, members.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {1.0, -1.0}) {
+      const auto farther = [&](int a, int b) {
+        const double ta = sign * V(a, axis), tb = sign * V(b, axis);
+        return ta > tb || (ta == tb && a < b);
+      };
+      std::nth_element(members.begin(), members.begin() + static_cast<std::ptrdiff_t>(count) - 1,
+                       members.end(), farther);
+      for (std::size_t k = 0; k < count; ++k) {
+        const double t = sign * N(members[k], axis);
+        vote += t;
+        weight += std::abs(t);
+      }
+    }
+  }
+  return {vote, weight};
+}
+
+/// The z components of the normals of the `count` highest points of `members` (ties by index).
+double highest_vote(PositionsRef V, const RowMatrixX3d& N, std::vector<int> members,
+                    std::size_t count) {
+  count = std::min(count, members.size());
+  std::nth_element(
+      members.begin(), members.begin() + static_cast<std::ptrdiff_t>(count) - 1, members.end(),
+      [&](int a, int b) { return V(a, 2) > V(b, 2) || (V(a, 2) == V(b, 2) && a < b); });
+  double vote = 0.0;
+  for (std::size_t k = 0; k < count; ++k) vote += N(members[k], 2);
+  return vote;
 }
 
 }  // namespace
@@ -113,9 +156,10 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
   std::vector<std::pair<double, int>> best(static_cast<std::size_t>(n),
                                            {std::numeric_limits<double>::infinity(), -1});
   int components = 0;
+  std::vector<int> component(static_cast<std::size_t>(n), -1);
   for (const int seed : order) {
     if (done[static_cast<std::size_t>(seed)] || !usable[seed]) continue;
-    ++components;
+    const int label = components++;
     if (N(seed, 2) < 0.0) N.row(seed) *= -1.0;
     heap.emplace(0.0, seed, seed);
     while (!heap.empty()) {
@@ -123,6 +167,7 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
       heap.pop();
       if (done[static_cast<std::size_t>(i)]) continue;
       done[static_cast<std::size_t>(i)] = 1;
+      component[static_cast<std::size_t>(i)] = label;
       if (N.row(i).dot(N.row(parent)) < 0.0) N.row(i) *= -1.0;
       for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
         if (done[static_cast<std::size_t>(*j)] || !usable[*j]) continue;
@@ -131,6 +176,23 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
         best[*j] = offer;
         heap.emplace(offer.first, *j, i);
       }
+    }
+  }
+  // The side of each component: the seed alone (its highest point) may be an outlier or a
+  // point whose normal is nearly horizontal, so the extreme points vote (see the header).
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(components));
+  for (int i = 0; i < n; ++i) {
+    if (component[i] >= 0) members[static_cast<std::size_t>(component[i])].push_back(i);
+  }
+  for (const std::vector<int>& m : members) {
+    const auto count = static_cast<std::size_t>(
+        std::clamp(std::ceil(kExtremeShare * static_cast<double>(m.size())), 1.0, kExtremeMost));
+    const auto [vote, weight] = extreme_vote(V, N, m, count);
+    // Not decisive (an open, symmetric surface): the highest points vote on +z instead.
+    const bool flip =
+        std::abs(vote) > kDecisiveVote * weight ? vote < 0.0 : highest_vote(V, N, m, count) < 0.0;
+    if (flip) {
+      for (const int i : m) N.row(i) *= -1.0;
     }
   }
   return components;

@@ -207,6 +207,27 @@ class NearestQuery {
   std::vector<Candidate> candidates_;
 };
 
+/// Every other point within radius_of(row) of each point (none where that is not > 0), at most
+/// max_count (0 = no limit), the nearest, sorted: radius_neighbours and the adaptive ones.
+template <class RadiusOf>
+Neighbourhoods within_radii(PositionsRef V, const std::vector<char>& excluded, int max_count,
+                            int threads, const RadiusOf& radius_of) {
+  const PointTree tree(V, excluded);
+  const std::size_t limit =
+      max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
+  return gather(V.rows(), tree, threads,
+                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
+                  c.clear();
+                  const int row = tree.row(static_cast<std::uint32_t>(p));
+                  const double r = radius_of(row);
+                  if (r > 0.0) tree.within(tree.point(p), r * r, c);
+                  keep_sorted(
+                      c, row,
+                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
+                      out);
+                });
+}
+
 }  // namespace
 
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
@@ -252,18 +273,39 @@ Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
   check_threads(threads);
-  const PointTree tree(V, excluded);
-  const std::size_t limit =
-      max_count > 0 ? static_cast<std::size_t>(max_count) : std::numeric_limits<std::size_t>::max();
-  return gather(V.rows(), tree, threads,
-                [&](std::size_t p, std::vector<Candidate>& c, std::vector<int>& out) {
-                  c.clear();
-                  tree.within(tree.point(p), radius * radius, c);
-                  keep_sorted(
-                      c, tree.row(static_cast<std::uint32_t>(p)),
-                      limit == std::numeric_limits<std::size_t>::max() ? limit : limit + out.size(),
-                      out);
-                });
+  return within_radii(V, excluded, max_count, threads, [radius](int) { return radius; });
+}
+
+Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, int max_count,
+                                          const std::vector<char>& excluded, int threads) {
+  if (!(scale > 0.0) || !std::isfinite(scale)) {
+    throw InvalidInput("neighbours: the adaptive radius scale must be finite and > 0, got " +
+                       std::to_string(scale));
+  }
+  if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
+  const Neighbourhoods knn = nearest_neighbours(V, k, excluded, threads);
+  const int n = knn.vertex_count();
+  std::vector<double> reach(static_cast<std::size_t>(n), NAN);  // to the k-th nearest
+  for (int i = 0; i < n; ++i) {
+    if (knn.size(i) > 0)
+      reach[static_cast<std::size_t>(i)] = (V.row(*(knn.end(i) - 1)) - V.row(i)).norm();
+  }
+  std::vector<double> radius(static_cast<std::size_t>(n), 0.0);
+  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<double> around;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const int p = static_cast<int>(i);
+      if (knn.size(p) == 0) continue;
+      around.assign(1, reach[static_cast<std::size_t>(p)]);
+      for (const int* j = knn.begin(p); j != knn.end(p); ++j)
+        around.push_back(reach[static_cast<std::size_t>(*j)]);
+      const auto middle = around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2);
+      std::nth_element(around.begin(), middle, around.end());
+      radius[static_cast<std::size_t>(i)] = scale * *middle;
+    }
+  });
+  return within_radii(V, excluded, max_count, threads,
+                      [&radius](int row) { return radius[static_cast<std::size_t>(row)]; });
 }
 
 std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,

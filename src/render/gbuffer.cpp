@@ -130,7 +130,8 @@ GBuffer rasterise_gbuffer(PositionsRef V, FacesRef F, NormalsRef N, const Camera
                      view_projection.data());
   const GLsizei count = render_detail::upload_mesh({.position = render_detail::to_floats(V),
                                                     .normal = render_detail::to_floats(N),
-                                                    .colour = {}},
+                                                    .colour = {},
+                                                    .size = {}},
                                                    render_detail::drawable_faces(V, F, N));
   glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
   require_no_gl_error("drawing the G-buffer");

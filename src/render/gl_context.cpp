@@ -205,7 +205,8 @@ std::string GlContext::description() const {
          text(GL_RENDERER);
 }
 
-GLuint build_program(const char* vertex_source, const char* fragment_source) {
+GLuint build_program(const char* vertex_source, const char* fragment_source,
+                     const char* geometry_source) {
   const auto compile = [](GLenum type, const char* source) {
     const GLuint shader = glCreateShader(type);
     glShaderSource(shader, 1, &source, nullptr);
@@ -222,6 +223,8 @@ GLuint build_program(const char* vertex_source, const char* fragment_source) {
   const GLuint program = glCreateProgram();
   glAttachShader(program, compile(GL_VERTEX_SHADER, vertex_source));
   glAttachShader(program, compile(GL_FRAGMENT_SHADER, fragment_source));
+  if (geometry_source != nullptr)
+    glAttachShader(program, compile(GL_GEOMETRY_SHADER, geometry_source));
   glLinkProgram(program);
   GLint ok = 0;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);

@@ -34,7 +34,8 @@ class GlContext {
 };
 
 /// Compiles and links a GLSL program. \throw RenderError with the driver's log.
-[[nodiscard]] GLuint build_program(const char* vertex_source, const char* fragment_source);
+[[nodiscard]] GLuint build_program(const char* vertex_source, const char* fragment_source,
+                                   const char* geometry_source = nullptr);
 
 /// \throw RenderError naming `what` unless the bound draw framebuffer is complete.
 void require_complete_framebuffer(const char* what);

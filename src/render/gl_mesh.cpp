@@ -7,7 +7,7 @@ bool finite_row(const Eigen::Ref<const RowMatrixX3d>& rows, Eigen::Index i) {
   return rows.row(i).allFinite();
 }
 
-void upload_attribute(GLuint location, const std::vector<float>& values) {
+void upload_attribute(GLuint location, const std::vector<float>& values, GLint components = 3) {
   if (values.empty()) return;
   GLuint buffer = 0;
   glGenBuffers(1, &buffer);
@@ -15,7 +15,7 @@ void upload_attribute(GLuint location, const std::vector<float>& values) {
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(values.size() * sizeof(float)),
                values.data(), GL_STATIC_DRAW);
   glEnableVertexAttribArray(location);
-  glVertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glVertexAttribPointer(location, components, GL_FLOAT, GL_FALSE, 0, nullptr);
 }
 
 }  // namespace
@@ -50,6 +50,7 @@ GLsizei upload_mesh(const VertexAttributes& attributes, const std::vector<GLuint
   upload_attribute(0, attributes.position);
   upload_attribute(1, attributes.normal);
   upload_attribute(2, attributes.colour);
+  upload_attribute(3, attributes.size, 1);
   GLuint index_buffer = 0;
   glGenBuffers(1, &index_buffer);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer);

@@ -9,12 +9,13 @@
 
 namespace focal::render_detail {
 
-/// Per-vertex attributes, 3 floats per vertex each; an empty array is left out. Locations:
-/// 0 position, 1 normal, 2 colour.
+/// Per-vertex attributes, 3 floats per vertex each (size: 1); an empty array is left out.
+/// Locations: 0 position, 1 normal, 2 colour, 3 size (the radius of a point's splat).
 struct VertexAttributes {
   std::vector<float> position;
   std::vector<float> normal;
   std::vector<float> colour;
+  std::vector<float> size;
 };
 
 /// Row-major float copy of an n x 3 array.

@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "render/bitmap_font.h"
 #include "focal/curvature/curvature.h"
+#include "focal/points/neighbours.h"
 #include "focal/render/render.h"
+#include "render/bitmap_font.h"
 #include "render/gl_context.h"
 #include "render/gl_mesh.h"
 
@@ -49,6 +50,7 @@ struct PanelContent {
   render_detail::VertexAttributes attributes;
   std::vector<GLuint> indices;
   bool flat_shading = false;  ///< face normals from the rasterised positions (no vertex normals)
+  bool splats = false;        ///< a point cloud: one disc per index (attributes.size its radius)
   std::vector<float> lines;   ///< pairs of 3D points
   std::string label;
 };
@@ -77,6 +79,11 @@ void check_options(PositionsRef V, FacesRef F, NormalsRef N,
     throw InvalidInput("render_field_picture: directions must have 0 or " + rows + " rows");
   }
   if (o.glyph_count < 1) throw InvalidInput("render_field_picture: glyph_count must be >= 1");
+  if (!(std::isfinite(o.splat_radius) && o.splat_radius >= 0.0)) {
+    throw InvalidInput(
+        "render_field_picture: splat_radius must be finite and >= 0 (0: from the "
+        "spacing)");
+  }
   if (o.focal_meshes) {
     for (const FocalMesh* g : {&o.focal_meshes->gamma1, &o.focal_meshes->gamma2}) {
       if (g->mesh.V.rows() != V.rows()) {
@@ -179,10 +186,93 @@ double surface_area(PositionsRef V, FacesRef F) {
   return area;
 }
 
+// --- point clouds ------------------------------------------------------------------------------
+
+/// Neighbours whose mean distance sets a splat's radius, and the radius relative to that mean.
+/// On a hexagonal sampling of spacing s the mean distance to the 8 nearest is 1.18 s; discs of
+/// radius 0.7 x 1.18 s = 0.83 s leave no gap on Poisson-disk samples (a disc radius of s / sqrt 3
+/// would just cover a perfect lattice).
+constexpr int kSplatNeighbours = 8;
+constexpr double kSplatRadiusPerMeanDistance = 0.7;
+
+/// Mean distance of each point to its 8 nearest (NaN for points with no neighbour).
+Eigen::VectorXd mean_neighbour_distances(PositionsRef V, int threads) {
+  Eigen::VectorXd mean =
+      Eigen::VectorXd::Constant(V.rows(), std::numeric_limits<double>::quiet_NaN());
+  const Neighbourhoods knn = nearest_neighbours(V, kSplatNeighbours, threads);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const auto begin = knn.offsets[i], end = knn.offsets[i + 1];
+    if (begin == end) continue;
+    double sum = 0.0;
+    for (auto k = begin; k < end; ++k) sum += (V.row(knn.indices[k]) - V.row(i)).norm();
+    mean[i] = sum / static_cast<double>(end - begin);
+  }
+  return mean;
+}
+
+/// Splat radius per point: `radius` for all, or (radius 0) 0.7 x the mean distance to the 8
+/// nearest; a point without neighbours gets 1% of the bounding box diagonal.
+std::vector<float> splat_radii(PositionsRef V, double radius, int threads) {
+  std::vector<float> out(static_cast<std::size_t>(V.rows()), static_cast<float>(radius));
+  if (radius > 0.0) return out;
+  const Eigen::VectorXd mean = mean_neighbour_distances(V, threads);
+  const double fallback = 0.01 * bounding_box_diagonal(V);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const double r =
+        std::isfinite(mean[i]) && mean[i] > 0.0 ? kSplatRadiusPerMeanDistance * mean[i] : fallback;
+    out[static_cast<std::size_t>(i)] = static_cast<float>(r);
+  }
+  return out;
+}
+
+/// Indices of the points that can be drawn: finite positions (a non-finite normal only turns
+/// the splat towards the eye).
+std::vector<GLuint> drawable_points(PositionsRef V) {
+  std::vector<GLuint> indices;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (V.row(i).allFinite()) indices.push_back(static_cast<GLuint>(i));
+  }
+  return indices;
+}
+
+/// Float normals with non-finite rows zeroed: the splat shader turns those towards the eye.
+std::vector<float> splat_normals(NormalsRef N, Eigen::Index count) {
+  std::vector<float> out(3 * static_cast<std::size_t>(count), 0.0f);
+  if (N.rows() != count) return out;
+  for (Eigen::Index i = 0; i < count; ++i) {
+    if (!N.row(i).allFinite()) continue;
+    for (int c = 0; c < 3; ++c)
+      out[3 * static_cast<std::size_t>(i) + c] = static_cast<float>(N(i, c));
+  }
+  return out;
+}
+
+/// A point cloud's panel: one disc per drawable point.
+PanelContent splat_panel(PositionsRef V, NormalsRef N, const std::vector<float>& colours,
+                         const FieldPictureOptions& o) {
+  PanelContent p;
+  p.attributes = {render_detail::to_floats(V), splat_normals(N, V.rows()), colours,
+                  splat_radii(V, o.splat_radius, o.threads)};
+  p.indices = drawable_points(V);
+  p.splats = true;
+  return p;
+}
+
+/// Area a cloud samples: each splat's share, (splat radius / 0.7 / 1.18)^2 x sqrt(3) / 2 (the
+/// cell of a hexagonal sampling of that spacing).
+double cloud_area(const std::vector<float>& radii) {
+  double area = 0.0;
+  for (float r : radii) {
+    const double s = r / (kSplatRadiusPerMeanDistance * 1.18);
+    area += s * s * std::sqrt(3.0) / 2.0;
+  }
+  return area;
+}
+
 /// Segments p -/+ h d through about `count` vertices, h 0.4 of the spacing between the chosen
 /// vertices (so that neighbouring glyphs do not touch), lifted off the surface by h / 4 along
 /// the normal so that curved surfaces do not hide them.
-std::vector<float> direction_glyphs(PositionsRef V, FacesRef F, NormalsRef N,
+std::vector<float> direction_glyphs(PositionsRef V, double area, NormalsRef N,
                                     const RowMatrixX3d& directions, int count) {
   std::vector<float> lines;
   if (directions.rows() == 0 || V.rows() == 0) return lines;
@@ -192,13 +282,13 @@ std::vector<float> direction_glyphs(PositionsRef V, FacesRef F, NormalsRef N,
   const std::uint64_t threshold = fraction >= 1.0
                                       ? std::numeric_limits<std::uint64_t>::max()
                                       : static_cast<std::uint64_t>(std::ldexp(fraction, 64));
-  const double spacing = std::sqrt(surface_area(V, F) / (fraction * static_cast<double>(V.rows())));
+  const double spacing = std::sqrt(area / (fraction * static_cast<double>(V.rows())));
   const double h = 0.4 * spacing;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (mix(static_cast<std::uint64_t>(i)) > threshold) continue;
     const Eigen::Vector3d p = V.row(i), n = N.row(i), d = directions.row(i);
     if (!p.allFinite() || !n.allFinite() || !d.allFinite() || d.norm() == 0.0) continue;
-    const Eigen::Vector3d centre = p + 0.25 * h * n.normalized();
+    const Eigen::Vector3d centre = p + 0.25 * h * (n.norm() > 0.0 ? n.normalized() : n);
     const Eigen::Vector3d half = h * d.normalized();
     for (const Eigen::Vector3d& end :
          {Eigen::Vector3d(centre - half), Eigen::Vector3d(centre + half)}) {
@@ -212,19 +302,31 @@ std::vector<PanelContent> panel_contents(PositionsRef V, FacesRef F, NormalsRef 
                                          const std::vector<float>& colours,
                                          const FieldPictureOptions& o) {
   std::vector<PanelContent> panels(1);
-  panels[0].attributes = {render_detail::to_floats(V), render_detail::to_floats(N), colours};
-  panels[0].indices = render_detail::drawable_faces(V, F, N);
-  panels[0].lines = direction_glyphs(V, F, N, o.directions, o.glyph_count);
+  if (F.rows() == 0) {
+    panels[0] = splat_panel(V, N, colours, o);
+    panels[0].lines =
+        direction_glyphs(V, cloud_area(panels[0].attributes.size), N, o.directions, o.glyph_count);
+  } else {
+    panels[0].attributes = {render_detail::to_floats(V), render_detail::to_floats(N), colours, {}};
+    panels[0].indices = render_detail::drawable_faces(V, F, N);
+    panels[0].lines = direction_glyphs(V, surface_area(V, F), N, o.directions, o.glyph_count);
+  }
   panels[0].label = "surface";
   if (!o.focal_meshes) return panels;
   const char* labels[] = {"focal mesh 1 (k1)", "focal mesh 2 (k2)"};
   int j = 0;
   for (const FocalMesh* g : {&o.focal_meshes->gamma1, &o.focal_meshes->gamma2}) {
     PanelContent p;
-    p.attributes = {render_detail::to_floats(g->mesh.V), {}, colours};
-    p.indices = render_detail::drawable_faces(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3));
-    p.flat_shading = true;
-    p.label = labels[j++];
+    if (g->mesh.F.rows() == 0) {  // the focal points of a cloud: splats facing the eye
+      p = splat_panel(g->mesh.V, RowMatrixX3d(0, 3), colours, o);
+      p.label = j == 0 ? "focal points 1 (k1)" : "focal points 2 (k2)";
+    } else {
+      p.attributes = {render_detail::to_floats(g->mesh.V), {}, colours, {}};
+      p.indices = render_detail::drawable_faces(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3));
+      p.flat_shading = true;
+    }
+    if (p.label.empty()) p.label = labels[j];
+    ++j;
     panels.push_back(std::move(p));
   }
   return panels;
@@ -269,6 +371,62 @@ void main() {
 }
 )";
 
+// Splats: each point becomes an octagon of its radius in the plane normal to its normal (or
+// facing the eye where it has none), drawn with the surface fragment shader and depth-tested.
+constexpr const char* kSplatVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 colour;
+layout(location = 3) in float radius;
+out vec3 point_position;
+out vec3 point_normal;
+out vec3 point_colour;
+out float point_radius;
+void main() {
+  point_position = position;
+  point_normal = normal;
+  point_colour = colour;
+  point_radius = radius;
+}
+)";
+
+constexpr const char* kSplatGeometryShader = R"(#version 330 core
+layout(points) in;
+layout(triangle_strip, max_vertices = 8) out;
+in vec3 point_position[];
+in vec3 point_normal[];
+in vec3 point_colour[];
+in float point_radius[];
+uniform mat4 view_projection;
+uniform vec3 eye;
+uniform vec3 towards_eye;
+uniform int orthographic;
+out vec3 world_position;
+out vec3 world_normal;
+out vec3 vertex_colour;
+void main() {
+  vec3 p = point_position[0];
+  vec3 n = point_normal[0];
+  if (!(dot(n, n) > 0.0)) n = orthographic != 0 ? towards_eye : eye - p;
+  n = normalize(n);
+  vec3 a = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+  vec3 u = normalize(cross(n, a));
+  vec3 w = cross(n, u);
+  // The octagon's corners in strip order: 0 1 7 2 6 3 5 4.
+  const int corner[8] = int[8](0, 1, 7, 2, 6, 3, 5, 4);
+  for (int k = 0; k < 8; ++k) {
+    float t = float(corner[k]) * 0.7853981634;
+    vec3 q = p + point_radius[0] * (cos(t) * u + sin(t) * w);
+    world_position = q;
+    world_normal = n;
+    vertex_colour = point_colour[0];
+    gl_Position = view_projection * vec4(q, 1.0);
+    EmitVertex();
+  }
+  EndPrimitive();
+}
+)";
+
 constexpr const char* kLineVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 uniform mat4 view_projection;
@@ -309,6 +467,7 @@ void set_vector(GLuint program, const char* name, const Eigen::Vector3d& v) {
 struct Programs {
   GLuint surface = 0;
   GLuint lines = 0;
+  GLuint splats = 0;
 };
 
 void draw_panel(const PanelContent& panel, const Rect& r, int picture_height, const Camera& camera,
@@ -317,20 +476,21 @@ void draw_panel(const PanelContent& panel, const Rect& r, int picture_height, co
   glViewport(r.x, picture_height - r.y - r.height, r.width, r.height);
   const Eigen::Matrix4f view_projection =
       view_projection_matrix(camera, static_cast<double>(r.width) / r.height).cast<float>();
-  glUseProgram(programs.surface);
-  glUniformMatrix4fv(glGetUniformLocation(programs.surface, "view_projection"), 1, GL_FALSE,
+  const GLuint program = panel.splats ? programs.splats : programs.surface;
+  glUseProgram(program);
+  glUniformMatrix4fv(glGetUniformLocation(program, "view_projection"), 1, GL_FALSE,
                      view_projection.data());
-  set_vector(programs.surface, "eye", camera.eye);
-  set_vector(programs.surface, "towards_eye", (camera.eye - camera.target).normalized());
-  glUniform1i(glGetUniformLocation(programs.surface, "orthographic"),
+  set_vector(program, "eye", camera.eye);
+  set_vector(program, "towards_eye", (camera.eye - camera.target).normalized());
+  glUniform1i(glGetUniformLocation(program, "orthographic"),
               camera.projection == Projection::orthographic);
-  glUniform1i(glGetUniformLocation(programs.surface, "flat_shading"), panel.flat_shading);
-  glUniform1f(glGetUniformLocation(programs.surface, "ambient"), kAmbient);
+  glUniform1i(glGetUniformLocation(program, "flat_shading"), panel.flat_shading);
+  glUniform1f(glGetUniformLocation(program, "ambient"), kAmbient);
   const GLsizei count = render_detail::upload_mesh(panel.attributes, panel.indices);
   // Surfaces are pushed back in depth so that glyphs lying on them win the depth test.
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(1.0f, 1.0f);
-  glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
+  glDrawElements(panel.splats ? GL_POINTS : GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
   glDisable(GL_POLYGON_OFFSET_FILL);
   if (panel.lines.empty()) return;
   glUseProgram(programs.lines);
@@ -366,7 +526,9 @@ Image render_panels(const std::vector<PanelContent>& panels, const Layout& layou
   glEnable(GL_SCISSOR_TEST);  // a panel's far-reaching focal points stay in their panel
   const Programs programs{
       render_detail::build_program(kSurfaceVertexShader, kSurfaceFragmentShader),
-      render_detail::build_program(kLineVertexShader, kLineFragmentShader)};
+      render_detail::build_program(kLineVertexShader, kLineFragmentShader),
+      render_detail::build_program(kSplatVertexShader, kSurfaceFragmentShader,
+                                   kSplatGeometryShader)};
   for (std::size_t p = 0; p < panels.size(); ++p) {
     const Rect& r = layout.panels[p];
     glScissor(r.x, o.height - r.y - r.height, r.width, r.height);

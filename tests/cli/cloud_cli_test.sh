@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Tests of the `focal` command on point clouds (files without faces): reading (.xyz text, PLY and
-# OBJ without faces), `info`, `curvature`, `focal-mesh`, `normals`, `generate --cloud`, and the
+# OBJ without faces), `info`, `curvature`, `focal-mesh`, `normals`, `render`, `generate --cloud`, and the
 # error contract (what, where, exit 2, no output written).
 #
 # Usage: cloud_cli_test.sh FOCAL_BINARY SCRATCH_DIR. Prints one line per check, then
@@ -50,6 +50,11 @@ run curvature sphere.xyz -o sphere.csv
 check "curvature on a cloud: exit 0, no warning" bash -c '[[ $1 -eq 0 && ! -s $2 ]]' _ "$rc" "$ERR"
 check "sphere cloud with exact normals: k1 = 1 to 1e-9" below "$(max_dev sphere.csv 1 1)" 1e-9
 check "sphere cloud with exact normals: k2 = 1 to 1e-9" below "$(max_dev sphere.csv 2 1)" 1e-9
+run curvature sphere.xyz -o adaptive.csv --adaptive-radius 1.2
+check "--adaptive-radius 1.2 with exact normals: H = 1 to 1e-9" below "$(max_dev adaptive.csv 3 1)" 1e-9
+expect_error "--adaptive-radius with --rings: applies to meshes" "applies to meshes" ar.csv curvature sphere.xyz -o ar.csv --adaptive-radius 1 --rings 2
+run curvature sphere.xyz -o ar0.csv --adaptive-radius 0
+check "--adaptive-radius 0: exit 1 (must be positive)" bash -c '[[ $1 -eq 1 && ! -e ar0.csv ]]' _ "$rc"
 
 # Without normals (estimated, MST-oriented), and the same points as PLY and OBJ without faces.
 cut -d' ' -f1-3 sphere.xyz >bare.xyz
@@ -92,7 +97,12 @@ expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two
 printf 'k1,k2,H\n1,2,3\n' >table.csv
 expect_error "a CSV whose header names no x, y, z: an error, not positions" "names no x, y, z" t.csv curvature table.csv -o t.csv
 expect_error "--rings on a cloud" "applies to meshes" r.csv curvature bare.xyz -o r.csv --rings 2
-expect_error "render on a cloud: not a mesh" "point cloud" r.png render bare.xyz -o r.png
+run render bare.xyz -o r.png --size 320x240 --field K --directions d1 --focal-meshes
+check "render on a cloud (splats, focal points, glyphs): exit 0 and a PNG" \
+  bash -c '[[ $1 -eq 0 && $(head -c 4 r.png | od -An -c | tr -d " ") == 211PNG ]]' _ "$rc"
+expect_error "render --rings on a cloud: applies to meshes" "applies to meshes" rr.png render bare.xyz -o rr.png --rings 2
+run render bare.xyz -o rs.png --splat-radius -1
+check "render --splat-radius -1: exit 1, nothing written" bash -c '[[ $1 -eq 1 && ! -e rs.png ]]' _ "$rc"
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

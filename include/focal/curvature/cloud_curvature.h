@@ -60,6 +60,10 @@ struct CloudOptions {
   /// > 0: the neighbours within this distance instead of the k nearest (at most 1024, the
   /// nearest).
   double radius = 0.0;
+  /// > 0 (with radius 0): neighbourhoods whose radius follows the local density, this many
+  /// times the smoothed distance to the k-th nearest (k, or 16 when k is 0; at most 1024
+  /// neighbours): adaptive_radius_neighbours. 0 = off.
+  double adaptive_radius = 0.0;
   /// How normals are estimated when the cloud has none (normals/cloud_normals.h).
   CloudNormalOptions normals{};
   Solver solver = Solver::closed_form;

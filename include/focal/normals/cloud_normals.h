@@ -9,7 +9,13 @@
 ///   neighbour graph with weights 1 - |n_i . n_j| (Hoppe et al. 1992; CGAL mst_orient_normals):
 ///   the tree is grown from the point of largest z of each connected component, whose normal is
 ///   turned to +z (outward there on a closed surface), and each point takes the side of its
-///   parent. Prim's algorithm with ties broken by index: deterministic.
+///   parent. Prim's algorithm with ties broken by index: deterministic. Then the extreme points
+///   vote on each component's side, so that no single seed decides it: for each of the six axis
+///   directions d the 1% of the component's points farthest along d (at least 1, at most 50; ties
+///   by index) add n . d (outward normals point away at the extremes of a closed surface), and
+///   the component takes the side of the vote when |sum| > 0.5 x the sum of |n . d| (a clear
+///   majority); otherwise (open, symmetric surfaces such as a saddle vote about 0) the same
+///   number of highest points vote on +z (the sum of their n_z), not the highest alone.
 /// - orient_towards_viewpoint: each normal turned to face a viewpoint (scanner position).
 /// - cloud_normals: all of it, then jet normals (normals/jets.h) over the same neighbourhoods,
 ///   which keep each PCA normal's side and are second-order accurate (PCA is first-order on

@@ -42,6 +42,17 @@ namespace focal {
 [[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
                                                const std::vector<char>& excluded, int threads = 0);
 
+/// Neighbourhoods whose radius follows the local density: point i gets every other point within
+/// scale x r_i (inclusive, at most `max_count`, the nearest; 0 = no limit), r_i the median, over
+/// i and its k nearest, of their distances to their own k-th nearest (smoothed, so that one
+/// sparse or dense spot does not set a radius of its own). Flags in `excluded` as
+/// nearest_neighbours. Lists sorted by (distance, index): identical for any thread count.
+/// \throw InvalidInput when k < 1, scale is not finite and > 0, max_count < 0 or threads < 0.
+[[nodiscard]] Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale,
+                                                        int max_count,
+                                                        const std::vector<char>& excluded = {},
+                                                        int threads = 0);
+
 /// Statistical outliers (#V flags): points whose mean distance to their neighbours is more than
 /// `ratio` times the median of their neighbours' own mean distances. Measured against the
 /// neighbours rather than the whole cloud (as PCL's and Open3D's statistical outlier removal

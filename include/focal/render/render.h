@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/mesh.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/image_space/image_space.h"
-#include "focal/core/mesh.h"
 
 namespace focal {
 
@@ -147,6 +147,11 @@ struct FieldPictureOptions {
   /// a non-finite entry are skipped.
   RowMatrixX3d directions;
   int glyph_count = 2500;
+  /// Point clouds (F with 0 rows) are drawn as splats: a disc per point in the plane normal to
+  /// its normal (facing the eye where the normal is not finite), depth-tested and shaded as
+  /// faces are. Radius in world units; 0 = 0.7 x the mean distance of each point to its 8
+  /// nearest (no gaps on Poisson-disk samples; docs/POINTS.md).
+  double splat_radius = 0.0;
   /// When set, two more panels right of the base mesh show Gamma_1 and Gamma_2 coloured by the
   /// same field (same vertex order as the base mesh), from the same camera, with flat shading.
   std::optional<FocalMeshes> focal_meshes;
