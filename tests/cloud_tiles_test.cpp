@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -15,26 +14,12 @@
 #include "focal/points/neighbours.h"
 #include "focal/surfaces/cloud_samples.h"
 #include "focal/tiles/tiles.h"
+#include "test_identical.h"
 
 namespace focal {
 namespace {
 
-bool same(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
-
-/// Bitwise equality of every field (NaN included), naming the first differing point.
-void expect_identical(const CurvatureResult& a, const CurvatureResult& b, const std::string& what) {
-  ASSERT_EQ(a.k1.size(), b.k1.size()) << what;
-  for (Eigen::Index i = 0; i < a.k1.size(); ++i) {
-    bool equal = same(a.k1[i], b.k1[i]) && same(a.k2[i], b.k2[i]) && same(a.H[i], b.H[i]) &&
-                 same(a.K[i], b.K[i]) && same(a.residual[i], b.residual[i]) &&
-                 a.point_class[i] == b.point_class[i] && a.rays_used[i] == b.rays_used[i] &&
-                 a.rays_excluded[i] == b.rays_excluded[i];
-    for (int c = 0; c < 3; ++c)
-      equal &= same(a.d1(i, c), b.d1(i, c)) && same(a.d2(i, c), b.d2(i, c));
-    ASSERT_TRUE(equal) << what << ": point " << i << " differs: k1 " << a.k1[i] << " vs "
-                       << b.k1[i];
-  }
-}
+using test::expect_identical;
 
 AnalyticSurface cloud(SurfaceKind kind, int points, std::uint64_t seed, double noise,
                       double graded, double outliers) {

@@ -96,6 +96,19 @@ void sort_ids(std::vector<int>& ids) {
   }
 }
 
+/// The tile's vertices (those reached, sorted) and the rows of its owned ones (ascending).
+void set_vertices(Tile& tile, std::vector<int> reached, const std::vector<int>& owned_ids) {
+  tile.vertices = std::move(reached);
+  sort_ids(tile.vertices);
+  tile.owned.reserve(owned_ids.size());
+  // Both ascending: one walk finds each owned vertex's row.
+  std::size_t row = 0;
+  for (int v : owned_ids) {
+    while (tile.vertices[row] != v) ++row;
+    tile.owned.push_back(static_cast<int>(row));
+  }
+}
+
 /// Marks of one search, per vertex or face: `mark[i] == stamp` means i was reached by the search
 /// of that stamp, so the marks are never cleared between tiles.
 struct Marks {
@@ -134,15 +147,7 @@ Tile make_tile(std::vector<int> owned_ids, FacesRef F, const detail::VertexFaces
     ring_begin = ring_end;
   }
   sort_ids(tile.faces);
-  tile.vertices = std::move(reached);
-  sort_ids(tile.vertices);
-  tile.owned.reserve(owned_ids.size());
-  // Both ascending: one walk finds each owned vertex's row.
-  std::size_t row = 0;
-  for (int v : owned_ids) {
-    while (tile.vertices[row] != v) ++row;
-    tile.owned.push_back(static_cast<int>(row));
-  }
+  set_vertices(tile, std::move(reached), owned_ids);
   return tile;
 }
 
@@ -166,14 +171,7 @@ Tile make_cloud_tile(std::vector<int> owned_ids, const Neighbourhoods& neighbour
     begin = end;
   }
   Tile tile;
-  tile.vertices = std::move(reached);
-  sort_ids(tile.vertices);
-  tile.owned.reserve(owned_ids.size());
-  std::size_t row = 0;
-  for (int v : owned_ids) {
-    while (tile.vertices[row] != v) ++row;
-    tile.owned.push_back(static_cast<int>(row));
-  }
+  set_vertices(tile, std::move(reached), owned_ids);
   return tile;
 }
 
