@@ -21,8 +21,8 @@ namespace {
 
 using test::expect_identical;
 
-AnalyticSurface cloud(SurfaceKind kind, int points, std::uint64_t seed, double noise,
-                      double graded, double outliers) {
+AnalyticSurface cloud(SurfaceKind kind, int points, std::uint64_t seed, double noise, double graded,
+                      double outliers) {
   CloudSampleOptions o;
   o.surface.kind = kind;
   o.surface.target_vertices = points;
@@ -55,9 +55,11 @@ std::vector<Case> clouds() {
 }
 
 TEST(CloudTiles, TheTilesGiveTheWholeCloudsBits) {
-  const std::vector<CloudOptions> options{
-      {}, {.k = 10}, {.radius = 0.15}, {.outlier_ratio = 0.0},
-      {.k = 8, .solver = Solver::levenberg_marquardt}};
+  const std::vector<CloudOptions> options{{},
+                                          {.k = 10},
+                                          {.radius = 0.15},
+                                          {.outlier_ratio = 0.0},
+                                          {.k = 8, .solver = Solver::levenberg_marquardt}};
   const std::vector<std::string> names{"default", "k 10", "radius 0.15", "no outlier test",
                                        "k 8 levenberg-marquardt"};
   bool wide_plan = false, outliers = false, estimated = false;
@@ -135,7 +137,8 @@ TEST(CloudTiles, AHaloOneStepShortChangesTheResult) {
     fit_cloud_curvature(s.mesh.V, whole, options);
     const CloudWideChoices choices{plan.spacing, plan.k};
     for (const int depth : {0, 1}) {
-      const Tiling tiling = partition_cloud(s.mesh.V, plan.neighbours, depth, {.tile_vertices = 300});
+      const Tiling tiling =
+          partition_cloud(s.mesh.V, plan.neighbours, depth, {.tile_vertices = 300});
       TileEstimate tiled{whole.curvature, {}};
       for (const Tile& tile : tiling.tiles) {
         scatter_rows(estimate_cloud_tile(extract_cloud_tile(s.mesh.V, plan.N, plan.outlier, tile),

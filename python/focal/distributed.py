@@ -31,7 +31,7 @@ import numpy as np
 
 import focal
 from focal import _focal_ext as _ext
-from focal import stream
+from focal import _clouds, stream
 
 #: The per-vertex fields of focal.Curvature that tiles write back.
 FIELDS = stream.FIELDS
@@ -185,14 +185,14 @@ def cloud_curvature(
         raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
     if client is None and threads is None:
         threads = 1
-    P, k, r, t = focal._clouds._cloud_arguments(points, k, radius, threads)
+    P, k, r, t = _clouds._cloud_arguments(points, k, radius, threads)
     N = None
     if normals is not None:
         N = focal._as_rows(normals, "normals", np.float64)
         if N.shape[0] != P.shape[0]:
             raise focal._shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
     o = {"k": k, "radius": r, "normal_method": normal_method,
-         "viewpoint": focal._clouds._viewpoint(viewpoint), "solver": solver,
+         "viewpoint": _clouds._viewpoint(viewpoint), "solver": solver,
          "outlier_ratio": float(outlier_ratio), "threads": t}
     plan = _ext.cloud_tile_plan(P, N, o, int(tile_vertices))
     Np, outlier = plan["N"], plan["outlier"]

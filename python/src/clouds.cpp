@@ -93,12 +93,12 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius,
 
 /// cloud_curvature's arguments as one dict (what a tile task carries).
 focal::CloudOptions cloud_options_of(const nb::dict& d) {
-  const auto viewpoint = d["viewpoint"].is_none()
-                             ? std::optional<std::vector<double>>()
-                             : nb::cast<std::vector<double>>(d["viewpoint"]);
-  focal::CloudOptions o = cloud_options(
-      nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]), nb::cast<std::string>(d["normal_method"]),
-      viewpoint, nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
+  const auto viewpoint = d["viewpoint"].is_none() ? std::optional<std::vector<double>>()
+                                                  : nb::cast<std::vector<double>>(d["viewpoint"]);
+  focal::CloudOptions o =
+      cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]),
+                    nb::cast<std::string>(d["normal_method"]), viewpoint,
+                    nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
   return o;
 }

@@ -151,7 +151,7 @@ Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options)
 }
 
 Neighbourhoods cloud_fit_neighbourhoods(PositionsRef V, const CloudOptions& options, int k,
-                                       const std::vector<char>& excluded) {
+                                        const std::vector<char>& excluded) {
   CloudOptions o = options;
   if (o.radius == 0.0) o.k = k;
   // No point left out: the lists of no exclusion (the same lists, as a whole run takes them).

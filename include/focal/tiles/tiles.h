@@ -107,7 +107,8 @@ void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
 [[nodiscard]] Tiling partition_cloud(PositionsRef V, const Neighbourhoods& neighbours,
                                      int halo_depth, const TileOptions& options = {});
 
-/// What a cloud's tiles take from the whole cloud besides their points' rows (plan_cloud_curvature).
+/// What a cloud's tiles take from the whole cloud besides their points' rows
+/// (plan_cloud_curvature).
 struct CloudWideChoices {
   double spacing = 0.0;  ///< CloudCurvature::spacing: the scale of the class tolerances
   int k = 0;             ///< CloudCurvature::k: neighbours of the fit (ignored with a radius)
@@ -116,8 +117,8 @@ struct CloudWideChoices {
 /// A cloud tile's rows, in the tile's (global) order.
 struct TileCloud {
   RowMatrixX3d V;
-  RowMatrixX3d N;              ///< the plan's normals (CloudCurvature::N)
-  std::vector<char> outlier;   ///< the plan's outlier flags, or empty
+  RowMatrixX3d N;             ///< the plan's normals (CloudCurvature::N)
+  std::vector<char> outlier;  ///< the plan's outlier flags, or empty
 };
 
 /// The rows of `tile` of V, the plan's normals and outlier flags (empty or #V).
