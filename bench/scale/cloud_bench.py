@@ -20,7 +20,7 @@ import time
 import focal
 import focal.distributed as fd
 from focal import _focal_ext as ext
-from scale_bench import RssSampler, peak_rss_mb, worker_rss_mb
+from scale_bench import peak_rss_mb, report_tiled, start_cluster
 
 
 def main() -> None:
@@ -32,13 +32,7 @@ def main() -> None:
     p.add_argument("--k", type=int, default=0, help="0: the library's default plan")
     p.add_argument("--no-normals", action="store_true", help="estimate the normals")
     args = p.parse_args()
-    from distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                           memory_limit=args.memory_limit, dashboard_address=":0")
-    client = Client(cluster)
-    client.run(lambda: __import__("focal"))
-    idle = client.run(worker_rss_mb)
+    client, cluster, idle = start_cluster(args.workers, args.memory_limit)
     t = time.perf_counter()
     m = focal.read_mesh(args.cloud)
     P, N = m.V, None if args.no_normals else m.N
@@ -72,15 +66,9 @@ def main() -> None:
           f"tiles {(t_plan + t_serial) / t_single:.2f} x); bit-identical: {same}")
     del plan
 
-    with RssSampler(client) as sampler:
-        t = time.perf_counter()
-        tiled = fd.cloud_curvature(P, N, client, tile_vertices=args.tile_vertices, k=args.k,
-                                   threads=1)
-        t_tiled = time.perf_counter() - t
-    same = all(getattr(tiled, n).tobytes() == single[n].tobytes() for n in fd.FIELDS)
-    print(f"tiled    {t_tiled:.2f} s = {t_tiled / t_single:.2f} x single; bit-identical: {same}")
-    print("workers  peak RSS " + ", ".join(f"{v:.0f} MB" for v in sampler.peak.values()) +
-          f" (idle {max(idle.values()):.0f} MB; limit {args.memory_limit} each)")
+    report_tiled(client, lambda: fd.cloud_curvature(P, N, client, k=args.k, threads=1,
+                                                    tile_vertices=args.tile_vertices),
+                 single, t_single, idle, args.memory_limit)
     client.close()
     cluster.close()
 
