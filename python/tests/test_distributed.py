@@ -94,9 +94,14 @@ def test_noisy_positions_plan_wider_rings_and_stay_identical(client):
     assert same_fields(whole, tiled)
 
 
-def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward):
-    V, F, N = awkward
-    whole = focal.curvature(V, F, N)
+@pytest.mark.parametrize("kind", ["mesh", "cloud"])
+def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward, cloud, kind):
+    if kind == "mesh":
+        V, F, N = awkward
+        whole = focal.curvature(V, F, N)
+    else:
+        P, PN, _ = cloud
+        whole = focal.cloud_curvature(P, PN)
     pids = client.run(os.getpid)
     victim = next(iter(pids.values()))
     killed = []
@@ -106,8 +111,12 @@ def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward):
             os.kill(victim, signal.SIGKILL)
             killed.append(index)
 
-    tiled = fd.curvature((V, F, N), client, tile_vertices=60, threads=1,
-                         on_tile=kill_on_first_tile)
+    if kind == "mesh":
+        tiled = fd.curvature((V, F, N), client, tile_vertices=60, threads=1,
+                             on_tile=kill_on_first_tile)
+    else:
+        tiled = fd.cloud_curvature(P, PN, client, tile_vertices=100, threads=1,
+                                   on_tile=kill_on_first_tile)
     assert killed
     assert same_fields(whole, tiled)
     client.wait_for_workers(2, timeout=60)
