@@ -120,8 +120,9 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
   cmd->add_flag("--force", f->force, "replace a read-only output file");
   cmd->add_option("--tiles", f->tiles,
-                  "estimate the mesh in N spatial tiles with halos, one after the other: the "
-                  "same numbers, the memory of one tile's estimate (docs/SCALE.md; .csv output). "
+                  "estimate the mesh (or cloud) in N spatial tiles with halos, one after the "
+                  "other: the same numbers, the memory of one tile's estimate (docs/SCALE.md; "
+                  ".csv output). "
                   "On a Dask cluster: python -m focal.distributed")
       ->check(CLI::PositiveNumber);
   cmd->parse_complete_callback([f] {

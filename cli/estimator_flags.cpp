@@ -339,7 +339,17 @@ Estimate run_estimate(const Input& input, const std::string& mesh_name, const Es
 TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name,
                                 const EstimatorFlags& flags, int tiles, const Log& log) {
   if (input.cloud) {
-    throw InvalidInput(mesh_name + ": is a point cloud (no faces); --tiles cuts meshes only");
+    const CloudOptions options = flags.cloud_options();
+    const std::int64_t n = input.mesh.V.rows();
+    const auto per_tile = static_cast<int>(std::max<std::int64_t>(1, (n + tiles - 1) / tiles));
+    TileEstimate c;
+    {
+      Stage stage(log, "cloud curvature in tiles of " + std::to_string(per_tile) + " points");
+      c = estimate_cloud_tiled(input.mesh.V, input.mesh.normals(), options,
+                               {.tile_vertices = per_tile, .threads = flags.threads});
+    }
+    print_summary(c.curvature, log);
+    return c;
   }
   const PreparedMesh& mesh = *input.prepared;
   const EstimateOptions options = flags.estimate_options();

@@ -78,8 +78,9 @@ struct Input {
 
 /// run_estimate's curvature and crease flags, tile by tile (estimate_tiled, focal/tiles/tiles.h:
 /// the same bits, the memory of the largest tile's estimate in place of the whole mesh's) in
-/// `tiles` tiles of about equal vertex counts. \throw InvalidInput as run_estimate, and for a point
-/// cloud.
+/// `tiles` tiles of about equal vertex counts; of a point cloud, run_cloud_estimate's curvature
+/// (estimate_cloud_tiled: the plan on the whole cloud, the fit tile by tile). \throw InvalidInput
+/// as run_estimate and run_cloud_estimate.
 [[nodiscard]] TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name,
                                               const EstimatorFlags& flags, int tiles,
                                               const Log& log);

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,10 +14,13 @@
 #include "focal/core/error.h"
 #include "focal/curvature/estimate.h"
 #include "focal/mesh/neighbourhood.h"
+#include "test_identical.h"
 #include "test_meshes.h"
 
 namespace focal {
 namespace {
+
+using test::expect_identical;
 
 /// a and b side by side: b's vertices after a's.
 Mesh join(const Mesh& a, const Mesh& b) {
@@ -71,22 +73,6 @@ Mesh awkward_mesh(std::uint64_t seed) {
   m.F.row(m.F.rows() - 1) << first[2], n + 1, n + 2;
   m.V.row(17).setConstant(NAN);  // a vertex of the torus
   return m;
-}
-
-/// Bitwise equality of every field (NaN included), naming the first differing vertex.
-void expect_identical(const CurvatureResult& a, const CurvatureResult& b, const std::string& what) {
-  ASSERT_EQ(a.k1.size(), b.k1.size()) << what;
-  for (Eigen::Index i = 0; i < a.k1.size(); ++i) {
-    const auto same = [&](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
-    bool equal = same(a.k1[i], b.k1[i]) && same(a.k2[i], b.k2[i]) && same(a.H[i], b.H[i]) &&
-                 same(a.K[i], b.K[i]) && same(a.residual[i], b.residual[i]) &&
-                 a.point_class[i] == b.point_class[i] && a.rays_used[i] == b.rays_used[i] &&
-                 a.rays_excluded[i] == b.rays_excluded[i];
-    for (int c = 0; c < 3; ++c)
-      equal &= same(a.d1(i, c), b.d1(i, c)) && same(a.d2(i, c), b.d2(i, c));
-    ASSERT_TRUE(equal) << what << ": vertex " << i << " differs: k1 " << a.k1[i] << " vs "
-                       << b.k1[i];
-  }
 }
 
 struct Case {

@@ -56,6 +56,35 @@ class RssSampler:
         self.thread.join()
 
 
+def start_cluster(workers: int, memory_limit: str):
+    """A LocalCluster of `workers` processes x 1 thread with focal imported, its client, and the
+    workers' idle RSS. Started before the input is read, so that the workers do not start as
+    copies of a large driver."""
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           memory_limit=memory_limit, dashboard_address=":0")
+    client = Client(cluster)
+    client.run(lambda: __import__("focal"))  # import once, outside the timing
+    return client, cluster, client.run(worker_rss_mb)
+
+
+def report_tiled(client, run, single, t_single, idle, memory_limit) -> None:
+    """Times run() (a tiled run), sampling its workers' peak RSS, and compares its fields with
+    `single`'s (a dict by name, or None)."""
+    with RssSampler(client) as sampler:
+        t = time.perf_counter()
+        tiled = run()
+        t_tiled = time.perf_counter() - t
+    line = f"tiled    {t_tiled:.2f} s"
+    if single is not None:
+        same = all(getattr(tiled, n).tobytes() == single[n].tobytes() for n in fd.FIELDS)
+        line += f" = {t_tiled / t_single:.2f} x single; bit-identical: {same}"
+    print(line)
+    print("workers  peak RSS " + ", ".join(f"{v:.0f} MB" for v in sampler.peak.values()) +
+          f" (idle {max(idle.values()):.0f} MB; limit {memory_limit} each)")
+
+
 def main() -> None:
     p = argparse.ArgumentParser()
     p.add_argument("mesh")
@@ -65,14 +94,7 @@ def main() -> None:
     p.add_argument("--estimator", default="recommended")
     p.add_argument("--no-single", action="store_true", help="skip the one-process run")
     args = p.parse_args()
-    from distributed import Client, LocalCluster
-
-    # Started before the mesh is read, so that the workers do not start as copies of a large driver.
-    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                           memory_limit=args.memory_limit, dashboard_address=":0")
-    client = Client(cluster)
-    client.run(lambda: __import__("focal"))  # import once, outside the timing
-    idle = client.run(worker_rss_mb)
+    client, cluster, idle = start_cluster(args.workers, args.memory_limit)
     t = time.perf_counter()
     m = focal.read_mesh(args.mesh)
     print(f"read     {len(m.V):,} vertices, {len(m.F):,} faces in {time.perf_counter() - t:.2f} s"
@@ -112,18 +134,9 @@ def main() -> None:
               f"bit-identical: {same}")
     del plan
 
-    with RssSampler(client) as sampler:
-        t = time.perf_counter()
-        tiled = fd.curvature(m, client, tile_vertices=args.tile_vertices, threads=1,
-                             estimator=args.estimator)
-        t_tiled = time.perf_counter() - t
-    line = f"tiled    {t_tiled:.2f} s"
-    if single is not None:
-        same = all(getattr(tiled, n).tobytes() == single[n].tobytes() for n in fd.FIELDS)
-        line += f" = {t_tiled / t_single:.2f} x single; bit-identical: {same}"
-    print(line)
-    print("workers  peak RSS " + ", ".join(f"{v:.0f} MB" for v in sampler.peak.values()) +
-          f" (idle {max(idle.values()):.0f} MB; limit {args.memory_limit} each)")
+    report_tiled(client, lambda: fd.curvature(m, client, tile_vertices=args.tile_vertices,
+                                              threads=1, estimator=args.estimator),
+                 single, None if single is None else t_single, idle, args.memory_limit)
     client.close()
     cluster.close()
 

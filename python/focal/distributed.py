@@ -12,6 +12,7 @@ run again elsewhere by Dask; a task that raises is retried ``retries`` times.
     import focal.distributed
     c = focal.distributed.curvature("scan.ply", tile_vertices=250_000)   # a LocalCluster
     c = focal.distributed.curvature((V, F, N), client=Client("tcp://scheduler:8786"))
+    c = focal.distributed.cloud_curvature(points, normals, tile_vertices=250_000)  # a cloud
 
 or from a shell: ``python -m focal.distributed scan.ply -o fields.npz --scheduler ADDRESS``.
 """
@@ -30,12 +31,12 @@ import numpy as np
 
 import focal
 from focal import _focal_ext as _ext
-from focal import stream
+from focal import _clouds, stream
 
 #: The per-vertex fields of focal.Curvature that tiles write back.
 FIELDS = stream.FIELDS
 
-__all__ = ["curvature", "curvature_stream", "main"]
+__all__ = ["cloud_curvature", "curvature", "curvature_stream", "main"]
 
 #: Tasks in flight per worker thread: enough to keep workers busy while results come back,
 #: few enough that the scheduler holds only a few tiles' arrays.
@@ -50,6 +51,13 @@ def _estimate_tile(V: np.ndarray, F: np.ndarray, N: Optional[np.ndarray], owned:
     if d["crease"] is not None:  # the recommended estimator's crease flags
         fields["crease"] = d["crease"][owned]
     return fields
+
+
+def _estimate_cloud_tile(V: np.ndarray, N: np.ndarray, outlier: Optional[np.ndarray],
+                         owned: np.ndarray, options: dict, choices: dict) -> dict:
+    """The task of a cloud's tile: the fit with the whole cloud's choices, its owned rows only."""
+    d = _ext.estimate_cloud_tile(V, N, outlier, options, choices)
+    return {name: d[name][owned] for name in FIELDS}
 
 
 def _mesh_of(path_or_arrays: Any):
@@ -96,7 +104,8 @@ def curvature(
     Parameters
     ----------
     path_or_arrays : a mesh file (read by ``focal.read_mesh``), a ``focal.Mesh`` or a tuple
-        ``(V, F)`` / ``(V, F, N)``.
+        ``(V, F)`` / ``(V, F, N)``; one without faces (a cloud file, F of shape (0, 3)) is a
+        point cloud, run as ``cloud_curvature`` (options: those of ``focal.cloud_curvature``).
     client : a ``distributed.Client``; None: a ``LocalCluster`` of ``workers`` processes (default
         one per core) with one thread each and ``memory_limit`` per worker (Dask's "auto"
         default), closed at the end.
@@ -116,9 +125,15 @@ def curvature(
 
     Raises InvalidInputError as ``focal.curvature``, FocalIOError for an unreadable file.
     """
-    from distributed import as_completed
-
     V, F, N = _mesh_of(path_or_arrays)
+    if isinstance(F, np.ndarray) and F.ndim == 2 and F.shape[0] == 0:
+        # A file (or focal.Mesh) without faces is a point cloud: its estimator is the cloud's.
+        if options.pop("estimator", "recommended") != "recommended":
+            raise focal.InvalidInputError("a point cloud (no faces) has one estimator: "
+                                          "estimator='paper' applies to meshes")
+        return cloud_curvature(V, N, client, tile_vertices=tile_vertices, workers=workers,
+                               memory_limit=memory_limit, retries=retries, progress=progress,
+                               on_tile=on_tile, **options)
     if int(tile_vertices) < 1:
         raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
     own_cluster = client is None
@@ -129,30 +144,100 @@ def curvature(
     Va, Fa, Na = focal._mesh_arrays(V, F, N)
     plan = _ext.tile_plan(Va, Fa, Na, o, int(tile_vertices))
     faces = plan["F"] if plan["F"] is not None else Fa
-    out = _empty_fields(Va.shape[0])
 
+    def task(t: dict) -> tuple:
+        a = _ext.extract_tile(Va, faces, Na, t["vertices"], t["faces"])
+        return _estimate_tile, (a["V"], a["F"], a["N"], t["owned"], o, plan["choices"])
+
+    out = _run_tiles(plan["tiles"], task, Va.shape[0], client, workers, memory_limit, retries,
+                     progress, on_tile)
+    return focal.Curvature(**out)
+
+
+def cloud_curvature(
+    points: Any,
+    normals: Any = None,
+    client: Any = None,
+    *,
+    tile_vertices: int = 250_000,
+    workers: Optional[int] = None,
+    memory_limit: Any = None,
+    retries: int = 2,
+    progress: bool = False,
+    on_tile: Optional[Callable[[int, np.ndarray, dict], None]] = None,
+    k: int = 16,
+    radius: Optional[float] = None,
+    normal_method: str = "jet",
+    viewpoint: Any = None,
+    solver: str = "closed-form",
+    outlier_ratio: float = 3.0,
+    threads: Optional[int] = None,
+) -> focal.Curvature:
+    """``focal.cloud_curvature`` of a point cloud, the fit tile by tile on a Dask cluster: the
+    same bits (include/focal/tiles/tiles.h, docs/SCALE.md "Point clouds").
+
+    The driver makes the plan on the whole cloud (the neighbourhoods, outlier flags, mean
+    spacing and normals: estimated normals are oriented over the whole cloud) and cuts the
+    tiles: a tile holds its owned points and their neighbours. Each task fits its tile's points.
+    Cloud options as ``focal.cloud_curvature`` except ``adaptive_radius`` (not tiled: a
+    point's radius reads its neighbours' neighbours, beyond a tile's halo); the others as
+    ``curvature``.
+    """
+    if int(tile_vertices) < 1:
+        raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
+    if client is None and threads is None:
+        threads = 1
+    # No adaptive radius: a point's radius reads its neighbours' neighbours, beyond the halo.
+    P, k, r, _, t = _clouds._cloud_arguments(points, k, radius, None, threads)
+    N = None
+    if normals is not None:
+        N = focal._as_rows(normals, "normals", np.float64)
+        if N.shape[0] != P.shape[0]:
+            raise focal._shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
+    o = {"k": k, "radius": r, "normal_method": normal_method,
+         "viewpoint": _clouds._viewpoint(viewpoint), "solver": solver,
+         "outlier_ratio": float(outlier_ratio), "threads": t}
+    plan = _ext.cloud_tile_plan(P, N, o, int(tile_vertices))
+    Np, outlier = plan["N"], plan["outlier"]
+
+    def task(tile: dict) -> tuple:
+        a = _ext.extract_cloud_tile(P, Np, outlier, tile["vertices"])
+        return _estimate_cloud_tile, (a["V"], a["N"], a["outlier"], tile["owned"], o,
+                                      plan["choices"])
+
+    out = _run_tiles(plan["tiles"], task, P.shape[0], client, workers, memory_limit, retries,
+                     progress, on_tile)
+    return focal.Curvature(**out)
+
+
+def _run_tiles(tiles: list, task: Callable[[dict], tuple], n: int, client: Any,
+               workers: Optional[int], memory_limit: Any, retries: int, progress: bool,
+               on_tile: Optional[Callable[[int, np.ndarray, dict], None]]) -> dict:
+    """Runs task(tile) = (function, arguments) of every tile on `client` (None: a LocalCluster,
+    closed at the end), a few per worker thread in flight, and writes each result's owned rows
+    into the fields of n vertices, which it returns."""
+    from distributed import as_completed
+
+    out = _empty_fields(n)
     cluster = None
-    if own_cluster:
+    if client is None:
         client, cluster = _local_client(workers, memory_limit)
     try:
-        tiles = plan["tiles"]
         in_flight = max(1, _TASKS_PER_THREAD * sum(client.nthreads().values()))
+        tile_of = {}
 
         def submit(i: int):
-            t = tiles[i]
-            a = _ext.extract_tile(Va, faces, Na, t["vertices"], t["faces"])
+            function, arguments = task(tiles[i])
             # The arrays travel inside the task, not scattered ahead: Dask can then rerun the
             # task elsewhere when its worker dies (scattered data would die with the worker).
             # Dask warns about such tasks ("Sending large graph"); here that is the intent.
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", message="Sending large graph")
-                fut = client.submit(_estimate_tile, a["V"], a["F"], a["N"], t["owned"], o,
-                                    plan["choices"], key=f"focal-tile-{i}-{uuid.uuid4().hex}",
-                                    retries=retries)
+                fut = client.submit(function, *arguments,
+                                    key=f"focal-tile-{i}-{uuid.uuid4().hex}", retries=retries)
             tile_of[fut.key] = i
             return fut
 
-        tile_of = {}
         first = [submit(i) for i in range(min(in_flight, len(tiles)))]
         if progress:
             from distributed import progress as dask_progress
@@ -166,7 +251,7 @@ def curvature(
             for name in FIELDS:
                 out[name][ids] = fields[name]
             if "crease" in fields:
-                out.setdefault("crease", np.zeros(Va.shape[0], np.uint8))[ids] = fields["crease"]
+                out.setdefault("crease", np.zeros(n, np.uint8))[ids] = fields["crease"]
             if on_tile is not None:
                 on_tile(i, ids, fields)
             fut.release()
@@ -177,7 +262,7 @@ def curvature(
         if cluster is not None:
             client.close()
             cluster.close()
-    return focal.Curvature(**out)
+    return out
 
 
 def curvature_stream(
@@ -310,7 +395,8 @@ def main(argv: Optional[list] = None) -> int:
         description="focal curvature of a mesh, tile by tile on a Dask cluster (the same "
         "numbers as `focal curvature`).",
     )
-    p.add_argument("input", help="mesh file (.ply, .obj, .off, .stl)")
+    p.add_argument("input", help="mesh or point cloud file (.ply, .obj, .off, .stl; clouds: "
+                   ".xyz .pts .txt .csv, PLY/OBJ without faces)")
     p.add_argument("-o", "--output", help="fields, .npz or .csv (input order); with --parts, "
                    "the parts concatenated (.npz)")
     p.add_argument("--parts", help="stream the input (binary PLY, paper's estimator, file "
@@ -346,7 +432,10 @@ def main(argv: Optional[list] = None) -> int:
         if args.parts is not None:
             curvature_stream(args.input, args.parts, client, output=args.output, **common)
         else:
-            _write_fields(args.output, curvature(args.input, client, **common))
+            mesh = focal.read_mesh(args.input)
+            if mesh.F.shape[0] == 0:
+                common["k"] = 0  # a cloud: the library's default plan, as `focal curvature`'s
+            _write_fields(args.output, curvature(mesh, client, **common))
     except (focal.FocalIOError, focal.InvalidInputError, OSError) as e:
         print(f"Error: {e}", file=sys.stderr)
         return 2

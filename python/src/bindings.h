@@ -60,6 +60,14 @@ nb::object optional_to_numpy(std::optional<Matrix>&& m) {
   return nb::cast(to_numpy(std::move(*m)));
 }
 
+/// Global ids (tiles, focal/tiles/tiles.h) as an int32 array, and back.
+using Ids = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+inline nb::object ids_to_numpy(const std::vector<int>& ids) {
+  return nb::cast(to_numpy(Eigen::VectorXi(
+      Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size())))));
+}
+inline std::vector<int> ids_from(const Ids& a) { return {a.data(), a.data() + a.shape(0)}; }
+
 /// Crease flags (Estimate::crease) as an array, None when the estimator gives none (empty).
 inline nb::object crease_or_none(focal::VectorXu8&& crease) {
   if (crease.size() == 0) return nb::none();

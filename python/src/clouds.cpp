@@ -11,6 +11,7 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -20,6 +21,7 @@
 #include "focal/core/error.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/normals/cloud_normals.h"
+#include "focal/tiles/tiles.h"
 
 namespace focal_python {
 namespace {
@@ -90,6 +92,100 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adapt
   return nb::cast(to_numpy(std::move(N)));
 }
 
+// ---- A cloud in tiles (focal/tiles/tiles.h), for python/focal/distributed.py ----------------
+
+/// cloud_curvature's arguments as one dict (what a tile task carries).
+focal::CloudOptions cloud_options_of(const nb::dict& d) {
+  const auto viewpoint = d["viewpoint"].is_none() ? std::optional<std::vector<double>>()
+                                                  : nb::cast<std::vector<double>>(d["viewpoint"]);
+  const double adaptive_radius =
+      d.contains("adaptive_radius") ? nb::cast<double>(d["adaptive_radius"]) : 0.0;
+  focal::CloudOptions o =
+      cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]), adaptive_radius,
+                    nb::cast<std::string>(d["normal_method"]), viewpoint,
+                    nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
+  o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
+  focal::require_tileable(o);
+  return o;
+}
+
+using Flags = nb::ndarray<const std::uint8_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+std::vector<char> flags_from(const std::optional<Flags>& a) {
+  if (!a) return {};
+  return {a->data(), a->data() + a->shape(0)};
+}
+
+nb::object flags_to_numpy(const std::vector<char>& flags) {
+  if (flags.empty()) return nb::none();
+  Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1> v(static_cast<Eigen::Index>(flags.size()));
+  for (std::size_t i = 0; i < flags.size(); ++i) v[static_cast<Eigen::Index>(i)] = flags[i];
+  return nb::cast(to_numpy(std::move(v)));
+}
+
+/// The whole cloud's plan (plan_cloud_curvature): its choices, normals and outlier flags, and
+/// its tiles (partition_cloud over the fit's neighbourhoods, depth 1).
+nb::dict cloud_tile_plan(const DoubleRows& V, const std::optional<DoubleRows>& N,
+                         const nb::dict& options, int tile_vertices) {
+  const focal::CloudOptions o = cloud_options_of(options);
+  focal::CloudCurvature plan;
+  focal::Tiling tiling;
+  {
+    nb::gil_scoped_release release;
+    plan = N ? focal::plan_cloud_curvature(view(V), focal::NormalsRef(view(*N)), o)
+             : focal::plan_cloud_curvature(view(V), std::nullopt, o);
+    tiling = focal::partition_cloud(view(V), plan.neighbours, 1,
+                                    {.tile_vertices = tile_vertices, .threads = o.threads});
+  }
+  nb::list tiles;
+  for (const focal::Tile& t : tiling.tiles) {
+    nb::dict d;
+    d["vertices"] = ids_to_numpy(t.vertices);
+    d["owned"] = ids_to_numpy(t.owned);
+    tiles.append(d);
+  }
+  nb::dict choices;
+  choices["spacing"] = plan.spacing;
+  choices["k"] = plan.k;
+  nb::dict d;
+  d["choices"] = choices;
+  d["N"] = to_numpy(std::move(plan.N));
+  d["outlier"] = flags_to_numpy(plan.outlier);
+  d["tiles"] = tiles;
+  return d;
+}
+
+nb::dict extract_cloud_tile(const DoubleRows& V, const DoubleRows& N,
+                            const std::optional<Flags>& outlier, const Ids& vertices) {
+  const focal::Tile tile{ids_from(vertices), {}, {}};
+  focal::TileCloud t;
+  {
+    nb::gil_scoped_release release;
+    t = focal::extract_cloud_tile(view(V), view(N), flags_from(outlier), tile);
+  }
+  nb::dict d;
+  d["V"] = to_numpy(std::move(t.V));
+  d["N"] = to_numpy(std::move(t.N));
+  d["outlier"] = flags_to_numpy(t.outlier);
+  return d;
+}
+
+/// The fit of every point of a cloud tile, with the whole cloud's choices.
+nb::dict estimate_cloud_tile(const DoubleRows& V, const DoubleRows& N,
+                             const std::optional<Flags>& outlier, const nb::dict& options,
+                             const nb::dict& choices) {
+  const focal::CloudOptions o = cloud_options_of(options);
+  const focal::CloudWideChoices c{nb::cast<double>(choices["spacing"]),
+                                  nb::cast<int>(choices["k"])};
+  focal::TileEstimate r;
+  {
+    nb::gil_scoped_release release;
+    const focal::TileCloud tile{view(V), view(N), flags_from(outlier)};
+    r = focal::estimate_cloud_tile(tile, c, o);
+  }
+  return curvature_dict(std::move(r.curvature));
+}
+
 }  // namespace
 
 void bind_clouds(nb::module_& m) {
@@ -98,6 +194,12 @@ void bind_clouds(nb::module_& m) {
         "outlier_ratio"_a, "threads"_a);
   m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "adaptive_radius"_a,
         "normal_method"_a, "viewpoint"_a.none(), "threads"_a);
+  m.def("cloud_tile_plan", &cloud_tile_plan, "V"_a.noconvert(), "N"_a.none().noconvert(),
+        "options"_a, "tile_vertices"_a);
+  m.def("extract_cloud_tile", &extract_cloud_tile, "V"_a.noconvert(), "N"_a.noconvert(),
+        "outlier"_a.none().noconvert(), "vertices"_a.noconvert());
+  m.def("estimate_cloud_tile", &estimate_cloud_tile, "V"_a.noconvert(), "N"_a.noconvert(),
+        "outlier"_a.none().noconvert(), "options"_a, "choices"_a);
 }
 
 }  // namespace focal_python

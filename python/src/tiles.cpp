@@ -20,15 +20,6 @@ namespace focal_python {
 namespace {
 
 using namespace nb::literals;
-using Ids = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
-
-nb::object ids_to_numpy(const std::vector<int>& ids) {
-  return nb::cast(to_numpy(Eigen::VectorXi(
-      Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size())))));
-}
-
-std::vector<int> ids_from(const Ids& a) { return {a.data(), a.data() + a.shape(0)}; }
-
 nb::dict choices_dict(const focal::MeshWideChoices& c) {
   nb::dict d;
   d["mean_edge_length"] = c.mean_edge_length;

@@ -1,7 +1,7 @@
 """focal.distributed on a Dask LocalCluster of 2 worker processes: tile by tile, the same bits as
 focal.curvature on the whole mesh (meshes with boundaries, several components, one inward, a
-non-manifold fin), also when a worker is killed during the run; the command line's outputs and
-exit codes.
+non-manifold fin) and on point clouds (graded density, outliers, with and without normals), also
+when a worker is killed during the run; the command line's outputs and exit codes.
 
 `import distributed` is not guarded: `make test` installs dask[distributed] into its venv, and a
 missing one fails the run.
@@ -94,9 +94,14 @@ def test_noisy_positions_plan_wider_rings_and_stay_identical(client):
     assert same_fields(whole, tiled)
 
 
-def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward):
-    V, F, N = awkward
-    whole = focal.curvature(V, F, N)
+@pytest.mark.parametrize("kind", ["mesh", "cloud"])
+def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward, cloud, kind):
+    if kind == "mesh":
+        V, F, N = awkward
+        whole = focal.curvature(V, F, N)
+    else:
+        P, PN, _ = cloud
+        whole = focal.cloud_curvature(P, PN)
     pids = client.run(os.getpid)
     victim = next(iter(pids.values()))
     killed = []
@@ -106,8 +111,12 @@ def test_a_worker_killed_during_the_run_gives_the_same_result(client, awkward):
             os.kill(victim, signal.SIGKILL)
             killed.append(index)
 
-    tiled = fd.curvature((V, F, N), client, tile_vertices=60, threads=1,
-                         on_tile=kill_on_first_tile)
+    if kind == "mesh":
+        tiled = fd.curvature((V, F, N), client, tile_vertices=60, threads=1,
+                             on_tile=kill_on_first_tile)
+    else:
+        tiled = fd.cloud_curvature(P, PN, client, tile_vertices=100, threads=1,
+                                   on_tile=kill_on_first_tile)
     assert killed
     assert same_fields(whole, tiled)
     client.wait_for_workers(2, timeout=60)
@@ -136,6 +145,73 @@ def test_bad_input_is_an_error_before_any_task(client, awkward):
         fd.curvature(42, client)
     with pytest.raises(focal.FocalIOError):
         fd.curvature("/nonexistent/mesh.ply", client)
+
+
+# Point clouds: the plan on the whole cloud in the driver, the fit tile by tile on the workers.
+
+
+@pytest.fixture(scope="module")
+def cloud():
+    """A torus's vertices as a cloud, its density graded along x (a sparser part: points 0.4 of
+    the way and beyond kept with falling probability), with 1% outliers in the bounding box."""
+    s = focal.generate_surface("torus", 4000, triangulation="irregular", seed=7)
+    rng = np.random.default_rng(7)
+    x = (s.V[:, 0] - s.V[:, 0].min()) / np.ptp(s.V[:, 0])
+    keep = rng.uniform(size=len(x)) >= 0.6 * np.clip(x - 0.4, 0, None) / 0.6
+    P, N = s.V[keep], s.N[keep]
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    far = lo + (hi - lo) * rng.uniform(size=(len(P) // 100, 3))
+    P = np.vstack([P, far])
+    N = np.vstack([N, np.tile([0.0, 0.0, 1.0], (len(far), 1))])
+    return P, N, len(far)
+
+
+@pytest.mark.parametrize(
+    "normals, options",
+    [(True, {}), (False, {}), (False, {"k": 0}), (True, {"k": 0}), (False, {"radius": 0.2}),
+     (True, {"outlier_ratio": 0})],
+    ids=["normals", "no-normals", "adaptive-no-normals", "adaptive-normals", "radius",
+         "no-outlier-test"],
+)
+def test_cloud_tiles_on_dask_give_the_whole_clouds_bits(client, cloud, normals, options):
+    P, N, far = cloud
+    N = N if normals else None
+    whole = focal.cloud_curvature(P, N, **options)
+    if options.get("outlier_ratio") != 0:
+        # Many land near the surface in the torus's thin box; the others are left out.
+        assert np.isnan(whole.H[-far:]).mean() > 0.3
+    tiled = fd.cloud_curvature(P, N, client, tile_vertices=450, threads=1, **options)
+    assert same_fields(whole, tiled)
+    assert not tiled.undefined.all()
+
+
+def test_a_cloud_file_runs_as_a_cloud(client, cloud, tmp_path):
+    P, N, _ = cloud
+    path = tmp_path / "cloud.xyz"
+    np.savetxt(path, np.hstack([P, N]), fmt="%.17g")
+    m = focal.read_mesh(path)
+    whole = focal.cloud_curvature(m.V, m.N)
+    seen = np.zeros(len(P), int)
+
+    def count(index, ids, fields):
+        seen[ids] += 1
+
+    assert same_fields(whole, fd.curvature(str(path), client, tile_vertices=700, on_tile=count))
+    assert (seen == 1).all()
+    out = tmp_path / "fields.csv"
+    r = run_cli(str(path), "-o", str(out), "--scheduler", client.scheduler.address,
+                "--tile-vertices", "900")
+    assert r.returncode == 0, r.stderr
+    # The command line runs the library's default plan (k=0), as `focal curvature` on a cloud.
+    expected = tmp_path / "whole.csv"
+    focal.write_fields(expected, focal.cloud_curvature(m.V, m.N, k=0))
+    assert out.read_bytes() == expected.read_bytes()
+    with pytest.raises(focal.InvalidInputError, match="applies to meshes"):
+        fd.curvature(str(path), client, estimator="paper")
+    with pytest.raises(focal.InvalidInputError, match="tile_vertices"):
+        fd.cloud_curvature(P, None, client, tile_vertices=0)
+    with pytest.raises(focal.InvalidInputError, match="normals"):
+        fd.cloud_curvature(P, N[:10], client)
 
 
 def run_cli(*args):

@@ -163,11 +163,22 @@ Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options)
   return neighbourhoods_without(V, options, {});
 }
 
-CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
-                                        const CloudOptions& options) {
+Neighbourhoods cloud_fit_neighbourhoods(PositionsRef V, const CloudOptions& options, int k,
+                                        const std::vector<char>& excluded) {
+  CloudOptions o = options;
+  if (o.radius == 0.0) o.k = k;
+  // No point left out: the lists of no exclusion (the same lists, as a whole run takes them).
+  const bool any = std::find(excluded.begin(), excluded.end(), 1) != excluded.end();
+  return neighbourhoods_without(V, o, any ? excluded : std::vector<char>{});
+}
+
+CloudCurvature plan_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
+                                    const CloudOptions& options) {
   validate(V, N, options);
-  CloudCurvature out =
-      uses_plan(options) ? adaptive_plan(V, N, options) : given_neighbours(V, N, options);
+  return uses_plan(options) ? adaptive_plan(V, N, options) : given_neighbours(V, N, options);
+}
+
+void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions& options) {
   std::vector<char> ok;
   out.N = detail::unit_rows(out.N, ok, options.threads);
   CurvatureOptions fit;
@@ -191,6 +202,12 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
     detail::robust_fit_vertices({input, {}, 0.0}, all, detail::class_tolerances(fit, scale),
                                 options.threads, true, out.curvature);
   }
+}
+
+CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
+                                        const CloudOptions& options) {
+  CloudCurvature out = plan_cloud_curvature(V, N, options);
+  fit_cloud_curvature(V, out, options);
   return out;
 }
 

@@ -96,6 +96,19 @@ void sort_ids(std::vector<int>& ids) {
   }
 }
 
+/// The tile's vertices (those reached, sorted) and the rows of its owned ones (ascending).
+void set_vertices(Tile& tile, std::vector<int> reached, const std::vector<int>& owned_ids) {
+  tile.vertices = std::move(reached);
+  sort_ids(tile.vertices);
+  tile.owned.reserve(owned_ids.size());
+  // Both ascending: one walk finds each owned vertex's row.
+  std::size_t row = 0;
+  for (int v : owned_ids) {
+    while (tile.vertices[row] != v) ++row;
+    tile.owned.push_back(static_cast<int>(row));
+  }
+}
+
 /// Marks of one search, per vertex or face: `mark[i] == stamp` means i was reached by the search
 /// of that stamp, so the marks are never cleared between tiles.
 struct Marks {
@@ -134,16 +147,48 @@ Tile make_tile(std::vector<int> owned_ids, FacesRef F, const detail::VertexFaces
     ring_begin = ring_end;
   }
   sort_ids(tile.faces);
-  tile.vertices = std::move(reached);
-  sort_ids(tile.vertices);
-  tile.owned.reserve(owned_ids.size());
-  // Both ascending: one walk finds each owned vertex's row.
-  std::size_t row = 0;
-  for (int v : owned_ids) {
-    while (tile.vertices[row] != v) ++row;
-    tile.owned.push_back(static_cast<int>(row));
-  }
+  set_vertices(tile, std::move(reached), owned_ids);
   return tile;
+}
+
+/// The cloud tile owning `owned_ids` (ascending): the points within `depth` links of them.
+Tile make_cloud_tile(std::vector<int> owned_ids, const Neighbourhoods& neighbours, int depth,
+                     int stamp, std::vector<int>& mark) {
+  std::vector<int> reached = owned_ids;
+  for (int v : reached) mark[static_cast<std::size_t>(v)] = stamp;
+  std::size_t begin = 0;
+  for (int step = 1; step <= depth; ++step) {
+    const std::size_t end = reached.size();
+    for (std::size_t k = begin; k < end; ++k) {
+      for (const int* j = neighbours.begin(reached[k]); j != neighbours.end(reached[k]); ++j) {
+        int& m = mark[static_cast<std::size_t>(*j)];
+        if (m != stamp) {
+          m = stamp;
+          reached.push_back(*j);
+        }
+      }
+    }
+    begin = end;
+  }
+  Tile tile;
+  set_vertices(tile, std::move(reached), owned_ids);
+  return tile;
+}
+
+/// Consecutive runs of `step` vertices of `order`, each sorted, handed to make(t, owned, slot)
+/// in parallel; `slot` is the worker's.
+template <class Make>
+void for_each_tile_of(const std::vector<int>& order, std::size_t step, int threads,
+                      std::vector<Tile>& tiles, const Make& make) {
+  tiles.resize((order.size() + step - 1) / step);
+  detail::parallel_chunks(static_cast<std::int64_t>(tiles.size()), threads, [&](std::int64_t t) {
+    const std::size_t first = static_cast<std::size_t>(t) * step;
+    const std::size_t last = std::min(order.size(), first + step);
+    std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
+                           order.begin() + static_cast<std::ptrdiff_t>(last));
+    sort_ids(owned);
+    tiles[static_cast<std::size_t>(t)] = make(static_cast<int>(t), std::move(owned));
+  });
 }
 
 void check_ids(const std::vector<int>& ids, Eigen::Index size, const char* what) {
@@ -165,28 +210,20 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
   const std::vector<int> order = morton_order(V, options.threads);
   Tiling out;
   out.halo_rings = halo_rings;
-  const auto step = static_cast<std::size_t>(options.tile_vertices);
-  out.tiles.resize((order.size() + step - 1) / step);
   // Tiles in parallel, each thread with its own marks (a tile's stamp is its index, so marks
   // are never cleared): 8 bytes per vertex and face per thread, allocated on first use.
   std::vector<std::unique_ptr<Marks>> marks(
       static_cast<std::size_t>(detail::thread_count(options.threads)));
-  detail::parallel_chunks(
-      static_cast<std::int64_t>(out.tiles.size()), options.threads, [&](std::int64_t t) {
-        auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
-        if (!m) {
-          m = std::make_unique<Marks>(
-              Marks{std::vector<int>(order.size(), -1),
-                    std::vector<int>(static_cast<std::size_t>(F.rows()), -1)});
-        }
-        const std::size_t first = static_cast<std::size_t>(t) * step;
-        const std::size_t last = std::min(order.size(), first + step);
-        std::vector<int> owned(order.begin() + static_cast<std::ptrdiff_t>(first),
-                               order.begin() + static_cast<std::ptrdiff_t>(last));
-        sort_ids(owned);
-        out.tiles[static_cast<std::size_t>(t)] =
-            make_tile(std::move(owned), F, inc, halo_rings, static_cast<int>(t), *m);
-      });
+  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), options.threads,
+                   out.tiles, [&](int t, std::vector<int> owned) {
+                     auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
+                     if (!m) {
+                       m = std::make_unique<Marks>(
+                           Marks{std::vector<int>(order.size(), -1),
+                                 std::vector<int>(static_cast<std::size_t>(F.rows()), -1)});
+                     }
+                     return make_tile(std::move(owned), F, inc, halo_rings, t, *m);
+                   });
   return out;
 }
 
@@ -255,6 +292,86 @@ TileEstimate estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& opt
   for (const Tile& tile : tiling.tiles) {
     const TileEstimate part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
                                             choices, options, tiles.threads);
+    scatter_rows(part, tile.owned, tile.vertices, out);
+  }
+  return out;
+}
+
+Tiling partition_cloud(PositionsRef V, const Neighbourhoods& neighbours, int halo_depth,
+                       const TileOptions& options) {
+  if (halo_depth < 0) throw InvalidInput("partition_cloud: halo_depth must be >= 0");
+  if (options.tile_vertices < 1) throw InvalidInput("partition_cloud: tile_vertices must be >= 1");
+  if (neighbours.vertex_count() != V.rows()) {
+    throw InvalidInput("partition_cloud: the neighbourhoods are not V's");
+  }
+  const std::vector<int> order = morton_order(V, options.threads);
+  Tiling out;
+  out.halo_rings = halo_depth;
+  std::vector<std::unique_ptr<std::vector<int>>> marks(
+      static_cast<std::size_t>(detail::thread_count(options.threads)));
+  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), options.threads,
+                   out.tiles, [&](int t, std::vector<int> owned) {
+                     auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
+                     if (!m) m = std::make_unique<std::vector<int>>(order.size(), -1);
+                     return make_cloud_tile(std::move(owned), neighbours, halo_depth, t, *m);
+                   });
+  return out;
+}
+
+TileCloud extract_cloud_tile(PositionsRef V, NormalsRef N, const std::vector<char>& outlier,
+                             const Tile& tile) {
+  check_ids(tile.vertices, V.rows(), "vertex");
+  if (N.rows() != V.rows()) throw InvalidInput("extract_cloud_tile: N is not #V x 3");
+  if (!outlier.empty() && outlier.size() != static_cast<std::size_t>(V.rows())) {
+    throw InvalidInput("extract_cloud_tile: the outlier flags are not #V");
+  }
+  TileCloud out;
+  const auto n = static_cast<Eigen::Index>(tile.vertices.size());
+  out.V.resize(n, 3);
+  out.N.resize(n, 3);
+  if (!outlier.empty()) out.outlier.resize(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int id = tile.vertices[static_cast<std::size_t>(i)];
+    out.V.row(i) = V.row(id);
+    out.N.row(i) = N.row(id);
+    if (!outlier.empty()) {
+      out.outlier[static_cast<std::size_t>(i)] = outlier[static_cast<std::size_t>(id)];
+    }
+  }
+  return out;
+}
+
+void require_tileable(const CloudOptions& options) {
+  if (options.adaptive_radius > 0.0) {
+    throw InvalidInput(
+        "tiles: adaptive radius neighbourhoods are not tiled (a point's radius depends on its "
+        "neighbours' neighbours, beyond a tile's halo); estimate the cloud whole");
+  }
+}
+
+TileEstimate estimate_cloud_tile(const TileCloud& tile, const CloudWideChoices& choices,
+                                 const CloudOptions& options) {
+  require_tileable(options);
+  if (tile.N.rows() != tile.V.rows()) throw InvalidInput("estimate_cloud_tile: N is not #V x 3");
+  CloudCurvature plan;
+  plan.N = tile.N;
+  plan.spacing = choices.spacing;
+  plan.k = choices.k;
+  plan.neighbours = cloud_fit_neighbourhoods(tile.V, options, choices.k, tile.outlier);
+  fit_cloud_curvature(tile.V, plan, options);
+  return {std::move(plan.curvature), {}};
+}
+
+TileEstimate estimate_cloud_tiled(PositionsRef V, std::optional<NormalsRef> N,
+                                  const CloudOptions& options, const TileOptions& tiles) {
+  require_tileable(options);
+  const CloudCurvature plan = plan_cloud_curvature(V, N, options);
+  const Tiling tiling = partition_cloud(V, plan.neighbours, 1, tiles);
+  const CloudWideChoices choices{plan.spacing, plan.k};
+  TileEstimate out{detail::unwritten_result(V.rows()), {}};
+  for (const Tile& tile : tiling.tiles) {
+    const TileEstimate part =
+        estimate_cloud_tile(extract_cloud_tile(V, plan.N, plan.outlier, tile), choices, options);
     scatter_rows(part, tile.owned, tile.vertices, out);
   }
   return out;

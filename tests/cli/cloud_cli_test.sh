@@ -73,6 +73,14 @@ check "OBJ v/vn without faces: normals paired in order, k1 = 1 to 1e-9" below "$
 { echo "x,y,z,nx,ny,nz"; tr ' ' ',' <sphere.xyz; } >s.csv
 run curvature s.csv -o csv-out.csv
 check "comma-separated text with a header: k1 = 1 to 1e-9" below "$(max_dev csv-out.csv 1 1)" 1e-9
+# --tiles N on a cloud: the plan on the whole cloud, the fit in N tiles (docs/SCALE.md): the same
+# file, with the file's normals and without.
+run curvature sphere.xyz -o sphere-tiles.csv --tiles 7
+check "--tiles 7 on a cloud with normals gives the file of the whole run" \
+  bash -c '[[ $1 -eq 0 && -s sphere-tiles.csv ]] && cmp -s sphere.csv sphere-tiles.csv' _ "$rc"
+run curvature bare.xyz -o bare-tiles.csv --tiles 5 --threads 1
+check "--tiles 5 on a cloud without normals gives the file of the whole run" \
+  bash -c '[[ $1 -eq 0 && -s bare-tiles.csv ]] && cmp -s bare.csv bare-tiles.csv' _ "$rc"
 run focal-mesh bare.xyz -o fm
 check "focal-mesh on a cloud writes two focal point clouds" \
   bash -c '[[ $1 -eq 0 && -s fm.focal1.ply && -s fm.focal2.ply ]]' _ "$rc"

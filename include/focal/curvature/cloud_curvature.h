@@ -103,4 +103,26 @@ struct CloudCurvature {
 /// \throw InvalidInput when k < 0, radius < 0 or threads < 0.
 [[nodiscard]] Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options);
 
+/// The two halves of estimate_cloud_curvature, for tiles (focal/tiles/tiles.h): the plan, which
+/// reads the whole cloud (the neighbourhoods, outliers, spacing, noise, normals and which are used:
+/// every field but `curvature`, N not yet made unit), ...
+/// \throw InvalidInput as estimate_cloud_curvature.
+[[nodiscard]] CloudCurvature plan_cloud_curvature(PositionsRef V,
+                                                  std::optional<NormalsRef> N = std::nullopt,
+                                                  const CloudOptions& options = {});
+
+/// ... and the fit of every point over plan.neighbours with plan.N (made unit here, in place)
+/// and plan.spacing, into plan.curvature. Each point's row reads only its own and its
+/// neighbours' positions and normals. plan_cloud_curvature then fit_cloud_curvature is
+/// estimate_cloud_curvature.
+void fit_cloud_curvature(PositionsRef V, CloudCurvature& plan, const CloudOptions& options);
+
+/// The neighbourhoods of a plan's fit: the k nearest (CloudCurvature::k of the plan), or those
+/// within options.radius when it is > 0, leaving out the points flagged in `excluded` (#V flags,
+/// or empty): plan.neighbours, computed on any subset of the cloud that holds a point's
+/// neighbours gives that point's list (ties broken by index, so in the subset's order when it
+/// keeps the cloud's).
+[[nodiscard]] Neighbourhoods cloud_fit_neighbourhoods(PositionsRef V, const CloudOptions& options,
+                                                      int k, const std::vector<char>& excluded);
+
 }  // namespace focal

@@ -18,6 +18,7 @@
 
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/cloud_curvature.h"
 #include "focal/curvature/estimate.h"
 #include "focal/mesh/prepared.h"
 
@@ -86,5 +87,62 @@ struct TileEstimate {
 /// crease flags sized #V, zero, on the first part that has any).
 void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
                   const std::vector<int>& ids, TileEstimate& whole);
+
+// ---- Point clouds --------------------------------------------------------------------------
+//
+// A cloud's tiles hold their owned points and every point within `halo_depth` links of them in
+// a neighbourhood graph; the estimate's is plan.neighbours of plan_cloud_curvature (the lists of
+// the fit), where a depth of 1 suffices: a point's row of the fit reads its own and its
+// neighbours' positions and normals only (fit_cloud_curvature), and a tile that holds a point's
+// neighbours gives the point the same list (cloud_fit_neighbourhoods: ties by index, and a tile
+// keeps the cloud's order). What the plan reads further (the outlier test's neighbours of
+// neighbours, the noise and file-normal choices, which are medians over the cloud, the spacing,
+// and normals oriented by a spanning tree of the whole cloud) is decided once, on the whole
+// cloud, and given to the tiles as CloudWideChoices and per-point rows (normals, outlier flags).
+
+/// Cuts a cloud into tiles of consecutive points in Morton order (as partition_mesh); each
+/// tile's vertices are its owned points and those reached from them in at most `halo_depth`
+/// steps along `neighbours` (#V lists); faces are empty. Tiling::halo_rings is halo_depth.
+/// \throw InvalidInput when the lists are not V's, halo_depth < 0 or tile_vertices < 1.
+[[nodiscard]] Tiling partition_cloud(PositionsRef V, const Neighbourhoods& neighbours,
+                                     int halo_depth, const TileOptions& options = {});
+
+/// What a cloud's tiles take from the whole cloud besides their points' rows
+/// (plan_cloud_curvature).
+struct CloudWideChoices {
+  double spacing = 0.0;  ///< CloudCurvature::spacing: the scale of the class tolerances
+  int k = 0;             ///< CloudCurvature::k: neighbours of the fit (ignored with a radius)
+};
+
+/// A cloud tile's rows, in the tile's (global) order.
+struct TileCloud {
+  RowMatrixX3d V;
+  RowMatrixX3d N;             ///< the plan's normals (CloudCurvature::N)
+  std::vector<char> outlier;  ///< the plan's outlier flags, or empty
+};
+
+/// The rows of `tile` of V, the plan's normals and outlier flags (empty or #V).
+/// \throw InvalidInput when the tile's ids are out of range or N is not #V x 3.
+[[nodiscard]] TileCloud extract_cloud_tile(PositionsRef V, NormalsRef N,
+                                           const std::vector<char>& outlier, const Tile& tile);
+
+/// The fit of a cloud tile with the whole cloud's choices: rows of every tile point, those of
+/// its owned points (with the halo of partition_cloud over plan.neighbours, depth 1) the whole
+/// cloud's. `options` as given to the whole cloud. crease is empty.
+[[nodiscard]] TileEstimate estimate_cloud_tile(const TileCloud& tile,
+                                               const CloudWideChoices& choices,
+                                               const CloudOptions& options);
+
+/// Cloud options whose estimate can be tiled with the halo of estimate_cloud_tile. Adaptive
+/// radii cannot (yet): a point's radius reads its neighbours' own neighbours, beyond the halo.
+/// \throw InvalidInput for adaptive_radius > 0.
+void require_tileable(const CloudOptions& options);
+
+/// estimate_cloud_curvature(V, N, options).curvature, tile by tile: the plan on the whole cloud
+/// (it holds the whole cloud's neighbourhoods and normals: with normals estimated, the normals
+/// of the whole cloud), then the fit tile by tile, the same bits.
+[[nodiscard]] TileEstimate estimate_cloud_tiled(PositionsRef V, std::optional<NormalsRef> N,
+                                                const CloudOptions& options = {},
+                                                const TileOptions& tiles = {});
 
 }  // namespace focal
