@@ -14,6 +14,7 @@
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "curvature/robust_fit.h"
+#include "curvature/spike_repair.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
@@ -439,8 +440,9 @@ void prefer_corrected(const Context& c, const PreparedMesh& fitted, const Vector
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
-/// normals (the mesh's, if any) are used, and the normals to fit, into `out`.
-void choose_normals(const Context& c, RecommendedResult& out) {
+/// normals (the mesh's, if any) are used, and the normals to fit, into `out`. Returns the
+/// mesh-wide choices it used (given or measured).
+RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
   const std::optional<NormalsRef> file = c.mesh.normals();
   const bool has_normals = file.has_value();
   const JetNormals jets = local_jets(c, 2, 3);
@@ -495,6 +497,19 @@ void choose_normals(const Context& c, RecommendedResult& out) {
       out.N.row(v) = keep_file ? Eigen::RowVector3d(file->row(v).normalized()) : max;
     }
   }
+  return mesh_wide;
+}
+
+/// Spikes on trusted file normals (spike_repair.h): the positions with each spike moved back
+/// onto the surface its neighbours and the normals describe, or nothing when there is none.
+std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
+  const RowMatrixX3d& N = detail::unit_normals(c.mesh).N;
+  const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
+  const Eigen::VectorXd off_planes =
+      detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads, false);
+  const std::vector<int> spikes = detail::find_spikes(offset, off_planes, *c.one_ring);
+  if (spikes.empty()) return std::nullopt;
+  return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
 }
 
 }  // namespace
@@ -547,11 +562,15 @@ int recommended_reach(const RecommendedPlan& plan) {
   //    their neighbours' mean, one ring further;
   //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
   //    fitted normals at the corners of the faces of its ball's vertices (at most
-  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings).
+  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings);
+  //  - on clean positions with trusted normals, each position read is the spike repair's
+  //    (spike_repair.h): a spike's offset reads its 1-ring, whether it is isolated the offsets
+  //    of that 1-ring, 2 rings in all.
   const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
   const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
                                  plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
-  return fit_reach + normal_reach;
+  const int position_reach = plan.rings > 1 ? 0 : detail::kSpikeRepairRings;
+  return fit_reach + normal_reach + position_reach;
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
@@ -561,12 +580,28 @@ RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOp
                           options);
 }
 
-RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
-                                                 const RecommendedOptions& options) {
-  validate_options(options, "estimate_curvature_recommended");
+namespace {
+
+/// estimate_curvature_recommended; `repair_spikes`: step 4 may start again on repaired positions.
+RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& options,
+                           bool repair_spikes) {
   Context c = make_context(mesh, options);
   RecommendedResult out;
-  choose_normals(c, out);
+  const RecommendedMeshWide mesh_wide = choose_normals(c, out);
+  if (repair_spikes && out.file_normals_used && out.plan.rings == 1) {
+    // Spikes (step 4): the whole estimate again on the repaired positions, with this mesh's
+    // mesh-wide choices and scale (away from the spikes the positions, and so the estimate, are
+    // the same).
+    if (const std::optional<RowMatrixX3d> V = spike_repaired(c)) {
+      RecommendedOptions o = options;
+      o.mesh_wide = mesh_wide;
+      o.threads = c.threads;
+      const PreparedMesh repaired = detail::PreparedAccess::make(
+          *V, mesh.F(), mesh.normals(), {.threads = c.threads, .mean_edge_length = c.edge_length},
+          "estimate_curvature_recommended");
+      return estimate(repaired, o, false);
+    }
+  }
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
@@ -587,6 +622,14 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
   fill_undefined(c, out.plan, no_skip, out.N, out.curvature);
   if (!out.file_normals_used) detail::undefine_isolated_triangles(mesh.F(), out.curvature);
   return out;
+}
+
+}  // namespace
+
+RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
+                                                 const RecommendedOptions& options) {
+  validate_options(options, "estimate_curvature_recommended");
+  return estimate(mesh, options, true);
 }
 
 RecommendedResult estimate_curvature_recommended(PositionsRef V, FacesRef F,
