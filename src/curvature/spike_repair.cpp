@@ -35,12 +35,18 @@ Eigen::VectorXd normal_offsets(PositionsRef V, const RowMatrixX3d& N, const Neig
     for (const int* j = ring.begin(v); j != ring.end(v); ++j) {
       const Eigen::Vector3d e = p - V.row(*j).transpose();
       const Eigen::Vector3d m = N.row(*j).transpose();
+      if (!m.allFinite()) continue;
+      if (!own_normal) {
+        t.push_back(e.dot(m));
+        continue;
+      }
       const double d = 1.0 + n.dot(m);
-      if (!m.allFinite() || !(d > 0.5)) continue;  // normals within 120 degrees
-      t.push_back(own_normal ? e.dot(n + m) / d : e.dot(m));
+      if (d > 0.5) t.push_back(e.dot(n + m) / d);  // normals within 120 degrees
     }
     const double length = tangent_edge_length(V, ring, v, n);
-    if (t.empty() || !(length > 0.0)) return;
+    // A median of a minority says nothing: a wild own normal leaves most neighbours out.
+    const auto size = static_cast<std::size_t>(ring.end(v) - ring.begin(v));
+    if (t.empty() || 2 * t.size() < size || !(length > 0.0)) return;
     const auto mid = t.begin() + static_cast<std::ptrdiff_t>(t.size() / 2);
     std::nth_element(t.begin(), mid, t.end());
     double median = *mid;

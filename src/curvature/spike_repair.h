@@ -15,8 +15,9 @@ namespace focal::detail {
 /// its neighbours j of (p_i - p_j) . (n_i + n_j) / (1 + n_i . n_j). On a smooth surface with exact
 /// normals the curvature's parts of (p_i - p_j) . n_j and (p_j - p_i) . n_i cancel to third order
 /// (both are -k |e|^2 / 2 + O(|e|^3)), so the offset is O(h^2) in edge lengths; a vertex moved by
-/// t along its normal measures t. N rows unit. NaN where a normal is not finite or the vertex has
-/// no neighbour (neighbours without a finite normal are left out). With `own_normal` false, the
+/// t along its normal measures t. N rows unit. Neighbours without a finite normal or whose
+/// normal is more than 120 degrees from n_i are left out; NaN where n_i is not finite or fewer
+/// than half of the neighbours are left (a wild own normal). With `own_normal` false, the
 /// median of (p_i - p_j) . n_j instead: the distance from the neighbours' tangent planes alone,
 /// O(h) in edge lengths on a smooth surface, and small at a vertex whose normal alone is wrong.
 Eigen::VectorXd normal_offsets(PositionsRef V, const RowMatrixX3d& N, const Neighbourhoods& ring,
