@@ -55,7 +55,7 @@ TEST(SpikeRepair, OffsetsAreSecondOrderSmallOnSmoothSurfaces) {
       const Eigen::VectorXd planes =
           detail::normal_offsets(s.mesh.V, unit(s.mesh.N), ring_of(s.mesh), 1, false);
       EXPECT_LT(planes.cwiseAbs().maxCoeff(), 0.25) << n;
-      EXPECT_TRUE(detail::find_spikes(t, planes, ring_of(s.mesh)).empty()) << n;
+      EXPECT_TRUE(detail::find_spikes(s.mesh.V, unit(s.mesh.N), ring_of(s.mesh), t).empty()) << n;
     }
   }
 }
@@ -70,8 +70,7 @@ TEST(SpikeRepair, FindsSpikesAndRepairsThemOntoTheSurface) {
   N.row(1500) = Eigen::RowVector3d(0.6, 0.0, 0.8);
   const Neighbourhoods ring = ring_of(s.mesh);
   const Eigen::VectorXd t = detail::normal_offsets(s.mesh.V, N, ring, 1);
-  const Eigen::VectorXd planes = detail::normal_offsets(s.mesh.V, N, ring, 1, false);
-  std::vector<int> found = detail::find_spikes(t, planes, ring);
+  std::vector<int> found = detail::find_spikes(s.mesh.V, N, ring, t);
   std::sort(found.begin(), found.end());
   EXPECT_EQ(found, spikes);
   const RowMatrixX3d repaired = detail::repaired_positions(s.mesh.V, N, ring, t, found);
@@ -93,17 +92,16 @@ TEST(SpikeRepair, CreasesAndNoiseAreNotSpikes) {
   const AnalyticSurface capped = make_capped_cylinder(1.0, 2.0, 3000);
   const Neighbourhoods ring = ring_of(capped.mesh);
   const RowMatrixX3d N = unit(capped.mesh.N);
-  EXPECT_TRUE(detail::find_spikes(detail::normal_offsets(capped.mesh.V, N, ring, 1),
-                                  detail::normal_offsets(capped.mesh.V, N, ring, 1, false), ring)
-                  .empty());
+  EXPECT_TRUE(
+      detail::find_spikes(capped.mesh.V, N, ring, detail::normal_offsets(capped.mesh.V, N, ring, 1))
+          .empty());
   // 10% vertex noise moves whole neighbourhoods by a tenth of an edge.
   AnalyticSurface noisy = analytic_surface(SurfaceKind::torus, Triangulation::irregular, 4000, 0.0, 3);
   add_position_noise(noisy.mesh, 0.1, 3);
   const Neighbourhoods noisy_ring = ring_of(noisy.mesh);
   const RowMatrixX3d M = unit(noisy.mesh.N);
-  EXPECT_TRUE(detail::find_spikes(detail::normal_offsets(noisy.mesh.V, M, noisy_ring, 1),
-                                  detail::normal_offsets(noisy.mesh.V, M, noisy_ring, 1, false),
-                                  noisy_ring)
+  EXPECT_TRUE(detail::find_spikes(noisy.mesh.V, M, noisy_ring,
+                                  detail::normal_offsets(noisy.mesh.V, M, noisy_ring, 1))
                   .empty());
 }
 

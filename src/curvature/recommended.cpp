@@ -258,16 +258,41 @@ constexpr double kExactFitResidual = 1e-9;
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
 /// exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
-/// triangles give no estimate, and takes the triangles' elsewhere.
-void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureResult& fit) {
+/// triangles give no estimate, and takes the triangles' elsewhere, except where `replaced` (if
+/// not empty) is set: the corrected step writes those rows, so the pass runs on the faces of the
+/// other vertices only (a vertex's row reads its own faces, in the same order: the same bits).
+void prefer_triangles(const Context& c, const PreparedMesh& fitted,
+                      const std::vector<char>& replaced, CurvatureResult& fit) {
   CurvatureOptions o = paper_options(c);
   o.method = Method::triangle;
-  const CurvatureResult triangles = estimate_curvature(fitted, o);
-  detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
-    const bool exact_fit = fit.residual[i] <= kExactFitResidual;
-    const bool triangles_defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
-    if (!exact_fit && triangles_defined) detail::copy_row(triangles, i, fit, i);
-  });
+  const auto wanted = [&](Eigen::Index i) {
+    return !(fit.residual[i] <= kExactFitResidual) &&
+           (replaced.empty() || !replaced[static_cast<std::size_t>(i)]);
+  };
+  const auto take = [&](const CurvatureResult& triangles) {
+    detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
+      const bool defined = triangles.class_of(static_cast<int>(i)) != PointClass::undefined;
+      if (wanted(i) && defined) detail::copy_row(triangles, i, fit, i);
+    });
+  };
+  const FacesRef& F = fitted.F();
+  std::vector<int> faces;
+  if (!replaced.empty()) {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      if (wanted(F(f, 0)) || wanted(F(f, 1)) || wanted(F(f, 2))) faces.push_back(static_cast<int>(f));
+    }
+  }
+  if (replaced.empty() || faces.size() == static_cast<std::size_t>(F.rows())) {
+    return take(estimate_curvature(fitted, o));
+  }
+  if (faces.empty()) return;
+  RowMatrixX3i part(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t k = 0; k < faces.size(); ++k) part.row(static_cast<Eigen::Index>(k)) = F.row(faces[k]);
+  // The whole mesh's scale (the classes' tolerances), the fitted normals, the same threads.
+  const PreparedMesh sub = detail::PreparedAccess::make(
+      fitted.V(), part, fitted.normals(),
+      {.threads = c.threads, .mean_edge_length = c.edge_length}, "prefer_triangles");
+  take(estimate_curvature(sub, o));
 }
 
 /// The file's normals compared with the jet normals: the side they point to, and per vertex the
@@ -428,15 +453,22 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
 /// Trusted file normals on clean positions: the corrected curvature measures
 /// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
 /// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
-void prefer_corrected(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
-                      CurvatureResult& fit) {
+detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
+                                const VectorXu8& crease, const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
   if (!keep.empty()) {
     for (const int v : near_flagged(c, keep, 2)) keep[static_cast<std::size_t>(v)] = 1;
   }
-  detail::prefer_corrected_measures(fitted, *c.one_ring, paper_options(c), keep,
-                                    kExactFitResidual, fit);
+  // A vertex of one face keeps that face's operator (its spread, the residual, is 0: the
+  // per-triangle pass's row counts as exact, as it did when the pass ran first).
+  keep.resize(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+  const auto incidence = detail::incidence(c.mesh);
+  for (int v = 0; v < c.mesh.vertex_count(); ++v) {
+    if (incidence->size(v) < 2) keep[static_cast<std::size_t>(v)] = 1;
+  }
+  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual,
+                                fit);
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -505,9 +537,7 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
 std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
   const RowMatrixX3d& N = detail::unit_normals(c.mesh).N;
   const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
-  const Eigen::VectorXd off_planes =
-      detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads, false);
-  const std::vector<int> spikes = detail::find_spikes(offset, off_planes, *c.one_ring);
+  const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
   if (spikes.empty()) return std::nullopt;
   return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
 }
@@ -607,11 +637,17 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
   const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+    // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
+    // judge the fit's residual (whether it is exact), before either writes a row.
+    std::optional<detail::CorrectedRows> measures;
+    if (out.file_normals_used) measures = corrected(c, fitted, out.crease, out.curvature);
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
-    prefer_triangles(c, fitted, out.curvature);
-    if (out.file_normals_used) prefer_corrected(c, fitted, out.crease, out.curvature);
+    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{},
+                     out.curvature);
+    if (measures) detail::apply_corrected_rows(*measures, c.threads, out.curvature);
+    measures.reset();
     refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.

@@ -28,15 +28,15 @@ Eigen::VectorXd normal_offsets(PositionsRef V, const RowMatrixX3d& N, const Neig
 /// about 0.1 to 0.3 (docs/ESTIMATOR.md, "Spikes").
 constexpr double kSpikeOffset = 0.75;
 
-/// Spikes: vertices whose offset (normal_offsets) and distance from the neighbours' planes
-/// (`off_planes`, normal_offsets without the own normal) both exceed kSpikeOffset while at most
+/// Spikes: vertices whose offset (`offset`, normal_offsets) and distance from the neighbours'
+/// planes (normal_offsets without the own normal, measured here at candidates only) both exceed kSpikeOffset while at most
 /// one of their neighbours' offsets exceeds half of it. A spike is one vertex off a smooth
 /// surface (or two, side by side: 3% of the evaluation's 0.5% spikes); an outlier normal leaves
 /// the vertex on its neighbours' planes; noise moves whole neighbourhoods; a line of vertices
 /// off the surface (two such neighbours) is a feature, not a spike. The capped cylinder's rims
 /// with exact normals measure offsets of 0.43 and distances of 0.31 at most.
-std::vector<int> find_spikes(const Eigen::VectorXd& offset, const Eigen::VectorXd& off_planes,
-                             const Neighbourhoods& ring);
+std::vector<int> find_spikes(PositionsRef V, const RowMatrixX3d& N, const Neighbourhoods& ring,
+                             const Eigen::VectorXd& offset);
 
 /// Rings a repaired position reads (its 1-ring's offsets, each of which reads a 1-ring).
 constexpr int kSpikeRepairRings = 2;
