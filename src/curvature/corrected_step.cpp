@@ -63,9 +63,9 @@ Eigen::VectorXd stencil_asymmetry(PositionsRef V, const RowMatrixX3d& N,
   return out;
 }
 
-void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
-                               const CurvatureOptions& options, const std::vector<char>& keep,
-                               double exact_residual, CurvatureResult& fit) {
+CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                             const CurvatureOptions& options, const std::vector<char>& keep,
+                             double exact_residual, const CurvatureResult& fit) {
   const UnitNormals& unit = unit_normals(fitted);
   const Eigen::VectorXd asymmetry =
       stencil_asymmetry(fitted.V(), unit.N, one_ring, options.threads);
@@ -79,11 +79,26 @@ void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods&
                     ? kCorrectedBall * local_edge_length(fitted.V(), one_ring, static_cast<int>(i))
                     : 0.0;
   });
-  const CurvatureResult corrected = baselines::detail::corrected_curvature(
-      fitted, unit.N, radius, kCorrectedBallRings, options);
+  CorrectedRows out{baselines::detail::corrected_curvature(fitted, unit.N, radius,
+                                                           kCorrectedBallRings, options),
+                    std::vector<char>(static_cast<std::size_t>(fitted.vertex_count()), 0)};
   parallel_for(fitted.vertex_count(), options.threads, [&](std::int64_t i) {
-    if (radius[i] > 0.0 && std::isfinite(corrected.H[i])) copy_row(corrected, i, fit, i);
+    out.replace[static_cast<std::size_t>(i)] = radius[i] > 0.0 && std::isfinite(out.values.H[i]);
   });
+  return out;
+}
+
+void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResult& fit) {
+  parallel_for(static_cast<std::int64_t>(rows.replace.size()), threads, [&](std::int64_t i) {
+    if (rows.replace[static_cast<std::size_t>(i)]) copy_row(rows.values, i, fit, i);
+  });
+}
+
+void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                               const CurvatureOptions& options, const std::vector<char>& keep,
+                               double exact_residual, CurvatureResult& fit) {
+  apply_corrected_rows(corrected_rows(fitted, one_ring, options, keep, exact_residual, fit),
+                       options.threads, fit);
 }
 
 }  // namespace focal::detail

@@ -52,4 +52,18 @@ void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods&
                                const CurvatureOptions& options, const std::vector<char>& keep,
                                double exact_residual, CurvatureResult& fit);
 
+/// The rows prefer_corrected_measures would write: the measures, and per vertex whether they
+/// replace the row of `fit` (known before `fit`'s rows from the per-triangle pass are, which
+/// then need computing only where this is 0: `fit` is read for its residual only).
+struct CorrectedRows {
+  CurvatureResult values;
+  std::vector<char> replace;
+};
+CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                             const CurvatureOptions& options, const std::vector<char>& keep,
+                             double exact_residual, const CurvatureResult& fit);
+
+/// Writes the rows of `rows` that replace into `fit`.
+void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResult& fit);
+
 }  // namespace focal::detail

@@ -15,6 +15,7 @@
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
 #include "curvature/robust_fit.h"
+#include "curvature/spike_repair.h"
 #include "curvature/triangle_curvature_detail.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
@@ -308,15 +309,42 @@ constexpr double kExactFitResidual = 1e-9;
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
 /// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
 /// exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
-/// triangles give no estimate, and takes the triangles' elsewhere.
-void prefer_triangles(const Context& c, const PreparedMesh& fitted, CurvatureResult& fit) {
+/// triangles give no estimate, and takes the triangles' elsewhere, except where `replaced` (if
+/// not empty) is set: the corrected step writes those rows, so the pass runs on the faces of the
+/// other vertices only (a vertex's row reads its own faces, in the same order: the same bits).
+void prefer_triangles(const Context& c, const PreparedMesh& fitted,
+                      const std::vector<char>& replaced, CurvatureResult& fit) {
   CurvatureOptions o = paper_options(c);
   o.method = Method::triangle;
-  std::vector<char> inexact(static_cast<std::size_t>(fitted.vertex_count()));
-  detail::parallel_for(fitted.vertex_count(), c.threads, [&](std::int64_t i) {
-    inexact[static_cast<std::size_t>(i)] = !(fit.residual[i] <= kExactFitResidual);
+  const Eigen::Index n = fitted.vertex_count();
+  std::vector<char> wanted(static_cast<std::size_t>(n));
+  detail::parallel_for(n, c.threads, [&](std::int64_t i) {
+    const auto v = static_cast<std::size_t>(i);
+    wanted[v] = !(fit.residual[i] <= kExactFitResidual) && (replaced.empty() || !replaced[v]);
   });
-  detail::replace_with_triangles(fitted, o, inexact, fit);
+  const FacesRef& F = fitted.F();
+  std::vector<int> faces;
+  if (!replaced.empty()) {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      if (wanted[static_cast<std::size_t>(F(f, 0))] || wanted[static_cast<std::size_t>(F(f, 1))] ||
+          wanted[static_cast<std::size_t>(F(f, 2))]) {
+        faces.push_back(static_cast<int>(f));
+      }
+    }
+  }
+  if (replaced.empty() || faces.size() == static_cast<std::size_t>(F.rows())) {
+    return detail::replace_with_triangles(fitted, o, wanted, fit);
+  }
+  if (faces.empty()) return;
+  RowMatrixX3i part(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t k = 0; k < faces.size(); ++k) {
+    part.row(static_cast<Eigen::Index>(k)) = F.row(faces[k]);
+  }
+  // The whole mesh's scale (the classes' tolerances), the fitted normals, the same threads.
+  const PreparedMesh sub = detail::PreparedAccess::make(
+      fitted.V(), part, fitted.normals(),
+      {.threads = c.threads, .mean_edge_length = c.edge_length}, "prefer_triangles");
+  detail::replace_with_triangles(sub, o, wanted, fit);
 }
 
 /// The file's normals compared with the jet normals: the side they point to, and per vertex the
@@ -481,20 +509,28 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
 /// Trusted file normals on clean positions: the corrected curvature measures
 /// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
 /// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
-void prefer_corrected(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
-                      CurvatureResult& fit) {
+detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
+                                const VectorXu8& crease, const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
   if (!keep.empty()) {
     for (const int v : near_flagged(c, keep, 2)) keep[static_cast<std::size_t>(v)] = 1;
   }
-  detail::prefer_corrected_measures(fitted, *c.one_ring, paper_options(c), keep,
-                                    kExactFitResidual, fit);
+  // A vertex of one face keeps that face's operator (its spread, the residual, is 0: the
+  // per-triangle pass's row counts as exact, as it did when the pass ran first).
+  keep.resize(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+  const auto incidence = detail::incidence(c.mesh);
+  for (int v = 0; v < c.mesh.vertex_count(); ++v) {
+    if (incidence->size(v) < 2) keep[static_cast<std::size_t>(v)] = 1;
+  }
+  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual,
+                                fit);
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
-/// normals (the mesh's, if any) are used, and the normals to fit, into `out`.
-void choose_normals(const Context& c, RecommendedResult& out) {
+/// normals (the mesh's, if any) are used, and the normals to fit, into `out`. Returns the
+/// mesh-wide choices it used (given or measured).
+RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
   const std::optional<NormalsRef> file = c.mesh.normals();
   const bool has_normals = file.has_value();
   const JetNormals jets = local_jets(c, 2, 3);
@@ -545,6 +581,17 @@ void choose_normals(const Context& c, RecommendedResult& out) {
       out.N.row(v) = keep_file ? Eigen::RowVector3d(file->row(v).normalized()) : max;
     }
   }
+  return mesh_wide;
+}
+
+/// Spikes on trusted file normals (spike_repair.h): the positions with each spike moved back
+/// onto the surface its neighbours and the normals describe, or nothing when there is none.
+std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
+  const RowMatrixX3d& N = detail::unit_normals(c.mesh).N;
+  const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
+  const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
+  if (spikes.empty()) return std::nullopt;
+  return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
 }
 
 }  // namespace
@@ -597,11 +644,15 @@ int recommended_reach(const RecommendedPlan& plan) {
   //    their neighbours' mean, one ring further;
   //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
   //    fitted normals at the corners of the faces of its ball's vertices (at most
-  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings).
+  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings);
+  //  - on clean positions with trusted normals, each position read is the spike repair's
+  //    (spike_repair.h): a spike's offset reads its 1-ring, whether it is isolated the offsets
+  //    of that 1-ring, 2 rings in all.
   const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
   const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
                                  plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
-  return fit_reach + normal_reach;
+  const int position_reach = plan.rings > 1 ? 0 : detail::kSpikeRepairRings;
+  return fit_reach + normal_reach + position_reach;
 }
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
@@ -611,22 +662,44 @@ RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOp
                           options);
 }
 
-RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
-                                                 const RecommendedOptions& options) {
-  validate_options(options, "estimate_curvature_recommended");
+namespace {
+
+/// estimate_curvature_recommended; `repair_spikes`: step 4 may start again on repaired positions.
+RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& options,
+                           bool repair_spikes) {
   Context c = make_context(mesh, options);
   RecommendedResult out;
-  choose_normals(c, out);
+  const RecommendedMeshWide mesh_wide = choose_normals(c, out);
+  if (repair_spikes && out.file_normals_used && out.plan.rings == 1) {
+    // Spikes (step 4): the whole estimate again on the repaired positions, with this mesh's
+    // mesh-wide choices and scale (away from the spikes the positions, and so the estimate, are
+    // the same).
+    if (const std::optional<RowMatrixX3d> V = spike_repaired(c)) {
+      RecommendedOptions o = options;
+      o.mesh_wide = mesh_wide;
+      o.threads = c.threads;
+      const PreparedMesh repaired = detail::PreparedAccess::make(
+          *V, mesh.F(), mesh.normals(), {.threads = c.threads, .mean_edge_length = c.edge_length},
+          "estimate_curvature_recommended");
+      return estimate(repaired, o, false);
+    }
+  }
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
+    // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
+    // judge the fit's residual (whether it is exact), before either writes a row.
+    std::optional<detail::CorrectedRows> measures;
+    if (out.file_normals_used) measures = corrected(c, fitted, out.crease, out.curvature);
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
-    prefer_triangles(c, fitted, out.curvature);
-    if (out.file_normals_used) prefer_corrected(c, fitted, out.crease, out.curvature);
+    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{},
+                     out.curvature);
+    if (measures) detail::apply_corrected_rows(*measures, c.threads, out.curvature);
+    measures.reset();
     refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
@@ -637,6 +710,14 @@ RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
   fill_undefined(c, out.plan, no_skip, out.N, out.curvature);
   if (!out.file_normals_used) detail::undefine_isolated_triangles(mesh.F(), out.curvature);
   return out;
+}
+
+}  // namespace
+
+RecommendedResult estimate_curvature_recommended(const PreparedMesh& mesh,
+                                                 const RecommendedOptions& options) {
+  validate_options(options, "estimate_curvature_recommended");
+  return estimate(mesh, options, true);
 }
 
 RecommendedResult estimate_curvature_recommended(PositionsRef V, FacesRef F,

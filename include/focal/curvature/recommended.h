@@ -37,7 +37,12 @@
 ///     rows over a ball of the vertex's mean edge length, where its 1-ring is not centrally
 ///     symmetric (on grids first-order errors cancel and the per-triangle pass stays), not
 ///     within 2 rings of a crease (src/curvature/corrected_step.h; measured in
-///     docs/ESTIMATOR.md, "The corrected step").
+///     docs/ESTIMATOR.md, "The corrected step"). Spikes first: where the file's normals are
+///     used on clean positions, an isolated vertex that lies off its neighbours' tangent planes
+///     and off the surface its own and their normals agree on, by more than 0.75 edge lengths
+///     (kSpikeOffset), is moved back along its normal onto that surface, and the whole estimate
+///     runs again on the repaired positions with this mesh's mesh-wide choices
+///     (src/curvature/spike_repair.h; docs/ESTIMATOR.md, "Spikes").
 ///  5. Creases (clean positions only): an edge whose faces' normals differ by more than
 ///     RecommendedOptions::crease_angle (60 degrees) is sharp, its corners are crease vertices
 ///     (RecommendedResult::crease). Within 2 rings of them the normals are Max's (each face lies
@@ -168,8 +173,10 @@ struct RecommendedPlan {
 /// once and passed). A vertex's normal reads at most max(4, jet_rings + 2) rings (2-ring jets
 /// from Max's normals, rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned
 /// with the 1-ring); the fit reads the normals of rings + kMaxExtraRings rings, and the normals
-/// that the refit of undefined vertices replaced by their neighbours' mean one ring further. 8 on
-/// clean positions, 12 at most (kRecommendedMaxReach). Derived in recommended.cpp.
+/// that the refit of undefined vertices replaced by their neighbours' mean one ring further; on
+/// clean positions every position read may be a spike's repaired one, which reads 2 rings
+/// further. 10 on clean positions, 12 at most (kRecommendedMaxReach). Derived in
+/// recommended.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
 /// recommended_reach of the widest plan (3 rings, 4-ring jets).
