@@ -3,8 +3,10 @@
 #   scripts/accuracy.sh [path/to/focal]
 # Always: focal's tables (`focal eval`) and, when Debian's libcgal-demo data is installed, the
 # scanned-mesh table (`focal eval --scan`). When bench/peers/.venv exists (bench/peers/setup.sh):
-# also the peers (libigl, pymeshlab, trimesh, VTK) on the same exported cases and scans, the
-# merged table, the issue 4 target count, the plots and the timing table. Nothing in the text is
+# also the peers (libigl, pymeshlab, trimesh, VTK, and CGAL's jet fitting where Debian's
+# libcgal-dev is installed) on the same exported cases, hard cases and scans, the merged tables,
+# the issue 4 and issue 16 target counts, the principal-direction table, the plots and the timing
+# table. Nothing in the text is
 # a number typed by hand: every figure below comes from this run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,14 +21,15 @@ start=$SECONDS
 say() { echo "[$((SECONDS - start)) s] $*" >&2; }
 
 rm -rf "$work" && mkdir -p "$docs" "$work/scans"
-rm -f "$docs"/*.png "$docs"/*.ply "$docs"/*.md "$docs"/{peers,merged,scans-focal,scans-peers,hard}.csv
+rm -f "$docs"/*.png "$docs"/*.ply "$docs"/*.md \
+  "$docs"/{peers,merged,scans-focal,scans-peers,hard,hard-peers,hard-merged,directions}.csv
 say "focal eval (48 cases, about 4000 vertices each)"
 "$focal" eval --suite standard --vertices 4000 --seed 1 --csv "$docs/eval.csv" \
   --markdown "$work/focal.md" --export "$work/cases" >/dev/null
 python3 scripts/baseline_medians.py "$docs/eval.csv" >"$work/baselines.md"
 say "focal eval --suite hard (41 hard cases of issue 16)"
 "$focal" eval --suite hard --vertices 4000 --seed 1 --csv "$docs/hard.csv" \
-  --markdown "$work/hard.md" >/dev/null
+  --markdown "$work/hard.md" --export "$work/hard-cases" >/dev/null
 
 have_scans=0
 if [[ -f $cgal_data ]]; then
@@ -44,10 +47,27 @@ if [[ -x $py ]]; then
   have_peers=1
   export PYTHONPATH=bench/peers PYTHONDONTWRITEBYTECODE=1  # no __pycache__ in the tree
   # pymeshlab prints "average vertex num in each fit" per quadric fit on stdout: dropped.
+  # CGAL 5.5's jet fitting (bench/points/cgal_peer.cpp) joins the peers where its headers are.
+  if [[ -f /usr/include/CGAL/Monge_via_jet_fitting.h ]] && command -v g++ >/dev/null; then
+    say "peers: building CGAL's jet fitting (bench/points/cgal_peer.cpp)"
+    launcher=$(command -v ccache || true)
+    $launcher g++ -std=c++17 -O2 -DNDEBUG -DCGAL_EIGEN3_ENABLED -I/usr/include/eigen3 \
+      bench/points/cgal_peer.cpp -o "$work/cgal_peer" -lgmp -lmpfr
+    export FOCAL_CGAL_PEER=$PWD/$work/cgal_peer
+  else
+    say "no CGAL headers (Debian package libcgal-dev): CGAL's jet fitting skipped"
+  fi
   say "peers: sign check on the unit sphere"
   "$py" bench/peers/peers.py signs "$work/cases" | grep '^|' >"$work/signs.md"
-  say "peers: accuracy on the exported cases"
-  "$py" bench/peers/peers.py accuracy "$work/cases" --csv "$docs/peers.csv" >/dev/null
+  say "peers: direction check on the torus"
+  "$py" bench/peers/peers.py directions "$work/cases" | grep '^|' >"$work/directions-check.md"
+  say "peers: accuracy on the exported cases and hard cases (two processes)"
+  "$py" bench/peers/peers.py accuracy "$work/cases" --csv "$docs/peers.csv" >/dev/null \
+    2>"$work/peers.log" &
+  standard_peers=$!
+  "$py" bench/peers/peers.py accuracy "$work/hard-cases" --csv "$docs/hard-peers.csv" \
+    >/dev/null 2>"$work/hard-peers.log"
+  wait "$standard_peers"
   report_scans=()
   if ((have_scans)); then
     say "peers: scans"
@@ -62,9 +82,9 @@ if [[ -x $py ]]; then
   fi
   say "merged table, target count, plots"
   "$py" bench/peers/report.py --eval "$docs/eval.csv" --peers "$docs/peers.csv" --out "$work" \
-    "${report_scans[@]}"
+    --hard-eval "$docs/hard.csv" --hard-peers "$docs/hard-peers.csv" "${report_scans[@]}"
   mv "$work"/*.png "$docs/"
-  cp "$work/merged.csv" "$docs/"
+  cp "$work"/{merged,hard-merged,directions}.csv "$docs/"
   versions=$("$py" -m pip freeze |
     grep -iE '^(libigl|pymeshlab|trimesh|rtree|scipy|pyvista|vtk|numpy|matplotlib)==' |
     sed 's/^/- /')
@@ -169,8 +189,14 @@ Each peer runs with its library's defaults on the exported mesh (\`bench/peers/p
   ball of radius r around the vertex; divided by pi r^2 (the area of the surface inside a small
   ball; exact on a sphere) they are curvature densities. r = 2 mean edge lengths. No k1, k2.
 - **VTK vtkCurvatures**: pyvista \`curvature("mean" | "gaussian" | "maximum" | "minimum")\`.
+- **CGAL jet fitting (k = 24)**: CGAL 5.5's \`Monge_via_jet_fitting\` (Debian libcgal-dev; degree-2
+  jet, degree-2 Monge form) over the vertex and its 24 nearest vertices (about its 2-ring), by
+  \`bench/points/cgal_peer.cpp\` (the point-cloud peer of docs/POINTS.md, built by this script);
+  the area-weighted normal of the faces only orients each Monge form. Left out where CGAL's
+  headers are missing.
 
-All peers use positions only: the libigl, trimesh and VTK calls take no normals, and the
+All peers use positions only: the libigl, trimesh and VTK calls take no normals, CGAL's fit
+gets the normals of the faces (from the positions) for its orientation only, and the
 pymeshlab filters return the same values whether they get the exact, noisy or zero normals
 (checked), so every peer counts as positions-only below.
 
@@ -245,7 +271,10 @@ the capped cylinder (`make_capped_cylinder`), truth per smooth piece, the rim ve
 crease) not scored. All metrics per case and method in [accuracy/hard.csv](accuracy/hard.csv);
 "lowest" counts a case where focal default's error is at most the lowest of every other method
 in the table (file normals) or of the other positions-only methods (no normals), within 0.1%.
-The peers are not run on these cases yet (their comparison is the held-out suite of the issue).
+This table (from `focal eval`) has focal's settings and baselines only; the peers run on the
+same exported cases (`focal eval --suite hard --export DIR`, the near-boundary cases' truth
+flagging rings 1-2 as scored and the crease vertices as not) in the next subsection, which
+gives the counts of issue 16's target.
 
 HARD
   cat "$work/hard.md"
@@ -272,6 +301,51 @@ Where focal default loses on these cases (measured, docs/ESTIMATOR.md "Hard case
   faces past any angle), so the noisy capped cylinder is fitted across its rims; its error is
   still the lowest of the table.
 HARDLOSSES
+  if ((have_peers)); then
+    cat <<'HARDPEERS'
+
+### Hard cases with the peers
+
+The same hard cases, measured by `peers.py accuracy` on the cases exported by
+`focal eval --suite hard --export`, merged with accuracy/hard.csv in
+[accuracy/hard-merged.csv](accuracy/hard-merged.csv) (per-peer CSV:
+[accuracy/hard-peers.csv](accuracy/hard-peers.csv)). The count of issue 16's target: focal
+default against the lowest of every other method, focal's settings, baselines and peers (file
+normals; every peer is positions-only), and against the other positions-only methods including
+every peer (no normals). Per case: focal default, the lowest of focal's other settings and
+baselines, and each peer (best of the row in bold).
+
+HARDPEERS
+    cat "$work/hard-peers.md"
+    cat <<'DIRECTIONS'
+
+## Principal directions
+
+The error of a principal direction is the angle between the estimated and the exact d1 (the
+direction of k1, the larger principal curvature) as lines, mod pi, in degrees (0 to 90); a
+missing or zero direction counts as 90. It is scored at the case's scored vertices (as for H:
+interior, or rings 1-2 for the near-boundary cases, creases not scored) where the estimate is
+defined and the exact k1 - k2 exceeds 0.2 times the largest |k1|, |k2| of the surface (off the
+umbilics, where d1 is not defined or not stable): `mean_angle_d1` (and `median_angle_d1`) in
+the CSVs, the same rule in `focal::evaluate` (src/evaluation/evaluation.cpp) and in
+`peers.py`. Cases without such vertices (the spheres) have no direction error and are left out.
+
+Which peers give directions, the direction taken as focal's d1, and the check on the exported
+irregular torus (`peers.py directions`: the script stops if a median angle is 10 degrees or
+more, i.e. the wrong one of the two directions):
+
+DIRECTIONS
+    cat "$work/directions-check.md"
+    cat <<'DIRECTIONS2'
+
+focal default's mean angle against the lowest mean angle of the peers that give directions,
+per case (ties within 0.1% count as ahead); grouped by triangulation and noise (standard
+suite) or category (hard cases), with the medians of each method's mean angle over the group.
+Every value per case in [accuracy/directions.csv](accuracy/directions.csv).
+
+DIRECTIONS2
+    cat "$work/directions.md"
+  fi
   if ((have_scans)); then
     cat <<'SCANS'
 
