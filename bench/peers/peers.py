@@ -203,6 +203,16 @@ def meshlab_apss(V, F, N):
     return {"H": 0.5 * value("Mean"), "K": value("Gauss")}
 
 
+def trueform_principal(V, F, N):
+    import trueform as tf
+    # trueform's principal curvatures over the k = 2 ring (its tutorial's setting): k0 >= k1 and
+    # +1 on the sphere (see `signs`); d0 is the direction of k0, focal's d1.
+    mesh = tf.Mesh(np.ascontiguousarray(F, dtype=np.int32), np.ascontiguousarray(V))
+    k1, k2, d1, _ = (np.asarray(x, dtype=np.float64)
+                     for x in tf.principal_curvatures(mesh, k=2, directions=True))
+    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2, "d1": d1}
+
+
 CGAL_K = 24  # nearest vertices of CGAL's jet fit (with the vertex itself: about its 2-ring)
 
 
@@ -237,6 +247,7 @@ PEERS = {
     "pymeshlab APSS": meshlab_apss,
     "trimesh ball measures / pi r^2": trimesh_measures,
     "VTK vtkCurvatures": vtk_curvatures,
+    "trueform principal_curvatures(k=2)": trueform_principal,
     f"CGAL jet fitting (k = {CGAL_K})": cgal_jets,
 }
 
@@ -357,7 +368,8 @@ def cmd_signs(args):
 
 
 # What each peer returns natively on the unit sphere with outward-oriented (counter-clockwise)
-# faces, measured with pymeshlab 2025.7.post1, libigl 2.6.3, trimesh 5.2.0, VTK 9.7.2.
+# faces, measured with pymeshlab 2025.7.post1, libigl 2.6.3, trimesh 5.2.0, VTK 9.7.2, trueform 0.10.7,
+# CGAL 5.5.
 NATIVE = {
     "libigl principal_curvature (quadric)": "PV1 = PV2 = +1",
     "libigl cotangent H + angle-defect K": "-M^-1 L V = 2 H n (+2 along the outward normal); "
@@ -368,6 +380,7 @@ NATIVE = {
     "pymeshlab APSS": "Mean = k1 + k2 = +2, Gauss = +1",
     "trimesh ball measures / pi r^2": "+H pi r^2 and +K pi r^2 (integrated over the ball)",
     "VTK vtkCurvatures": "Mean = +1, Gauss = +1",
+    "trueform principal_curvatures(k=2)": "k0 = k1 = +1 (k0 the larger)",
     f"CGAL jet fitting (k = {CGAL_K})": "Monge coefficients k = -1 (z along the outward normal)",
 }
 FACTOR = {
@@ -379,6 +392,7 @@ FACTOR = {
     "pymeshlab APSS": "H = Mean / 2",
     "trimesh ball measures / pi r^2": "1 / (pi r^2), r = 2 mean edge lengths",
     "VTK vtkCurvatures": "none",
+    "trueform principal_curvatures(k=2)": "none",
     f"CGAL jet fitting (k = {CGAL_K})": "-1 (in cgal_peer), k1 and k2 swapped",
 }
 
@@ -409,6 +423,7 @@ D1_SOURCE = {
     "pymeshlab Taubin": "PD1 where Min >= Max Curvature, else PD2",
     "pymeshlab normal cycles": "PD2 where Min >= Max Curvature, else PD1",
     "pymeshlab quadric fitting": "PD1 where Min >= Max Curvature, else PD2",
+    "trueform principal_curvatures(k=2)": "d0 (of k0, the larger)",
     f"CGAL jet fitting (k = {CGAL_K})": "minimal_principal_direction (of CGAL's k2 = -focal's k1)",
 }
 
