@@ -3,6 +3,8 @@
 
   peers.py signs DIR                 each peer's native and normalised H on the exported unit
                                      sphere (truth +1): the sign conventions, checked
+  peers.py directions DIR            which peers give principal directions; the one taken as d1
+                                     checked on the exported torus
   peers.py accuracy DIR --csv OUT    every peer on every case exported by `focal eval --export DIR`,
                                      metrics and CSV columns as focal eval's
   peers.py scan MESH... --csv OUT [--fields DIR]
@@ -25,6 +27,7 @@ import re
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -113,8 +116,9 @@ def igl_quadric(V, F, N):
     import igl
     # libigl's quadric fit (Panozzo et al. 2010) with its defaults: radius 5, k-ring
     # neighbourhood. PV1 >= PV2; +1/r on a sphere (see `signs`).
-    _, _, k1, k2, _ = igl.principal_curvature(V, F)
-    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2}
+    # PD1 is the direction of PV1 (the larger): focal's d1 (checked by `directions`).
+    d1, _, k1, k2, _ = igl.principal_curvature(V, F)
+    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2, "d1": d1}
 
 
 def igl_cotangent(V, F, N):
@@ -154,7 +158,7 @@ def vtk_curvatures(V, F, N):
     return out
 
 
-def meshlab_run(V, F, N, call):
+def meshlab_run(V, F, N, call, directions=False):
     import pymeshlab as ml
     ms = ml.MeshSet()
     ms.add_mesh(ml.Mesh(vertex_matrix=V, face_matrix=F, v_normals_matrix=N))
@@ -162,6 +166,9 @@ def meshlab_run(V, F, N, call):
     m = ms.current_mesh()
     if m.vertex_number() != len(V):
         raise RuntimeError("pymeshlab changed the vertex count")
+    if directions:
+        return (m.vertex_scalar_array().copy(), m.vertex_curvature_principal_dir1_matrix().copy(),
+                m.vertex_curvature_principal_dir2_matrix().copy())
     return m.vertex_scalar_array().copy()
 
 
@@ -171,15 +178,21 @@ def meshlab_principal(method):
         # off keeps the vertex order.
         def value(colour):
             return meshlab_run(V, F, N, lambda ms: ms.compute_curvature_principal_directions_per_vertex(
-                method=method, curvcolormethod=colour, autoclean=False))
-        a, b = value("Max Curvature"), value("Min Curvature")
+                method=method, curvcolormethod=colour, autoclean=False), directions=True)
+        (a, pd1, pd2), (b, _, _) = value("Max Curvature"), value("Min Curvature")
         k1, k2 = np.maximum(a, b), np.minimum(a, b)
+        # Measured (and checked by `directions`): the "Min Curvature" scalar b is the larger one
+        # in focal's convention at most vertices, and the direction that belongs to b is vcg's
+        # PD1 for Taubin and quadric fitting, PD2 for normal cycles. Focal's d1 is the direction
+        # of the larger of a and b.
+        of_b, of_a = (pd2, pd1) if method == "Normal Cycles" else (pd1, pd2)
+        d1 = np.where((b >= a)[:, None], of_b, of_a)
         if method == "Normal Cycles":
             # Measured: vcg's normal cycle tensor is not divided by an area; its eigenvalues are
             # k times 2/3 of the 1-ring area (0.6668 on the regular sphere, see `signs`).
             A = (2.0 / 3.0) * vertex_areas(V, F)
             k1, k2 = k1 / A, k2 / A
-        return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2}
+        return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2, "d1": d1}
     return run
 
 
@@ -192,6 +205,40 @@ def meshlab_apss(V, F, N):
     return {"H": 0.5 * value("Mean"), "K": value("Gauss")}
 
 
+def trueform_principal(V, F, N):
+    import trueform as tf
+    # trueform's principal curvatures over the k = 2 ring (its tutorial's setting): k0 >= k1 and
+    # +1 on the sphere (see `signs`); d0 is the direction of k0, focal's d1.
+    mesh = tf.Mesh(np.ascontiguousarray(F, dtype=np.int32), np.ascontiguousarray(V))
+    k1, k2, d1, _ = (np.asarray(x, dtype=np.float64)
+                     for x in tf.principal_curvatures(mesh, k=2, directions=True))
+    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2, "d1": d1}
+
+
+CGAL_K = 24  # nearest vertices of CGAL's jet fit (with the vertex itself: about its 2-ring)
+
+
+def cgal_jets(V, F, N):
+    import igl
+    # CGAL 5.5's Monge_via_jet_fitting (degree-2 jet, degree-2 Monge form) over the CGAL_K
+    # nearest vertices, bench/points/cgal_peer.cpp, built by scripts/accuracy.sh; the binary's
+    # path in FOCAL_CGAL_PEER. The fit reads positions only; the area-weighted normal of the faces
+    # only orients its Monge form (comply_wrt_given_normal). The binary negates CGAL's sign
+    # (a sphere with outward normals has CGAL k = -1/r) into focal's.
+    binary = os.environ.get("FOCAL_CGAL_PEER", "")
+    if not os.access(binary, os.X_OK):
+        raise RuntimeError("FOCAL_CGAL_PEER is not an executable cgal_peer")
+    n = igl.per_vertex_normals(V, F, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
+    with tempfile.TemporaryDirectory() as tmp:
+        xyz, out = os.path.join(tmp, "in.xyz"), os.path.join(tmp, "out.csv")
+        np.savetxt(xyz, np.hstack([V, n]), fmt="%.17g")
+        subprocess.run([binary, xyz, str(CGAL_K), out], check=True, capture_output=True)
+        r = np.genfromtxt(out, delimiter=",", names=True)
+    k1, k2 = r["k1"], r["k2"]
+    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2,
+            "d1": np.column_stack([r["d1x"], r["d1y"], r["d1z"]])}
+
+
 # Display name -> function; NATIVE and FACTOR below document the conventions.
 PEERS = {
     "libigl principal_curvature (quadric)": igl_quadric,
@@ -202,7 +249,15 @@ PEERS = {
     "pymeshlab APSS": meshlab_apss,
     "trimesh ball measures / pi r^2": trimesh_measures,
     "VTK vtkCurvatures": vtk_curvatures,
+    "trueform principal_curvatures(k=2)": trueform_principal,
+    f"CGAL jet fitting (k = {CGAL_K})": cgal_jets,
 }
+
+
+def available_peers():
+    """PEERS without CGAL's jets when no cgal_peer binary is given (FOCAL_CGAL_PEER)."""
+    return {name: peer for name, peer in PEERS.items()
+            if peer is not cgal_jets or os.access(os.environ.get("FOCAL_CGAL_PEER", ""), os.X_OK)}
 
 # --------------------------------------------------------------------------------------------
 # Metrics, as src/evaluation.cpp
@@ -212,6 +267,21 @@ def rms_pair(estimate, exact):
     error = float(np.sum((estimate - exact) ** 2))
     truth = float(np.sum(exact ** 2))
     return error, truth
+
+
+def umbilic_gap(truth):
+    """As focal's evaluation: directions are scored where k1 - k2 > 0.2 max |k| of the surface."""
+    return 0.2 * float(np.max(np.maximum(np.abs(truth["k1"]), np.abs(truth["k2"]))))
+
+
+def line_angles(d, exact):
+    """Angles in degrees between the lines of d and exact (mod pi), as focal's
+    line_angle_degrees; a zero or non-finite direction counts as 90 degrees."""
+    norms = np.linalg.norm(d, axis=1) * np.linalg.norm(exact, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.minimum(1.0, np.abs(np.sum(d * exact, axis=1)) / norms)
+    c = np.where(np.isfinite(c), c, 0.0)
+    return np.degrees(np.arccos(c))
 
 
 def measure(fields, truth, at):
@@ -232,12 +302,21 @@ def measure(fields, truth, at):
         m["rel_" + q] = math.sqrt(error / t) if t > 1e-18 * (error + 1.0) else math.nan
         m["rms_" + q] = math.sqrt(error / n) if n > 0 else math.nan
     m["variance_H"] = float(np.var(fields["H"][idx])) if n > 0 else math.nan
+    m["median_angle_d1"] = m["mean_angle_d1"] = math.nan
+    if "d1" in fields:
+        scored = idx[truth["k1"][idx] - truth["k2"][idx] > umbilic_gap(truth)]
+        if len(scored):
+            exact = np.column_stack([truth["d1x"], truth["d1y"], truth["d1z"]])[scored]
+            angles = np.sort(line_angles(np.asarray(fields["d1"], float)[scored], exact))
+            # focal's median: the element at n / 2 of the sorted angles (nth_element).
+            m["median_angle_d1"] = float(angles[len(angles) // 2])
+            m["mean_angle_d1"] = float(angles.mean())
     return m
 
 
 COLUMNS = ["surface", "triangulation", "noise", "method", "vertices", "undefined", "rel_H",
            "rel_K", "rel_k1", "rel_k2", "rms_H", "rms_K", "rms_k1", "rms_k2", "median_angle_d1",
-           "mean_angle_d1", "variance_H", "boundary_vertices", "boundary_rel_H"]
+           "mean_angle_d1", "variance_H", "boundary_vertices", "boundary_rel_H", "category"]
 
 
 def fmt(x):
@@ -259,15 +338,14 @@ def cmd_accuracy(args):
         V, F, N, truth = read_case(args.dir, case["slug"])
         interior = np.flatnonzero(truth["interior"] == 1)
         near = np.flatnonzero(truth["interior"] == 0)
-        for name, peer in PEERS.items():
+        for name, peer in available_peers().items():
             start = time.perf_counter()
             fields = peer(V, F, N)
             seconds[name] = seconds.get(name, 0) + time.perf_counter() - start
             m, b = measure(fields, truth, interior), measure(fields, truth, near)
             m.update(surface=case["surface"], triangulation=case["triangulation"],
-                     noise=case["noise"], method=name, median_angle_d1=math.nan,
-                     mean_angle_d1=math.nan, boundary_vertices=b["vertices"],
-                     boundary_rel_H=b["rel_H"])
+                     noise=case["noise"], method=name, boundary_vertices=b["vertices"],
+                     boundary_rel_H=b["rel_H"], category=case.get("category", "standard"))
             rows.append(m)
         print(f"  {case['slug']}", file=sys.stderr)
     write_csv(args.csv, COLUMNS, rows)
@@ -281,7 +359,7 @@ def cmd_signs(args):
     print("| peer | native output on the unit sphere (truth H = +1, K = +1) | factor applied |"
           " normalised median H |\n|---|---|---|---|")
     bad = []
-    for name, peer in PEERS.items():
+    for name, peer in available_peers().items():
         fields = peer(V, F, N)
         H = float(np.median(fields["H"]))
         print(f"| {name} | {NATIVE[name]} | {FACTOR[name]} | {H:.4g} |")
@@ -292,7 +370,8 @@ def cmd_signs(args):
 
 
 # What each peer returns natively on the unit sphere with outward-oriented (counter-clockwise)
-# faces, measured with pymeshlab 2025.7.post1, libigl 2.6.3, trimesh 5.2.0, VTK 9.7.2.
+# faces, measured with pymeshlab 2025.7.post1, libigl 2.6.3, trimesh 5.2.0, VTK 9.7.2, trueform 0.10.7,
+# CGAL 5.5.
 NATIVE = {
     "libigl principal_curvature (quadric)": "PV1 = PV2 = +1",
     "libigl cotangent H + angle-defect K": "-M^-1 L V = 2 H n (+2 along the outward normal); "
@@ -303,6 +382,8 @@ NATIVE = {
     "pymeshlab APSS": "Mean = k1 + k2 = +2, Gauss = +1",
     "trimesh ball measures / pi r^2": "+H pi r^2 and +K pi r^2 (integrated over the ball)",
     "VTK vtkCurvatures": "Mean = +1, Gauss = +1",
+    "trueform principal_curvatures(k=2)": "k0 = k1 = +1 (k0 the larger)",
+    f"CGAL jet fitting (k = {CGAL_K})": "Monge coefficients k = -1 (z along the outward normal)",
 }
 FACTOR = {
     "libigl principal_curvature (quadric)": "none",
@@ -313,6 +394,39 @@ FACTOR = {
     "pymeshlab APSS": "H = Mean / 2",
     "trimesh ball measures / pi r^2": "1 / (pi r^2), r = 2 mean edge lengths",
     "VTK vtkCurvatures": "none",
+    "trueform principal_curvatures(k=2)": "none",
+    f"CGAL jet fitting (k = {CGAL_K})": "-1 (in cgal_peer), k1 and k2 swapped",
+}
+
+
+def cmd_directions(args):
+    """Which peers give principal directions, and a check that the direction taken as d1 is the
+    one of k1: its median angle to the exact d1 on the exported torus is below 10 degrees."""
+    V, F, N, truth = read_case(args.dir, "torus-irregular-clean")
+    interior = np.flatnonzero(truth["interior"] == 1)
+    print("| peer | gives directions | taken as focal's d1 | median angle to the exact d1 on "
+          "the irregular torus (degrees) |\n|---|---|---|---|")
+    bad = []
+    for name, peer in available_peers().items():
+        fields = peer(V, F, N)
+        if "d1" not in fields:
+            print(f"| {name} | no | | |")
+            continue
+        angle = measure(fields, truth, interior)["median_angle_d1"]
+        print(f"| {name} | yes | {D1_SOURCE[name]} | {angle:.3g} |")
+        if not angle < 10:
+            bad.append(name)
+    if bad:
+        raise SystemExit("direction check failed for: " + ", ".join(bad))
+
+
+D1_SOURCE = {
+    "libigl principal_curvature (quadric)": "PD1 (of PV1, the larger)",
+    "pymeshlab Taubin": "PD1 where Min >= Max Curvature, else PD2",
+    "pymeshlab normal cycles": "PD2 where Min >= Max Curvature, else PD1",
+    "pymeshlab quadric fitting": "PD1 where Min >= Max Curvature, else PD2",
+    "trueform principal_curvatures(k=2)": "d0 (of k0, the larger)",
+    f"CGAL jet fitting (k = {CGAL_K})": "minimal_principal_direction (of CGAL's k2 = -focal's k1)",
 }
 
 # --------------------------------------------------------------------------------------------
@@ -349,7 +463,7 @@ def cmd_scan(args):
         V, F = read_scan(path)
         name = os.path.splitext(os.path.basename(path))[0]
         N = np.zeros_like(V)  # scans carry no normals; no peer here uses given normals
-        for method, peer in PEERS.items():
+        for method, peer in available_peers().items():
             H = np.asarray(peer(V, F, N)["H"], float)
             r = smoothness(V, F, H)
             r.update(scan=name, method=method)
@@ -440,7 +554,8 @@ def cmd_timing(args):
         f"{statistics.median(w for _, w in paper):.0f}")
     row("focal curvature, default: recommended (normals + curvature)", focal_default,
         f"{statistics.median(w for _, w in default):.0f}")
-    peers = dict(PEERS)
+    # Timed without directions (trueform_curvatures) and CGAL through its own binary (--cgal).
+    peers = {n: p for n, p in PEERS.items() if p not in (cgal_jets, trueform_principal)}
     if args.trueform:
         peers["trueform principal_curvatures (k = 2)"] = trueform_curvatures
     for name, peer in peers.items():
@@ -472,6 +587,8 @@ def main():
     a.add_argument("--csv", required=True)
     s = sub.add_parser("signs")
     s.add_argument("dir")
+    d = sub.add_parser("directions")
+    d.add_argument("dir")
     c = sub.add_parser("scan")
     c.add_argument("meshes", nargs="+")
     c.add_argument("--csv", required=True)
@@ -485,7 +602,7 @@ def main():
     t.add_argument("--trueform", action="store_true", help="also trueform (bench/python)")
     t.add_argument("--cgal", help="also CGAL 5.5 jets: bench/points/cgal_peer (build_peers.sh)")
     args = p.parse_args()
-    {"accuracy": cmd_accuracy, "signs": cmd_signs, "scan": cmd_scan,
+    {"accuracy": cmd_accuracy, "signs": cmd_signs, "directions": cmd_directions, "scan": cmd_scan,
      "timing": cmd_timing}[args.command](args)
 
 

@@ -8,6 +8,6 @@ python=${1:-python3}
 "$python" -m venv .venv
 .venv/bin/pip install --quiet --upgrade pip
 .venv/bin/pip install --quiet -r requirements.txt
-.venv/bin/python -c "import igl, pymeshlab, trimesh, rtree, pyvista, vtk, numpy, matplotlib"
+.venv/bin/python -c "import igl, pymeshlab, trimesh, rtree, pyvista, vtk, numpy, matplotlib, trueform"
 echo "peers installed in bench/peers/.venv:"
-.venv/bin/pip freeze | grep -iE '^(libigl|pymeshlab|trimesh|rtree|scipy|pyvista|vtk|numpy|matplotlib)=='
+.venv/bin/pip freeze | grep -iE '^(libigl|pymeshlab|trimesh|rtree|scipy|pyvista|vtk|numpy|matplotlib|trueform)=='

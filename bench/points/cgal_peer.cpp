@@ -8,8 +8,9 @@
 // z along the normal, so a sphere with outward normals has -1/r; focal's is +1/r. The output is
 // negated (and k1, k2 swapped) into focal's convention.
 //
-// Usage: cgal_peer IN.xyz K OUT.csv   (IN: x y z [nx ny nz] per line). Writes k1,k2,H per point
-// and prints "normals_s fit_s" (wall seconds) on stdout.
+// Usage: cgal_peer IN.xyz K OUT.csv   (IN: x y z [nx ny nz] per line). Writes k1,k2,H and d1 (the
+// unit direction of focal's k1: CGAL's minimal principal direction, the sign being negated) per
+// point and prints "normals_s fit_s" (wall seconds) on stdout.
 
 #include <CGAL/Monge_via_jet_fitting.h>
 #include <CGAL/Orthogonal_k_neighbor_search.h>
@@ -77,6 +78,7 @@ int main(int argc, char** argv) {
   for (const auto& p : points) positions.push_back(std::get<0>(p));
   Search::Tree tree(positions.begin(), positions.end());
   std::vector<double> k1(points.size()), k2(points.size());
+  std::vector<Vector> d1(points.size());
   std::vector<Point> neighbourhood;
   for (std::size_t i = 0; i < points.size(); ++i) {
     neighbourhood.clear();
@@ -87,13 +89,15 @@ int main(int argc, char** argv) {
     form.comply_wrt_given_normal(std::get<1>(points[i]));
     k1[i] = -form.principal_curvatures(1);  // focal's sign: bending away from the normal > 0
     k2[i] = -form.principal_curvatures(0);
+    d1[i] = form.minimal_principal_direction();  // the direction of CGAL's k2, focal's k1
   }
   const auto t2 = Clock::now();
   std::ofstream out(argv[3]);
-  out << "k1,k2,H\n";
+  out << "k1,k2,H,d1x,d1y,d1z\n";
   out.precision(17);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    out << k1[i] << ',' << k2[i] << ',' << 0.5 * (k1[i] + k2[i]) << '\n';
+    out << k1[i] << ',' << k2[i] << ',' << 0.5 * (k1[i] + k2[i]) << ',' << d1[i].x() << ','
+        << d1[i].y() << ',' << d1[i].z() << '\n';
   }
   std::printf("%.4f %.4f\n", std::chrono::duration<double>(t1 - t0).count(),
               std::chrono::duration<double>(t2 - t1).count());

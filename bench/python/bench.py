@@ -7,8 +7,9 @@ on the same NumPy arrays (bench/python/run.sh runs it; docs/PYTHON.md shows its 
   bench.py overhead             the Python call against the C++ call it makes, 100K vertices;
                                 NumPy allocations during the call (copies of inputs would be)
 
-Peers are bench/peers/peers.py's (libigl, pymeshlab, trimesh, VTK through pyvista; their
-outputs brought to focal's sign convention there) plus trueform. Every peer gets the positions
+Peers are bench/peers/peers.py's (libigl, pymeshlab, trimesh, VTK through pyvista, trueform, and
+CGAL's jets where FOCAL_CGAL_PEER names a built bench/points/cgal_peer; their outputs brought to
+focal's sign convention there). Every peer gets the positions
 and faces only, as does focal (its normals from the faces): no one gets exact normals.
 (pymeshlab's mesh takes a normal matrix: zeros are passed; its curvature filters recompute the
 normals, measured: the same H with zeros or area-weighted normals given.)
@@ -30,20 +31,6 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "peers"))
 import peers  # noqa: E402  (bench/peers/peers.py: the peers and their conventions)
 
 
-def trueform_principal(V, F, N):
-    import trueform as tf
-    # trueform's principal curvatures over the k = 2 ring (its tutorial's setting); its sign
-    # convention is checked on the sphere by `signs` below and brought to focal's.
-    mesh = tf.Mesh(np.ascontiguousarray(F, dtype=np.int32), np.ascontiguousarray(V))
-    a, b = (TRUEFORM_SIGN * np.asarray(k, dtype=np.float64)
-            for k in tf.principal_curvatures(mesh, k=2))
-    k1, k2 = np.maximum(a, b), np.minimum(a, b)
-    return {"k1": k1, "k2": k2, "H": 0.5 * (k1 + k2), "K": k1 * k2}
-
-
-TRUEFORM_SIGN = 1.0  # set by calibrate_trueform(): +1 when its sphere curvature is positive
-
-
 def focal_default(V, F, N):
     return focal.curvature(V, F).__dict__
 
@@ -55,18 +42,8 @@ def focal_paper(V, F, N):
 METHODS = {
     "focal (default: recommended)": focal_default,
     "focal estimator=\"paper\"": focal_paper,
-    **peers.PEERS,
-    "trueform principal_curvatures(k=2)": trueform_principal,
+    **peers.available_peers(),
 }
-
-
-def calibrate_trueform():
-    global TRUEFORM_SIGN
-    s = focal.generate_surface("sphere", 2000)
-    H = trueform_principal(s.V, s.F, None)["H"]
-    TRUEFORM_SIGN = 1.0 if np.median(H) > 0 else -1.0
-    print(f"trueform: median H on the unit sphere {np.median(H) * TRUEFORM_SIGN:+.4f} after "
-          f"sign {TRUEFORM_SIGN:+.0f} (truth +1)", file=sys.stderr)
 
 
 def interior(F, n):
@@ -219,8 +196,6 @@ def main():
     o.add_argument("--vertices", type=int, default=100_000)
     o.add_argument("--repeats", type=int, default=11)
     args = p.parse_args()
-    if args.command in ("accuracy", "timing"):
-        calibrate_trueform()
     {"accuracy": cmd_accuracy, "timing": cmd_timing, "overhead": cmd_overhead}[args.command](args)
 
 

@@ -342,8 +342,8 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted,
   }
   // The whole mesh's scale (the classes' tolerances), the fitted normals, the same threads.
   const PreparedMesh sub = detail::PreparedAccess::make(
-      fitted.V(), part, fitted.normals(),
-      {.threads = c.threads, .mean_edge_length = c.edge_length}, "prefer_triangles");
+      fitted.V(), part, fitted.normals(), {.threads = c.threads, .mean_edge_length = c.edge_length},
+      "prefer_triangles");
   detail::replace_with_triangles(sub, o, wanted, fit);
 }
 
@@ -696,8 +696,7 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
-    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{},
-                     out.curvature);
+    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{}, out.curvature);
     if (measures) detail::apply_corrected_rows(*measures, c.threads, out.curvature);
     measures.reset();
     refit_beside_creases(c, fitted, out.crease, out.curvature);
