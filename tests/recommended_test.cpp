@@ -186,10 +186,10 @@ TEST(Recommended, BoundaryVerticesAreEstimated) {
 
 TEST(Recommended, NormalsFromPositionsNearBoundaries) {
   // Without normals on clean positions, the jets of vertices whose 2-ring a boundary cuts fit
-  // over 3 rings (recommended.cpp, with_boundary_jets): a one-sided 2-ring holds about as many
-  // points as a cubic has coefficients. Relative RMS error of H within two rings of the
-  // boundary against the analytic truth, measured: saddle 0.0130, monkey saddle 0.0114,
-  // cylinder 0.0021 (with 2-ring jets there: 0.144, 0.0744, 0.0107).
+  // over 3 rings where that field is smoother (recommended.cpp, with_boundary_jets): a one-sided
+  // 2-ring holds about as many points as a cubic has coefficients. Relative RMS error of H
+  // within two rings of the boundary against the analytic truth, measured: saddle 0.0134,
+  // monkey saddle 0.0114, cylinder 0.0016 (with 2-ring jets there: 0.144, 0.0744, 0.0107).
   struct Case {
     SurfaceKind kind;
     double limit;

@@ -151,9 +151,11 @@ constexpr int kBoundaryJetRings = 3;
 
 /// `jets` (the 2-ring cubic jets) with the rows of vertices whose 2-ring is cut by a boundary
 /// (within kBoundaryJetDistance rings of it) replaced by cubic jets over kBoundaryJetRings
-/// rings: a one-sided 2-ring holds about half an interior 2-ring's points, about as many as a
-/// cubic's 10 coefficients, and its jet nearly interpolates them; the one-sided 3-ring holds
-/// about as many points as an interior 2-ring. Rows where the wider jet fails stay.
+/// rings where those are the smoother field there (1-ring two-slit residual, roughness_of): a
+/// one-sided 2-ring holds about half an interior 2-ring's points, about as many as a cubic's 10
+/// coefficients, and its jet nearly interpolates them; the one-sided 3-ring holds about as many
+/// points as an interior 2-ring (on a thin tube it reaches around it, and the 2-ring may stay
+/// smoother). Rows where the wider jet fails stay.
 RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
   const std::vector<bool> boundary =
       boundary_vertices(static_cast<int>(c.mesh.vertex_count()), c.mesh.F(), c.threads);
@@ -169,6 +171,11 @@ RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
   for (std::size_t k = 0; k < near.size(); ++k) {
     const auto row = static_cast<Eigen::Index>(k);
     if (wide.N.row(row).allFinite()) out.row(near[k]) = wide.N.row(row);
+  }
+  const Eigen::VectorXd r2 = roughness_at(c, jets, near), r3 = roughness_at(c, out, near);
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(k);
+    if (std::isfinite(r2[row]) && !(r3[row] <= r2[row])) out.row(near[k]) = jets.row(near[k]);
   }
   return out;
 }
