@@ -269,7 +269,7 @@ TEST(Tiles, ReachFollowsTheOptions) {
   // No choices yet: the widest plan (3 rings).
   EXPECT_EQ(estimate_reach(recommended), kRecommendedMaxReach);
   recommended.recommended.mesh_wide = RecommendedMeshWide{.noise = 1e-4, .position_noise = 1e-4};
-  EXPECT_EQ(estimate_reach(recommended), 10);
+  EXPECT_EQ(estimate_reach(recommended), 11);
 }
 
 TEST(Tiles, RejectsBadArguments) {

@@ -144,6 +144,42 @@ JetNormals local_jets(const Context& c, int rings, int degree) {
 /// Vertices sampled for the noise measurement: at most about kNoiseSamples, evenly by index.
 constexpr Eigen::Index kNoiseSamples = 4096;
 
+/// Rings from a boundary within which a vertex's 2-ring is cut by it (distances 0 and 1), and
+/// the rings of the jets there (recommended_reach).
+constexpr int kBoundaryJetDistance = 1;
+constexpr int kBoundaryJetRings = 3;
+
+/// `jets` (the 2-ring cubic jets) with the rows of vertices whose 2-ring is cut by a boundary
+/// (within kBoundaryJetDistance rings of it) replaced by cubic jets over kBoundaryJetRings
+/// rings where those are the smoother field there (1-ring two-slit residual, roughness_of): a
+/// one-sided 2-ring holds about half an interior 2-ring's points, about as many as a cubic's 10
+/// coefficients, and its jet nearly interpolates them; the one-sided 3-ring holds about as many
+/// points as an interior 2-ring (on a thin tube it reaches around it, and the 2-ring may stay
+/// smoother). Rows where the wider jet fails stay.
+RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
+  const std::vector<bool> boundary =
+      boundary_vertices(static_cast<int>(c.mesh.vertex_count()), c.mesh.F(), c.threads);
+  std::vector<int> near;
+  const Eigen::VectorXi distance = rings_to_boundary(*c.one_ring, boundary, kBoundaryJetDistance);
+  for (int i = 0; i < distance.size(); ++i) {
+    if (distance[i] <= kBoundaryJetDistance) near.push_back(i);
+  }
+  RowMatrixX3d out = jets;
+  if (near.empty()) return out;
+  const JetNormals wide = detail::jet_normals_at(c.mesh.V(), *c.one_ring, c.max,
+                                                 jet_options(c, kBoundaryJetRings, 3), near);
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(k);
+    if (wide.N.row(row).allFinite()) out.row(near[k]) = wide.N.row(row);
+  }
+  const Eigen::VectorXd r2 = roughness_at(c, jets, near), r3 = roughness_at(c, out, near);
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(k);
+    if (std::isfinite(r2[row]) && !(r3[row] <= r2[row])) out.row(near[k]) = jets.row(near[k]);
+  }
+  return out;
+}
+
 /// The position noise of recommended_plan (recommended.h): the 2-ring cubic jets' residuals
 /// `r2` with their truncation error taken out, by the 3-ring jets' residuals on a sample. A
 /// cubic's truncation error grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's:
@@ -557,8 +593,8 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
     } else {
       // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
       // first-order (rough) on irregular meshes.
-      out.N =
-          select_normals(jets.N, roughness_of(c, jets.N), c.max, roughness_of(c, c.max), c.threads);
+      const RowMatrixX3d J = with_boundary_jets(c, jets.N);
+      out.N = select_normals(J, roughness_of(c, J), c.max, roughness_of(c, c.max), c.threads);
     }
     for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
       if (side > 0.0 && out.N.row(i).allFinite()) continue;  // nothing to change
@@ -635,7 +671,9 @@ int recommended_reach(const RecommendedPlan& plan) {
   // Max's normal at their centre only):
   //  - a fitted normal at u, on clean positions, is chosen between candidates (jets over 2
   //    rings, Max's, the file's) by their 1-ring fits' residuals at u, and the crease steps read
-  //    the faces of vertices within 2 rings of u: 1 + 2 + 1 = 4 rings from u; on noisy
+  //    the faces of vertices within 2 rings of u: 1 + 2 + 1 = 4 rings from u, one more where
+  //    u is within kBoundaryJetDistance of a boundary (its jets over kBoundaryJetRings rings;
+  //    whether it is reads 2 rings); on noisy
   //    positions it is the jet of u over plan.jet_rings rings from Max's normals, turned with
   //    its 1-ring's normals: jet_rings + 2 (with a margin of one);
   //  - the fit of v reads the fitted normals within plan.rings, the per-triangle pass those at
@@ -648,7 +686,7 @@ int recommended_reach(const RecommendedPlan& plan) {
   //  - on clean positions with trusted normals, each position read is the spike repair's
   //    (spike_repair.h): a spike's offset reads its 1-ring, whether it is isolated the offsets
   //    of that 1-ring, 2 rings in all.
-  const int normal_reach = std::max(4, plan.rings > 1 ? plan.jet_rings + 2 : 0);
+  const int normal_reach = std::max(kBoundaryJetRings + 2, plan.rings > 1 ? plan.jet_rings + 2 : 0);
   const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
                                  plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
   const int position_reach = plan.rings > 1 ? 0 : detail::kSpikeRepairRings;

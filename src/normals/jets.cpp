@@ -535,6 +535,33 @@ Eigen::VectorXd detail::jet_residuals_at(PositionsRef V, const Neighbourhoods& o
   return out;
 }
 
+JetNormals detail::jet_normals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
+                                  const JetOptions& options, const std::vector<int>& vertices) {
+  validate_options(options);
+  JetNormals out;
+  const auto n = static_cast<Eigen::Index>(vertices.size());
+  out.N.resize(n, 3);
+  out.residual.resize(n);
+  out.degree.resize(n);
+  detail::PerThread<JetScratch> scratch(options.threads);
+  detail::parallel_for_blocks(n, 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    JetScratch& s = scratch.local();
+    for (auto k = begin; k < end; ++k) {
+      const int v = vertices[static_cast<std::size_t>(k)];
+      const Eigen::Vector3d n0 = start.row(v).transpose();
+      const LocalJet jet = n0.allFinite() ? fit_vertex(V, one_ring, v, n0, options, s) : LocalJet{};
+      out.degree[k] = jet.degree;
+      out.residual[k] = jet.residual;
+      if (jet.degree == 0) {
+        out.N.row(k).setConstant(std::numeric_limits<double>::quiet_NaN());
+      } else {
+        out.N.row(k) = jet_normal(jet).transpose();
+      }
+    }
+  });
+  return out;
+}
+
 CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   validate_options(options);

@@ -21,4 +21,8 @@ JetNormals jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring, Norm
 Eigen::VectorXd jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
                                  const JetOptions& options, const std::vector<int>& vertices);
 
+/// jet_normals_from at the listed vertices only (row k: vertex vertices[k]; the same bits).
+JetNormals jet_normals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
+                          const JetOptions& options, const std::vector<int>& vertices);
+
 }  // namespace focal::detail

@@ -170,12 +170,12 @@ struct RecommendedPlan {
 /// How far the recommended estimate of one vertex reads the mesh, in rings, for a plan: a tile
 /// needs a halo this wide (focal/tiles/tiles.h) for its owned vertices to get the whole-mesh
 /// result (the plan and the verdict on the file's normals are global: RecommendedMeshWide, decided
-/// once and passed). A vertex's normal reads at most max(4, jet_rings + 2) rings (2-ring jets
-/// from Max's normals, rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned
+/// once and passed). A vertex's normal reads at most max(5, jet_rings + 2) rings (2-ring jets,
+/// 3-ring within a ring of a boundary, from Max's normals, rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned
 /// with the 1-ring); the fit reads the normals of rings + kMaxExtraRings rings, and the normals
 /// that the refit of undefined vertices replaced by their neighbours' mean one ring further; on
 /// clean positions every position read may be a spike's repaired one, which reads 2 rings
-/// further. 10 on clean positions, 12 at most (kRecommendedMaxReach). Derived in
+/// further. 11 on clean positions, 12 at most (kRecommendedMaxReach). Derived in
 /// recommended.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
