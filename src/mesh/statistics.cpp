@@ -154,8 +154,11 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
       const int count = ring.offsets[v + 1];
       // Serial and in increasing v: each list moves down (total <= 2 * inc.begin(v)), never onto
       // a list not yet moved.
-      std::memmove(ring_buffer + total, ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)),
-                   static_cast<std::size_t>(count) * sizeof(int));
+      // (An empty list is skipped: with no faces the buffer may be null, which memmove forbids.)
+      if (count > 0) {
+        std::memmove(ring_buffer + total, ring_buffer + 2 * static_cast<std::size_t>(inc.begin(v)),
+                     static_cast<std::size_t>(count) * sizeof(int));
+      }
       total += count;
       ring.offsets[v + 1] = total;
     }
