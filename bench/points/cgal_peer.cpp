@@ -32,6 +32,8 @@
 #include <utility>
 #include <vector>
 
+#include "xyz_rows.h"
+
 using Kernel = CGAL::Simple_cartesian<double>;
 using Point = Kernel::Point_3;
 using Vector = Kernel::Vector_3;
@@ -49,18 +51,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   const unsigned k = static_cast<unsigned>(std::atoi(argv[2]));
-  std::ifstream in(argv[1]);
+  const XyzRows input = read_xyz_rows(argv[1]);
+  const bool has_normals = input.has_normals;
   std::vector<PointWithNormal> points;
-  bool has_normals = false;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream s(line);
-    double v[6];
-    int n = 0;
-    while (n < 6 && s >> v[n]) ++n;
-    if (n < 3) continue;
-    has_normals = n == 6;
-    points.emplace_back(Point(v[0], v[1], v[2]),
-                        n == 6 ? Vector(v[3], v[4], v[5]) : Vector(0, 0, 0), points.size());
+  for (const auto& v : input.rows) {
+    points.emplace_back(Point(v[0], v[1], v[2]), Vector(v[3], v[4], v[5]), points.size());
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();

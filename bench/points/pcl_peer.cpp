@@ -22,6 +22,8 @@
 #include <sstream>
 #include <string>
 
+#include "xyz_rows.h"
+
 int main(int argc, char** argv) {
   if (argc != 4) {
     std::fprintf(stderr, "usage: pcl_peer IN.xyz K OUT.csv\n");
@@ -30,15 +32,9 @@ int main(int argc, char** argv) {
   const int k = std::atoi(argv[2]);
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  std::ifstream in(argv[1]);
-  bool has_normals = false;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream s(line);
-    double v[6];
-    int n = 0;
-    while (n < 6 && s >> v[n]) ++n;
-    if (n < 3) continue;
-    has_normals = n == 6;
+  const XyzRows input = read_xyz_rows(argv[1]);
+  const bool has_normals = input.has_normals;
+  for (const auto& v : input.rows) {
     cloud->push_back(pcl::PointXYZ(static_cast<float>(v[0]), static_cast<float>(v[1]),
                                    static_cast<float>(v[2])));
     if (has_normals) {
