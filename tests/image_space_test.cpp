@@ -757,6 +757,7 @@ TEST(ImageSpaceCuda, WithoutTheBackendTheStandInsThrowDeviceError) {
   if (cuda_built()) GTEST_SKIP() << "this build has the CUDA backend";
   const GeometryImage g = image_of(SurfaceKind::sphere, 8, 8);
   EXPECT_THROW((void)estimate_image_curvature_cuda(g.gbuffer), DeviceError);
+  EXPECT_THROW(ImageCurvatureCudaContext(8, 8), DeviceError);
   const Mesh m = test::flat_grid(4);
   EXPECT_THROW((void)triangle_curvature_cuda(m.V, m.F, m.N), DeviceError);
 }
@@ -766,6 +767,7 @@ TEST(ImageSpaceCuda, WithTheBackendButNoDeviceTheyThrowDeviceError) {
   if (!cuda_devices().empty()) GTEST_SKIP() << "a CUDA device is present";
   const GeometryImage g = image_of(SurfaceKind::sphere, 8, 8);
   EXPECT_THROW((void)estimate_image_curvature_cuda(g.gbuffer), DeviceError);
+  EXPECT_THROW(ImageCurvatureCudaContext(8, 8), DeviceError);
   const Mesh m = test::flat_grid(4);
   EXPECT_THROW((void)triangle_curvature_cuda(m.V, m.F, m.N), DeviceError);
 }
@@ -850,6 +852,72 @@ TEST(ImageSpaceCuda, ImageCurvatureMatchesTheCpu) {
       expect_close_fields(gpu.H, cpu.H, bounds, true, "H");
     }
   }
+}
+
+/// Bit for bit: the same kernels on the same data, whatever the buffers' history.
+void expect_identical(const ImageCurvature& a, const ImageCurvature& b, const std::string& what) {
+  const auto same_bits = [](const auto& x, const auto& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+  };
+  EXPECT_EQ(a.width, b.width) << what;
+  EXPECT_EQ(a.height, b.height) << what;
+  EXPECT_TRUE(same_bits(a.k1, b.k1) && same_bits(a.k2, b.k2) && same_bits(a.H, b.H) &&
+              same_bits(a.K, b.K) && same_bits(a.focal_depth1, b.focal_depth1) &&
+              same_bits(a.focal_depth2, b.focal_depth2) && same_bits(a.d1, b.d1) &&
+              same_bits(a.d2, b.d2) && same_bits(a.valid, b.valid))
+      << what;
+}
+
+TEST(ImageSpaceCuda, AContextsFramesAreTheOneShotCallsBits) {
+  FOCAL_NEEDS_GPU();
+  const auto images = rounding_images();  // three surfaces, one size: one context's frames
+  for (int w : {0, 2}) {
+    ImageSpaceOptions o;
+    o.window = w;
+    ImageCurvatureCudaContext context(images[0].second.gbuffer.width,
+                                      images[0].second.gbuffer.height, o);
+    ImageCurvature reused;
+    for (int round = 0; round < 2; ++round) {  // the second round reuses every buffer
+      for (const auto& [kind, g] : images) {
+        const std::string what = std::string(surface_name(kind)) + " window " + std::to_string(w) +
+                                 " round " + std::to_string(round);
+        const ImageCurvature one_shot = estimate_image_curvature_cuda(g.gbuffer, o);
+        expect_identical(context.estimate(g.gbuffer), one_shot, what);
+        context.estimate(g.gbuffer, reused);
+        expect_identical(reused, one_shot, what + " into a reused result");
+      }
+    }
+    // Stages: two computes on one upload give the same frame.
+    context.upload(images[1].second.gbuffer);
+    context.compute();
+    context.compute();
+    ImageCurvature staged;
+    context.download(staged);
+    expect_identical(staged, estimate_image_curvature_cuda(images[1].second.gbuffer, o),
+                     "staged, window " + std::to_string(w));
+  }
+}
+
+TEST(ImageSpaceCuda, AContextRejectsOtherSizesAndCallsOutOfOrder) {
+  FOCAL_NEEDS_GPU();
+  EXPECT_THROW(ImageCurvatureCudaContext(0, 8), InvalidInput);
+  EXPECT_THROW(ImageCurvatureCudaContext(8, -1), InvalidInput);
+  ImageSpaceOptions bad;
+  bad.window = 17;
+  EXPECT_THROW(ImageCurvatureCudaContext(8, 8, bad), InvalidInput);
+  ImageCurvatureCudaContext context(16, 12);
+  ImageCurvature out;
+  EXPECT_THROW(context.compute(), InvalidInput);
+  EXPECT_THROW(context.download(out), InvalidInput);
+  const GeometryImage other = image_of(SurfaceKind::sphere, 12, 16);  // transposed size
+  EXPECT_THROW(context.upload(other.gbuffer), InvalidInput);
+  GeometryImage short_mask = image_of(SurfaceKind::sphere, 16, 12);
+  short_mask.gbuffer.mask.pop_back();
+  EXPECT_THROW(context.upload(short_mask.gbuffer), InvalidInput);
+  // After the errors the context still works.
+  const GeometryImage g = image_of(SurfaceKind::sphere, 16, 12);
+  expect_identical(context.estimate(g.gbuffer), estimate_image_curvature_cuda(g.gbuffer),
+                   "after the errors");
 }
 
 TEST(ImageSpaceCuda, TriangleCurvatureMatchesTheCpu) {

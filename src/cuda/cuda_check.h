@@ -73,6 +73,15 @@ class DeviceBuffer {
   void download(T* host, std::size_t n) const {
     check(cudaMemcpy(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to host");
   }
+  /// Queued on `stream`: asynchronous where `host` is pinned.
+  void upload_async(const T* host, std::size_t n, cudaStream_t stream) {
+    check(cudaMemcpyAsync(data_, host, n * sizeof(T), cudaMemcpyHostToDevice, stream),
+          "cudaMemcpyAsync to device");
+  }
+  void download_async(T* host, std::size_t n, cudaStream_t stream) const {
+    check(cudaMemcpyAsync(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost, stream),
+          "cudaMemcpyAsync to host");
+  }
   [[nodiscard]] std::vector<T> to_host() const {
     std::vector<T> host(size_);
     download(host.data(), size_);
@@ -85,6 +94,57 @@ class DeviceBuffer {
  private:
   T* data_ = nullptr;
   std::size_t size_ = 0;
+};
+
+/// n elements of T in page-locked host memory (cudaMallocHost), freed on scope exit: copies
+/// from and to it run at the bus's rate and can be asynchronous, unlike pageable memory.
+template <class T>
+class PinnedBuffer {
+ public:
+  PinnedBuffer() = default;
+  explicit PinnedBuffer(std::size_t n) : size_(n) {
+    if (n > 0)
+      check(cudaMallocHost(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMallocHost");
+  }
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+  PinnedBuffer(PinnedBuffer&& o) noexcept : data_(o.data_), size_(o.size_) {
+    o.data_ = nullptr;
+    o.size_ = 0;
+  }
+  PinnedBuffer& operator=(PinnedBuffer&& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(size_, o.size_);
+    return *this;
+  }
+  ~PinnedBuffer() {
+    if (data_ != nullptr) cudaFreeHost(data_);  // no throw from a destructor
+  }
+
+  [[nodiscard]] T* data() const { return data_; }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  T* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+/// A CUDA stream of the current device, destroyed on scope exit.
+class Stream {
+ public:
+  Stream() {
+    check(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate");
+  }
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+  ~Stream() { cudaStreamDestroy(stream_); }  // no throw from a destructor
+
+  [[nodiscard]] cudaStream_t get() const { return stream_; }
+  /// Waits for everything queued on the stream; throws DeviceError naming `what` on an error.
+  void synchronize(const char* what) const { check(cudaStreamSynchronize(stream_), what); }
+
+ private:
+  cudaStream_t stream_ = nullptr;
 };
 
 }  // namespace focal::cuda

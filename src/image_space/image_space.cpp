@@ -5,14 +5,13 @@
 
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <string>
 
-#include "cuda/launch.h"
-#include "focal/cuda/device.h"
-#include "focal/core/error.h"
-#include "image_space/detail.h"
 #include "core/parallel.h"
+#include "cuda/launch.h"
+#include "focal/core/error.h"
+#include "focal/cuda/device.h"
+#include "image_space/detail.h"
 
 namespace focal {
 namespace detail {
@@ -39,14 +38,17 @@ void validate_image_input(const GBuffer& g, const ImageSpaceOptions& options, co
                        std::to_string(g.height) + " is negative");
   }
   const std::size_t pixels = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
-  if (pixels > static_cast<std::size_t>(std::numeric_limits<int>::max() / 3)) {
+  if (pixels > kMaxPixels) {
     throw InvalidInput(std::string(what) + ": G-buffer of " + std::to_string(pixels) +
-                       " pixels is too large (at most " +
-                       std::to_string(std::numeric_limits<int>::max() / 3) + ")");
+                       " pixels is too large (at most " + std::to_string(kMaxPixels) + ")");
   }
   check_size(g.position.size(), 3 * pixels, "position", what, g);
   check_size(g.normal.size(), 3 * pixels, "normal", what, g);
   check_size(g.mask.size(), pixels, "mask", what, g);
+  validate_image_options(options, what);
+}
+
+void validate_image_options(const ImageSpaceOptions& options, const char* what) {
   // NaN fails the comparison too.
   if (!(options.discontinuity_ratio > 1.0)) {
     throw InvalidInput(std::string(what) +
@@ -72,6 +74,16 @@ ImageCurvature allocate_image_curvature(int width, int height) {
   r.d2.resize(3 * n);
   r.valid.resize(n);
   return r;
+}
+
+bool has_image_size(const ImageCurvature& r, int width, int height) {
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  bool sized = r.width == width && r.height == height && r.d1.size() == 3 * n &&
+               r.d2.size() == 3 * n && r.valid.size() == n;
+  for (const std::vector<float>* f : {&r.k1, &r.k2, &r.H, &r.K, &r.focal_depth1, &r.focal_depth2}) {
+    sized = sized && f->size() == n;
+  }
+  return sized;
 }
 
 }  // namespace detail
@@ -117,6 +129,84 @@ ImageCurvature estimate_image_curvature_cuda(const GBuffer& gbuffer,
                                       options.window, detail::fields_of(result), device);
   }
   return result;
+}
+
+namespace detail {
+
+void image_curvature_on_device(const image_kernel::ImageView& image, float discontinuity_ratio,
+                               int window, const image_kernel::ImageFields& out, int device) {
+  // Pageable transfers: pinning the caller's arrays for one call costs more than it saves.
+  const ImageDeviceStatePtr state =
+      make_image_device_state(image.width, image.height, window, false, device);
+  upload_frame(*state, image);
+  run_frame(*state, discontinuity_ratio, window);
+  download_frame(*state, out);
+}
+
+}  // namespace detail
+
+namespace {
+
+constexpr const char* kContext = "ImageCurvatureCudaContext";
+
+/// The context's frame size (the size of any G-buffer, and at least one pixel) and options.
+void validate_context(int width, int height, const ImageSpaceOptions& options) {
+  if (width < 1 || height < 1 ||
+      static_cast<std::size_t>(width) * static_cast<std::size_t>(height) > detail::kMaxPixels) {
+    throw InvalidInput(std::string(kContext) + ": frame size " + std::to_string(width) + " x " +
+                       std::to_string(height) + " must be at least 1 x 1 and at most " +
+                       std::to_string(detail::kMaxPixels) + " pixels");
+  }
+  detail::validate_image_options(options, kContext);
+}
+
+}  // namespace
+
+ImageCurvatureCudaContext::ImageCurvatureCudaContext(int width, int height,
+                                                     const ImageSpaceOptions& options, int device)
+    : width_(width), height_(height), device_(device), options_(options) {
+  (void)require_cuda_device(device);  // DeviceError first, as the one-shot call
+  validate_context(width, height, options);
+  state_ = detail::make_image_device_state(width, height, options.window, true, device);
+}
+
+ImageCurvature ImageCurvatureCudaContext::estimate(const GBuffer& gbuffer) {
+  ImageCurvature out;
+  estimate(gbuffer, out);
+  return out;
+}
+
+void ImageCurvatureCudaContext::estimate(const GBuffer& gbuffer, ImageCurvature& out) {
+  upload(gbuffer);
+  compute();
+  download(out);
+}
+
+void ImageCurvatureCudaContext::upload(const GBuffer& gbuffer) {
+  if (gbuffer.width != width_ || gbuffer.height != height_) {
+    throw InvalidInput(std::string(kContext) + ": G-buffer of " + std::to_string(gbuffer.width) +
+                       " x " + std::to_string(gbuffer.height) + " pixels in a context of " +
+                       std::to_string(width_) + " x " + std::to_string(height_));
+  }
+  detail::validate_image_input(gbuffer, options_, kContext);
+  uploaded_ = false;  // a failed copy leaves no frame to compute on
+  detail::upload_frame(*state_, detail::view_of(gbuffer));
+  uploaded_ = true;
+}
+
+void ImageCurvatureCudaContext::compute() {
+  if (!uploaded_) throw InvalidInput(std::string(kContext) + ": compute before any upload");
+  computed_ = false;
+  detail::run_frame(*state_, static_cast<float>(options_.discontinuity_ratio), options_.window);
+  computed_ = true;
+}
+
+void ImageCurvatureCudaContext::download(ImageCurvature& out) {
+  if (!computed_) throw InvalidInput(std::string(kContext) + ": download before any compute");
+  if (!detail::has_image_size(out, width_, height_)) {
+    out = detail::allocate_image_curvature(width_, height_);
+  }
+  detail::download_frame(*state_, detail::fields_of(out));
 }
 
 }  // namespace focal

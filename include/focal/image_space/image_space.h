@@ -16,8 +16,8 @@
 /// on where the surface lies. docs/IMAGE_SPACE.md states the measured accuracy.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
-
 
 namespace focal {
 
@@ -77,5 +77,59 @@ struct ImageCurvature {
 [[nodiscard]] ImageCurvature estimate_image_curvature_cuda(const GBuffer& gbuffer,
                                                            const ImageSpaceOptions& options = {},
                                                            int device = 0);
+
+namespace detail {
+struct ImageDeviceState;  ///< defined by the CUDA backend (src/cuda/image_space.cu)
+struct ImageDeviceStateDeleter {
+  void operator()(ImageDeviceState* state) const noexcept;
+};
+using ImageDeviceStatePtr = std::unique_ptr<ImageDeviceState, ImageDeviceStateDeleter>;
+}  // namespace detail
+
+/// Image space on CUDA device `device` for a stream of frames of one size (an interactive
+/// viewer, a video): the device buffers of the G-buffer, of the fields and of the window's
+/// operators, a stream and page-locked (pinned) host buffers for the transfers are allocated
+/// once, by the constructor, and kept until the context is destroyed. The one-shot
+/// estimate_image_curvature_cuda allocates and frees them on every call.
+///
+/// Each frame gives the bits estimate_image_curvature_cuda(gbuffer, options, device) gives: the
+/// same kernels on the same data. The stages can be called on their own (upload, compute,
+/// download), e.g. to time the kernels alone or to compute several times on one upload.
+/// Calls are synchronous and leave the calling thread's current CUDA device as it was. A context
+/// is not thread-safe: one per thread.
+class ImageCurvatureCudaContext {
+ public:
+  /// \throw DeviceError without the CUDA backend or the device, or when the buffers cannot be
+  ///        allocated; InvalidInput when width or height is below 1 or the options are out of
+  ///        range (as estimate_image_curvature).
+  ImageCurvatureCudaContext(int width, int height, const ImageSpaceOptions& options = {},
+                            int device = 0);
+
+  /// One frame: upload, compute, download.
+  /// \throw InvalidInput when the G-buffer's size is not the context's or its arrays disagree
+  ///        with it; DeviceError on a CUDA error.
+  [[nodiscard]] ImageCurvature estimate(const GBuffer& gbuffer);
+  /// The same into `out`, whose arrays are reused when already of the context's size.
+  void estimate(const GBuffer& gbuffer, ImageCurvature& out);
+
+  /// Copies the G-buffer to the device (through the pinned buffers). \throw as estimate.
+  void upload(const GBuffer& gbuffer);
+  /// Runs the kernels on the last uploaded G-buffer and waits for them.
+  /// \throw InvalidInput before any upload; DeviceError on a CUDA error.
+  void compute();
+  /// The fields of the last compute into `out` (resized to the context's size if needed).
+  /// \throw InvalidInput before any compute; DeviceError on a CUDA error.
+  void download(ImageCurvature& out);
+
+  [[nodiscard]] int width() const { return width_; }
+  [[nodiscard]] int height() const { return height_; }
+  [[nodiscard]] int device() const { return device_; }
+
+ private:
+  int width_, height_, device_;
+  ImageSpaceOptions options_;
+  bool uploaded_ = false, computed_ = false;
+  detail::ImageDeviceStatePtr state_;
+};
 
 }  // namespace focal
