@@ -45,6 +45,7 @@ __all__ = [
     "FocalPointFlag",
     "GBuffer",
     "ImageCurvature",
+    "ImageCurvatureContext",
     "InvalidInputError",
     "Mesh",
     "MeshFindings",
@@ -759,15 +760,45 @@ def image_space_curvature(
     once into the library's G-buffer. Pixels in the last row and column, outside the mask, across
     a discontinuity or with a normal outside the triplet's hemisphere are invalid (NaN, valid 0).
     """
+    pos, nor, m = _gbuffer(position, normal, mask)
+    d = _ext.image_space_curvature(pos, nor, m, float(discontinuity_ratio), int(window),
+                                   _threads(threads), None if device is None else int(device))
+    return ImageCurvature(**d)
+
+
+def _gbuffer(position: Any, normal: Any, mask: Any) -> tuple:
+    """position, normal (h, w, 3) float32 and mask (h, w) uint8 (all ones for None), checked."""
     pos = _pixels(position, "position", 3, np.float32)
     nor = _pixels(normal, "normal", 3, np.float32, pos.shape[:2])
     if mask is None:
         m = np.ones(pos.shape[:2], dtype=np.uint8)
     else:
         m = _pixels(_array(mask, "mask") != 0, "mask", 1, np.uint8, pos.shape[:2])
-    d = _ext.image_space_curvature(pos, nor, m, float(discontinuity_ratio), int(window),
-                                   _threads(threads), None if device is None else int(device))
-    return ImageCurvature(**d)
+    return pos, nor, m
+
+
+class ImageCurvatureContext:
+    """``image_space_curvature`` on a CUDA device for frames of one size (a viewer, a video):
+    the device buffers, a stream and pinned host buffers are allocated once, here, and kept
+    until the context is dropped, where the one-shot call allocates them per frame.
+
+    Each frame's fields are the bits of ``image_space_curvature(..., device=device)`` with the
+    same options (the same kernels on the same data; docs/GPU.md). Raises DeviceError without
+    the CUDA backend or the device, InvalidInputError for a size below 1 x 1 or options out of
+    range, and (in ``estimate``) for a frame of another size.
+    """
+
+    def __init__(self, width: int, height: int, *, discontinuity_ratio: float = 4.0,
+                 window: int = 0, device: int = 0) -> None:
+        self._context = _ext.ImageCurvatureCudaContext(
+            int(width), int(height), float(discontinuity_ratio), int(window), int(device))
+        self.width, self.height, self.device = int(width), int(height), int(device)
+
+    def estimate(self, position: Any, normal: Any, mask: Any = None) -> ImageCurvature:
+        """One frame: position, normal (height, width, 3), mask (height, width) or None."""
+        pos, nor, m = _gbuffer(position, normal, mask)
+        return ImageCurvature(**self._context.estimate(pos, nor, m))
+
 
 from ._clouds import cloud_curvature, cloud_normals  # noqa: E402  (point clouds, docs/POINTS.md)
 

@@ -205,3 +205,24 @@ def test_without_egl_render_raises_device_error(tmp_path):
     assert r.stdout.count("DeviceError:") == 2, r.stdout
     assert "EGL" in r.stdout
     assert not out.exists()
+
+
+def test_image_context_frames_are_the_one_shot_calls_bits_or_a_device_error():
+    # With a GPU: each frame of a context equals the one-shot call on the device. Without one
+    # (CI): both are a DeviceError saying why, and FOCAL_REQUIRE_GPU=1 makes that a failure.
+    frames = [sphere_gbuffer(r, size=48)[:3] for r in (1.0, 3.0)]
+    try:
+        context = focal.ImageCurvatureContext(48, 48, window=1)
+    except focal.DeviceError as e:
+        assert os.environ.get("FOCAL_REQUIRE_GPU") != "1", f"FOCAL_REQUIRE_GPU=1: {e}"
+        assert "GPU" in str(e) or "CUDA" in str(e), str(e)
+        with pytest.raises(focal.DeviceError):
+            focal.image_space_curvature(*frames[0], device=0)
+        return
+    for g in frames + frames:  # the second pass reuses the context's buffers
+        one_shot = focal.image_space_curvature(*g, window=1, device=0)
+        frame = context.estimate(*g)
+        for name in ("k1", "k2", "H", "K", "d1", "d2", "valid"):
+            np.testing.assert_array_equal(getattr(frame, name), getattr(one_shot, name))
+    with pytest.raises(focal.InvalidInputError):
+        context.estimate(frames[0][0][:, :40], frames[0][1][:, :40])
