@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -184,6 +185,34 @@ TEST(CudaVertexFitOnHost, DoubleReproducesCpuEstimator) {
 // pairs and the power-of-two length unit keep the same accuracy (a mesh at 1e4 radii from the
 // origin, scaled by 1e-6: plain float coordinates would be off by 1.4e-3 / 2.3e4 of their size,
 // 1.5% of an edge length).
+// hi + lo carry each coordinate to about 48 bits (2 x 24): |hi + lo - x| <= 2^-47 |x| (the
+// rounding of lo). Guards the split against the compiler: g++ 12 -O3 once gave lo = 0 for two
+// of three coordinates when it was inlined into a loop.
+TEST(CudaVertexFitOnHost, RecordsCarryPositionsAndNormalsToAbout48Bits) {
+  const Mesh m =
+      test::analytic_surface(SurfaceKind::torus, Triangulation::irregular, 4000, 0.0, 1).mesh;
+  const cuda::PreparedVertexFit<float> p = cuda::prepare_vertex_fit<float>(m.V, m.F, m.N, {});
+  std::vector<cuda::VertexRecord<float>> renormalised = p.vertices;
+  const RowMatrixX3d N2 = 3.0 * m.N;  // any length: the records hold the unit normal
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) cuda::set_record_normal(N2, i, renormalised[i]);
+  const double bound = std::ldexp(1.0, -47);
+  const double unit = cuda::length_unit(mean_edge_length(m.V, m.F), 1);
+  int bad = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    const cuda::VertexRecord<float>& r = p.vertices[static_cast<std::size_t>(i)];
+    const cuda::VertexRecord<float>& q = renormalised[static_cast<std::size_t>(i)];
+    const Eigen::RowVector3d n = m.N.row(i).normalized();
+    for (int c = 0; c < 3; ++c) {
+      const double x = m.V(i, c) / unit;
+      bad += !(std::abs(double(r.position_hi[c]) + double(r.position_lo[c]) - x) <=
+               bound * std::abs(x));
+      bad += !(std::abs(double(r.normal_hi[c]) + double(r.normal_lo[c]) - n[c]) <= bound);
+      bad += !(std::abs(double(q.normal_hi[c]) + double(q.normal_lo[c]) - n[c]) <= bound);
+    }
+  }
+  EXPECT_EQ(bad, 0);
+}
+
 TEST(CudaVertexFitOnHost, FloatAccuracyIndependentOfPlacementAndUnits) {
   Mesh m = test::analytic_surface(SurfaceKind::torus, Triangulation::irregular, 4000, 0.0, 1).mesh;
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
@@ -268,18 +297,69 @@ TEST(CudaVertexFitOnDevice, InvalidInputBeforeAnyWork) {
   EXPECT_EQ(empty.k1.size(), 0);
 }
 
+/// Bit for bit (NaN rows included): the same kernel on the same data.
+void expect_identical(const CurvatureResult& a, const CurvatureResult& b, const std::string& what) {
+  const auto same = [](const auto& x, const auto& y) {
+    return x.size() == y.size() &&
+           std::memcmp(x.data(), y.data(),
+                       static_cast<std::size_t>(x.size()) * sizeof(*x.data())) == 0;
+  };
+  EXPECT_TRUE(same(a.k1, b.k1) && same(a.k2, b.k2) && same(a.H, b.H) && same(a.K, b.K) &&
+              same(a.residual, b.residual) && same(a.d1, b.d1) && same(a.d2, b.d2) &&
+              same(a.point_class, b.point_class) && same(a.rays_used, b.rays_used) &&
+              same(a.rays_excluded, b.rays_excluded))
+      << what;
+}
+
+TEST(CudaVertexFitOnDevice, AContextsEstimatesAreTheOneShotCallsBitsAsNormalsChange) {
+  FOCAL_NEEDS_GPU();
+  for (const Case& k : cases()) {
+    const Mesh m = mesh_of(k);
+    const CurvatureOptions o = options_of(k);
+    CurvatureCudaContext context(m.V, m.F, m.N, o);
+    EXPECT_EQ(context.vertex_count(), m.V.rows());
+    expect_identical(context.estimate(), estimate_curvature_cuda(m.V, m.F, m.N, o), k.name);
+    // Other normals: inward, then a rotation of some, a zero row and a NaN row.
+    const RowMatrixX3d inward = -m.N;
+    context.set_normals(inward);
+    expect_identical(context.estimate(), estimate_curvature_cuda(m.V, m.F, inward, o),
+                     k.name + " inward");
+    RowMatrixX3d tilted = m.N;
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()).matrix();
+    for (Eigen::Index i = 0; i < tilted.rows(); i += 3) tilted.row(i) *= turn.transpose();
+    tilted.row(1).setZero();
+    tilted(2, 0) = NAN;
+    context.set_normals(tilted);
+    expect_identical(context.estimate(), estimate_curvature_cuda(m.V, m.F, tilted, o),
+                     k.name + " tilted");
+  }
+}
+
+TEST(CudaVertexFitOnDevice, AContextRejectsNormalsOfAnotherMesh) {
+  FOCAL_NEEDS_GPU();
+  const Mesh m = test::flat_grid(4);
+  CurvatureCudaContext context(m.V, m.F, m.N);
+  EXPECT_THROW(context.set_normals(m.N.topRows(3)), InvalidInput);
+  expect_identical(context.estimate(), estimate_curvature_cuda(m.V, m.F, m.N), "after the error");
+  CurvatureOptions o;
+  o.method = Method::triangle;
+  EXPECT_THROW(CurvatureCudaContext(m.V, m.F, m.N, o), InvalidInput);
+}
+
 // --- (c) device errors --------------------------------------------------------------------
 
 TEST(CudaVertexFitErrors, StandInThrowsDeviceErrorWithoutBackend) {
   if (cuda_built()) GTEST_SKIP() << "this build has the CUDA backend; the stand-in is not linked";
   const Mesh m = test::flat_grid(4);
   EXPECT_THROW((void)estimate_curvature_cuda(m.V, m.F, m.N), DeviceError);
+  EXPECT_THROW(CurvatureCudaContext(m.V, m.F, m.N), DeviceError);
 }
 
 TEST(CudaVertexFitErrors, BadDeviceIndexThrowsDeviceError) {
   const Mesh m = test::flat_grid(4);
   EXPECT_THROW((void)estimate_curvature_cuda(m.V, m.F, m.N, {}, -1), DeviceError);
   EXPECT_THROW((void)estimate_curvature_cuda(m.V, m.F, m.N, {}, 1 << 20), DeviceError);
+  EXPECT_THROW(CurvatureCudaContext(m.V, m.F, m.N, {}, -1), DeviceError);
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 //
 //  - per-vertex fit (estimate_curvature_cuda) on generated tori: the kernel alone with the data
 //    resident (CUDA events, median of --reps), upload + kernel + download (CUDA events), and the
-//    public call (wall clock: validation, CSR on the host, transfers);
+//    public call (wall clock: validation, CSR on the host, transfers), and CurvatureCudaContext
+//    with new normals per call (set_normals + fit + download, wall clock);
 //  - per-triangle path (triangle_curvature_cuda): the public call, wall clock (no resident entry);
 //  - image space at 512^2, 1024^2, 2048^2 (estimate_image_curvature_cuda on geometry_image):
 //    the public call per frame, wall clock, transfers included; ImageCurvatureCudaContext's
@@ -22,13 +23,13 @@
 #include <vector>
 
 #include "cuda/vertex_fit.h"
+#include "focal/core/error.h"
 #include "focal/cuda/curvature.h"
 #include "focal/cuda/device.h"
-#include "focal/core/error.h"
+#include "focal/curvature/triangle_curvature.h"
 #include "focal/image_space/image_space.h"
 #include "focal/surfaces/geometry_image.h"
 #include "focal/surfaces/surfaces.h"
-#include "focal/curvature/triangle_curvature.h"
 
 namespace {
 
@@ -54,8 +55,8 @@ double wall_ms(int reps, const std::function<void()>& f) {
   for (int r = 0; r < reps; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     f();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                     .count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   return median(ms);
 }
@@ -82,8 +83,8 @@ std::string verdict(const Agreement& g, double tolerance, const char* what) {
   const bool ok = g.max_error <= tolerance && g.mismatched_definedness == 0;
   all_checks_pass = all_checks_pass && ok;
   char s[160];
-  std::snprintf(s, sizeof s, "%s %s %.1e (<= %.0e), %ld undefined differ", ok ? "ok" : "FAIL",
-                what, g.max_error, tolerance, g.mismatched_definedness);
+  std::snprintf(s, sizeof s, "%s %s %.1e (<= %.0e), %ld undefined differ", ok ? "ok" : "FAIL", what,
+                g.max_error, tolerance, g.mismatched_definedness);
   return s;
 }
 
@@ -114,9 +115,10 @@ void per_vertex(int target, int reps) {
   const focal::CurvatureResult gpu = fit.result();
   // Float device path vs double CPU, relative to the vertex's largest |k| (docs/GPU.md: 1e-5).
   const auto kappa = [&](long i) { return std::max(std::abs(cpu.k1[i]), std::abs(cpu.k2[i])); };
-  Agreement g = agree(n, [&](long i) { return cpu.k1[i]; }, [&](long i) { return gpu.k1[i]; }, kappa);
-  const Agreement g2 =
-      agree(n, [&](long i) { return cpu.k2[i]; }, [&](long i) { return gpu.k2[i]; }, kappa);
+  Agreement g = agree(
+      n, [&](long i) { return cpu.k1[i]; }, [&](long i) { return gpu.k1[i]; }, kappa);
+  const Agreement g2 = agree(
+      n, [&](long i) { return cpu.k2[i]; }, [&](long i) { return gpu.k2[i]; }, kappa);
   g.max_error = std::max(g.max_error, g2.max_error);
   g.mismatched_definedness += g2.mismatched_definedness;
   const std::string check = verdict(g, 1e-5, "|dk|/kappa");
@@ -133,10 +135,26 @@ void per_vertex(int target, int reps) {
   std::snprintf(bw, sizeof bw, "%.1f GB/s over PCIe", fit.transfer_bytes() / t_ms / 1e6);
   rows.push_back({"per-vertex fit, upload + kernel + download", size, t_ms, n / t_ms * 1e3,
                   "vertices/s", bw, ""});
-  rows.push_back({"estimate_curvature_cuda (host CSR, transfers)", size, api_ms,
-                  n / api_ms * 1e3, "vertices/s", "", ""});
-  rows.push_back({"estimate_curvature (CPU reference)", size, cpu_ms, n / cpu_ms * 1e3,
+  rows.push_back({"estimate_curvature_cuda (host CSR, transfers)", size, api_ms, n / api_ms * 1e3,
                   "vertices/s", "", ""});
+  // The mesh resident, normals changing: set_normals (records rewritten and uploaded) + fit +
+  // download, against the one-shot call's bits.
+  focal::CurvatureCudaContext context(m.V, m.F, m.N, o);
+  const focal::RowMatrixX3d inward = -m.N;
+  const double context_ms = wall_ms(3, [&] {
+    context.set_normals(inward);
+    (void)context.estimate();
+  });
+  const focal::CurvatureResult want = focal::estimate_curvature_cuda(m.V, m.F, inward, o);
+  const focal::CurvatureResult got = context.estimate();
+  const bool same =
+      (want.H.array() == got.H.array() || (want.H.array().isNaN() && got.H.array().isNaN())).all();
+  if (!same) all_checks_pass = false;
+  rows.push_back({"CurvatureCudaContext: set_normals + fit + download", size, context_ms,
+                  n / context_ms * 1e3, "vertices/s",
+                  same ? "H bits of the public call" : "FAIL: bits", ""});
+  rows.push_back(
+      {"estimate_curvature (CPU reference)", size, cpu_ms, n / cpu_ms * 1e3, "vertices/s", "", ""});
 }
 
 void per_triangle(int target) {
@@ -146,8 +164,8 @@ void per_triangle(int target) {
   const focal::TriangleCurvatureResult cpu = focal::triangle_curvature(m.V, m.F, m.N);
   const focal::TriangleCurvatureResult gpu = focal::triangle_curvature_cuda(m.V, m.F, m.N);
   const auto kappa = [&](long i) { return std::max(std::abs(cpu.k1[i]), std::abs(cpu.k2[i])); };
-  const Agreement g =
-      agree(f, [&](long i) { return cpu.H[i]; }, [&](long i) { return gpu.H[i]; }, kappa);
+  const Agreement g = agree(
+      f, [&](long i) { return cpu.H[i]; }, [&](long i) { return gpu.H[i]; }, kappa);
   const std::string check = verdict(g, 1e-4, "|dH|/kappa");
   const double ms = wall_ms(5, [&] { (void)focal::triangle_curvature_cuda(m.V, m.F, m.N); });
   rows.push_back({"triangle_curvature_cuda (public call, transfers)",
@@ -166,8 +184,7 @@ bool same_bits(const focal::ImageCurvature& a, const focal::ImageCurvature& b) {
 
 /// ImageCurvatureCudaContext on the frame: the kernels alone on the resident G-buffer, and a
 /// whole frame through the pinned buffers (upload, kernels, download into a reused result).
-void image_space_context(const focal::GBuffer& g, const focal::ImageCurvature& one_shot,
-                         int reps) {
+void image_space_context(const focal::GBuffer& g, const focal::ImageCurvature& one_shot, int reps) {
   focal::ImageCurvatureCudaContext context(g.width, g.height);
   focal::ImageCurvature out;
   context.estimate(g, out);
@@ -194,11 +211,12 @@ void image_space(int width, int reps) {
   const auto kappa = [&](long i) {
     return std::max(std::abs(double(cpu.k1[i])), std::abs(double(cpu.k2[i])));
   };
-  Agreement g = agree(pixels, [&](long i) { return double(cpu.H[i]); },
-                      [&](long i) { return double(gpu.H[i]); }, kappa);
-  const Agreement gk = agree(pixels, [&](long i) { return double(cpu.K[i]); },
-                             [&](long i) { return double(gpu.K[i]); },
-                             [&](long i) { return kappa(i) * kappa(i); });
+  Agreement g = agree(
+      pixels, [&](long i) { return double(cpu.H[i]); }, [&](long i) { return double(gpu.H[i]); },
+      kappa);
+  const Agreement gk = agree(
+      pixels, [&](long i) { return double(cpu.K[i]); }, [&](long i) { return double(gpu.K[i]); },
+      [&](long i) { return kappa(i) * kappa(i); });
   g.max_error = std::max(g.max_error, gk.max_error);
   g.mismatched_definedness += gk.mismatched_definedness;
   const std::string check = verdict(g, 1e-4, "|dH|/kappa, |dK|/kappa^2");
@@ -215,8 +233,8 @@ void print_table(const focal::CudaDevice& d) {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
   std::printf("Device: %s (compute %d.%d, %d SMs, %.0f GiB); %s\n\n", d.name.c_str(),
-              d.compute_major, d.compute_minor, d.multiprocessors,
-              d.memory_bytes / 1073741824.0, date);
+              d.compute_major, d.compute_minor, d.multiprocessors, d.memory_bytes / 1073741824.0,
+              date);
   std::printf("| path | size | median ms | rate | check vs CPU | target |\n");
   std::printf("|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
@@ -243,8 +261,10 @@ int main(int argc, char** argv) {
   int max_vertices = 10000000, reps = 50;
   for (int a = 1; a + 1 < argc; a += 2) {
     const std::string flag = argv[a];
-    if (flag == "--max-vertices") max_vertices = std::atoi(argv[a + 1]);
-    else if (flag == "--reps") reps = std::atoi(argv[a + 1]);
+    if (flag == "--max-vertices")
+      max_vertices = std::atoi(argv[a + 1]);
+    else if (flag == "--reps")
+      reps = std::atoi(argv[a + 1]);
   }
   try {
     const focal::CudaDevice device = focal::require_cuda_device(0);

@@ -135,6 +135,20 @@ ResidentVertexFit::ResidentVertexFit(PositionsRef V, FacesRef F, NormalsRef N,
 
 ResidentVertexFit::~ResidentVertexFit() = default;
 
+void ResidentVertexFit::set_normals(NormalsRef N) {
+  const std::size_t count = state_->n();
+  if (static_cast<std::size_t>(N.rows()) != count) {
+    throw InvalidInput("CurvatureCudaContext: " + std::to_string(N.rows()) + " normals for " +
+                       std::to_string(count) + " vertices");
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    set_record_normal(N, static_cast<Eigen::Index>(i), state_->host.vertices[i]);
+  }
+  if (count == 0) return;
+  const DeviceScope scope(state_->device);
+  state_->vertices.upload(state_->host.vertices.data(), count);
+}
+
 float ResidentVertexFit::run_kernel() {
   const DeviceScope scope(state_->device);
   EventTimer timer;
@@ -174,12 +188,39 @@ std::size_t ResidentVertexFit::transfer_bytes() const {
 
 }  // namespace cuda
 
+namespace {
+
+CurvatureResult fit_once(cuda::ResidentVertexFit& fit) {
+  if (fit.vertex_count() > 0) (void)fit.run_kernel();
+  return fit.result();
+}
+
+}  // namespace
+
 CurvatureResult estimate_curvature_cuda(PositionsRef V, FacesRef F, NormalsRef N,
                                         const CurvatureOptions& options, int device) {
   cuda::ResidentVertexFit fit(V, F, N, options, device);
-  if (fit.vertex_count() == 0) return fit.result();
-  (void)fit.run_kernel();
-  return fit.result();
+  return fit_once(fit);
 }
+
+struct CurvatureCudaContext::Resident {
+  Resident(PositionsRef V, FacesRef F, NormalsRef N, const CurvatureOptions& options, int device)
+      : fit(V, F, N, options, device) {}
+  cuda::ResidentVertexFit fit;
+};
+
+CurvatureCudaContext::CurvatureCudaContext(PositionsRef V, FacesRef F, NormalsRef N,
+                                           const CurvatureOptions& options, int device)
+    : resident_(std::make_unique<Resident>(V, F, N, options, device)) {}
+
+CurvatureCudaContext::~CurvatureCudaContext() = default;
+CurvatureCudaContext::CurvatureCudaContext(CurvatureCudaContext&&) noexcept = default;
+CurvatureCudaContext& CurvatureCudaContext::operator=(CurvatureCudaContext&&) noexcept = default;
+
+void CurvatureCudaContext::set_normals(NormalsRef N) { resident_->fit.set_normals(N); }
+
+CurvatureResult CurvatureCudaContext::estimate() { return fit_once(resident_->fit); }
+
+int CurvatureCudaContext::vertex_count() const { return resident_->fit.vertex_count(); }
 
 }  // namespace focal

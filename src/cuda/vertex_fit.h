@@ -41,8 +41,7 @@ inline void validate_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N,
   if (!(o.umbilic_tolerance >= 0.0)) throw InvalidInput(who + "umbilic_tolerance must be >= 0");
   if (o.threads < 0) throw InvalidInput(who + "threads must be >= 0");
   if (N.rows() != V.rows()) {
-    throw InvalidInput(who + std::to_string(N.rows()) + " normals for " +
-                       std::to_string(V.rows()) +
+    throw InvalidInput(who + std::to_string(N.rows()) + " normals for " + std::to_string(V.rows()) +
                        " vertices (normals are required; estimate them with vertex_normals)");
   }
   validate_mesh_arrays(V, F, N, "estimate_curvature_cuda", o.threads);
@@ -58,10 +57,23 @@ constexpr double min_relative_determinant() {
 }
 
 /// hi + lo with lo the rounding error of hi: 2 x 24 bits carry a double to about 48 bits.
+/// Out of line: inlined into a loop over a record's three coordinates, g++ 12 at -O3 vectorises
+/// two of them and gives lo = 0 there (measured on every vertex of a torus), as if
+/// double(float(x)) were x; called, it computes what it says.
 template <class T>
-inline void split(double x, T& hi, T& lo) {
+[[gnu::noinline]] void split(double x, T& hi, T& lo) {
   hi = static_cast<T>(x);
   lo = static_cast<T>(x - static_cast<double>(hi));
+}
+
+/// Writes vertex i's unit normal (NaN where N's row is zero or not finite: its vertex is
+/// `undefined`, as curvature/detail.h's unit_rows) into its record as hi + lo pairs.
+template <class T>
+inline void set_record_normal(NormalsRef N, Eigen::Index i, VertexRecord<T>& r) {
+  const double length = N.row(i).norm();
+  const bool normal_ok = std::isfinite(length) && length > 0.0;
+  for (int c = 0; c < 3; ++c)
+    split(normal_ok ? N(i, c) / length : NAN, r.normal_hi[c], r.normal_lo[c]);
 }
 
 /// Everything the kernel reads, on the host; params holds the scalars (pointers unset).
@@ -98,12 +110,8 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
   p.vertices.resize(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
     VertexRecord<T>& r = p.vertices[static_cast<std::size_t>(i)];
-    const double length = N.row(i).norm();  // as curvature/detail.h's unit_rows
-    const bool normal_ok = std::isfinite(length) && length > 0.0;
-    for (int c = 0; c < 3; ++c) {
-      split(V(i, c) / unit, r.position_hi[c], r.position_lo[c]);
-      split(normal_ok ? N(i, c) / length : NAN, r.normal_hi[c], r.normal_lo[c]);
-    }
+    for (int c = 0; c < 3; ++c) split(V(i, c) / unit, r.position_hi[c], r.position_lo[c]);
+    set_record_normal(N, i, r);
   }
   const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(n), F, options.threads);
   p.rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings, options.threads);
@@ -128,12 +136,19 @@ struct VertexFitFields {
   std::vector<int> rays_used, rays_excluded;
 
   explicit VertexFitFields(std::size_t n)
-      : k1(n), k2(n), H(n), K(n), d1(3 * n), d2(3 * n), residual(n), point_class(n),
-        rays_used(n), rays_excluded(n) {}
+      : k1(n),
+        k2(n),
+        H(n),
+        K(n),
+        d1(3 * n),
+        d2(3 * n),
+        residual(n),
+        point_class(n),
+        rays_used(n),
+        rays_excluded(n) {}
   [[nodiscard]] VertexFitOutput<T> view() {
-    return {k1.data(), k2.data(), H.data(),        K.data(),         d1.data(),
-            d2.data(), residual.data(), point_class.data(), rays_used.data(),
-            rays_excluded.data()};
+    return {k1.data(), k2.data(),       H.data(),           K.data(),         d1.data(),
+            d2.data(), residual.data(), point_class.data(), rays_used.data(), rays_excluded.data()};
   }
 };
 
@@ -143,7 +158,8 @@ CurvatureResult to_result(const VertexFitFields<T>& f) {
   const auto n = static_cast<Eigen::Index>(f.k1.size());
   CurvatureResult r;
   const auto vector = [n](const std::vector<T>& v) {
-    return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(v.data(), n).template cast<double>();
+    return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(v.data(), n)
+        .template cast<double>();
   };
   const auto rows = [n](const std::vector<T>& v) {
     return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 3, Eigen::RowMajor>>(v.data(), n, 3)
@@ -192,6 +208,9 @@ class ResidentVertexFit {
   ResidentVertexFit(const ResidentVertexFit&) = delete;
   ResidentVertexFit& operator=(const ResidentVertexFit&) = delete;
 
+  /// Replaces the normals (#V x 3, as the constructor's) and uploads the vertex records; the
+  /// neighbourhoods and outputs stay on the device. \throw InvalidInput on a wrong row count.
+  void set_normals(NormalsRef N);
   /// One launch over every vertex; returns the kernel's time in milliseconds.
   float run_kernel();
   /// Upload of the inputs, one launch, download of every output; milliseconds.

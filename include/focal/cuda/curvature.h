@@ -7,6 +7,8 @@
 /// every function here throws DeviceError saying so, never falling back to the CPU silently.
 /// Calls are synchronous and leave the calling thread's current CUDA device as it was.
 
+#include <memory>
+
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/triangle_curvature.h"
 
@@ -34,6 +36,36 @@ namespace focal {
 [[nodiscard]] CurvatureResult estimate_curvature_cuda(PositionsRef V, FacesRef F, NormalsRef N,
                                                       const CurvatureOptions& options = {},
                                                       int device = 0);
+
+/// estimate_curvature_cuda for a mesh whose normals change between estimates (a normal filter
+/// or an optimisation in a loop, normals from another tool): the vertex records, the
+/// neighbourhoods and the output buffers are built and uploaded once, by the constructor; each
+/// set_normals rewrites and uploads only the vertex records (positions and normals, 48 bytes a
+/// vertex), and each estimate launches the fit and downloads the fields.
+///
+/// Each estimate gives the bits of estimate_curvature_cuda(V, F, N, options, device) with the
+/// current normals: the same kernel on the same data. Calls are synchronous and leave the
+/// calling thread's current CUDA device as it was; a context is not thread-safe.
+class CurvatureCudaContext {
+ public:
+  /// \throw as estimate_curvature_cuda.
+  CurvatureCudaContext(PositionsRef V, FacesRef F, NormalsRef N,
+                       const CurvatureOptions& options = {}, int device = 0);
+  ~CurvatureCudaContext();
+  CurvatureCudaContext(CurvatureCudaContext&&) noexcept;
+  CurvatureCudaContext& operator=(CurvatureCudaContext&&) noexcept;
+
+  /// New normals, #V x 3 (zero or non-finite rows make their vertex `undefined`).
+  /// \throw InvalidInput on a wrong row count; DeviceError on a CUDA error.
+  void set_normals(NormalsRef N);
+  /// The fit with the current normals. \throw DeviceError on a CUDA error.
+  [[nodiscard]] CurvatureResult estimate();
+  [[nodiscard]] int vertex_count() const;
+
+ private:
+  struct Resident;  ///< the device's copy (src/cuda/vertex_fit.cu)
+  std::unique_ptr<Resident> resident_;
+};
 
 /// The per-triangle characteristic equation on a device.
 /// \throw DeviceError without the CUDA backend or a device; InvalidInput as triangle_curvature.
