@@ -270,6 +270,28 @@ TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
   return {std::move(e.curvature), std::move(e.crease)};
 }
 
+RecommendedStatistics tile_statistics(const TileMesh& tile, const std::vector<int>& ids,
+                                      const std::vector<int>& owned,
+                                      Eigen::Index whole_vertex_count, double mean_edge_length,
+                                      const EstimateOptions& options, int threads) {
+  if (options.estimator != Estimator::recommended) {
+    throw InvalidInput("tile_statistics: measures the recommended estimator's choices only");
+  }
+  if (!tile.N ||
+      (options.normals != NormalsSource::automatic && options.normals != NormalsSource::file)) {
+    throw InvalidInput(
+        "tile_statistics: needs the mesh's own normals (nx, ny, nz): without them the "
+        "recommended estimate orients the faces of closed components over the whole mesh, "
+        "which a tile cannot decide");
+  }
+  const PreparedMesh mesh(tile.V, tile.F, NormalsRef(*tile.N),
+                          {.threads = threads, .mean_edge_length = mean_edge_length});
+  // The rows fixed as the whole mesh's are (filled, made unit: per row, from its faces).
+  const PreparedNormals prepared = prepare_normals(mesh, options);
+  const PreparedMesh fit = prepared.N ? mesh.with_normals(NormalsRef(*prepared.N)) : mesh;
+  return recommended_statistics(fit, owned, ids, whole_vertex_count, options.recommended);
+}
+
 void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
                   const std::vector<int>& ids, TileEstimate& whole) {
   if (part.crease.size() != 0 && whole.crease.size() == 0) {

@@ -77,6 +77,19 @@ struct TileEstimate {
 [[nodiscard]] TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
                                          const EstimateOptions& options, int threads = 0);
 
+/// The recommended estimator's recommended_statistics of a tile's owned vertices (rows `owned`,
+/// whole-mesh ids `ids`, one per tile vertex), on the tile's normals prepared as the estimate
+/// prepares them (prepare_normals), with the whole mesh's mean edge length: the tile's share of
+/// the whole mesh's RecommendedMeshWide, for a mesh that no process holds whole (the medians
+/// over all tiles, recommended_mesh_wide_from). The tile needs a halo of
+/// kRecommendedStatisticsReach rings. 	hrow InvalidInput when `options` is not the recommended
+/// estimator on the mesh's own normals, or the tile has none: without them the whole mesh's
+/// closed components are oriented (prepare_normals), which a tile cannot decide.
+[[nodiscard]] RecommendedStatistics tile_statistics(
+    const TileMesh& tile, const std::vector<int>& ids, const std::vector<int>& owned,
+    Eigen::Index whole_vertex_count, double mean_edge_length, const EstimateOptions& options,
+    int threads = 0);
+
 /// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
 /// .curvature and .crease, with the memory of the largest tile in place of the whole mesh's.
 [[nodiscard]] TileEstimate estimate_tiled(const PreparedMesh& mesh,
