@@ -317,15 +317,27 @@ def curvature_stream(
     cluster = None
     if own_cluster:
         client, cluster = _local_client(workers, memory_limit)
-    try:
-        futures = [client.submit(stream.estimate_tile, plan, t, parts, retries=retries,
-                                 key=f"focal-stream-tile-{t}-{uuid.uuid4().hex}")
+
+    def run(function, name: str, *arguments) -> list:
+        futures = [client.submit(function, plan, t, *arguments, retries=retries,
+                                 key=f"focal-stream-{name}-{t}-{uuid.uuid4().hex}")
                    for t in range(plan["tile_count"])]
         if progress:
             from distributed import progress as dask_progress
 
             dask_progress(futures)
-        done = [r for _, r in as_completed(futures, with_results=True)]
+        return sorted((r for _, r in as_completed(futures, with_results=True)),
+                      key=lambda r: r["tile"])
+
+    try:
+        statistics = None
+        if o["estimator"] == "recommended":
+            # The whole mesh's choices from every tile's statistics (a pass of tasks), then
+            # the tiles' estimates with them.
+            statistics = run(stream.tile_statistics, "statistics")
+            stream.choose(plan, statistics)
+            phase_done("choices")
+        done = run(stream.estimate_tile, "tile", parts)
     finally:
         if cluster is not None:
             client.close()
@@ -333,8 +345,10 @@ def curvature_stream(
     phase_done("tiles")
     manifest = {k: plan[k] for k in ("path", "vertex_count", "face_count", "tile_count",
                                       "halo_rings", "choices", "options")}
-    manifest["fields"] = list(stream.FIELDS)
-    manifest["parts"] = sorted(done, key=lambda r: r["tile"])
+    manifest["fields"] = list(stream.FIELDS) + (["crease"] if statistics is not None else [])
+    manifest["parts"] = done
+    if statistics is not None:
+        manifest["statistics_peak_rss"] = max(r["peak_rss"] for r in statistics)
     with open(os.path.join(parts, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
     if output is not None:

@@ -241,15 +241,11 @@ class TileMap:
 
 
 def _uniform_options(options: dict, mesh: PlyMesh) -> None:
-    if options["estimator"] != "paper":
-        raise focal.InvalidInputError(
-            "streaming input runs estimator='paper' only: the recommended estimator's "
-            "whole-mesh choices (noise, file normals) need the whole mesh in memory "
-            "(focal.distributed.curvature without stream)")
     if options["normals"] not in ("auto", "file") or not mesh.has_normals:
         raise focal.InvalidInputError(
             f"{mesh.path}: streaming input needs the file's normals (nx, ny, nz): normals "
-            "from the faces are oriented per closed component over the whole mesh")
+            "from the faces, and the recommended estimator without normals, orient the faces "
+            "of closed components over the whole mesh, which streaming does not do")
 
 
 def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: int) -> dict:
@@ -311,12 +307,112 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
         "path": os.path.abspath(mesh.path), "workdir": os.path.abspath(workdir),
         "vertex_count": mesh.vertex_count, "face_count": mesh.face_count,
         "tile_count": tile_count, "lo": lo.tolist(), "hi": hi.tolist(),
-        "choices": {"mean_edge_length": mean_edge},
-        "halo_rings": int(_ext.estimate_reach(options)), "options": options,
+        "choices": {"mean_edge_length": mean_edge}, "options": options,
+        # The recommended estimator's reach depends on its whole-mesh choices (choose()).
+        "halo_rings": (None if options["estimator"] == "recommended"
+                       else int(_ext.estimate_reach(options))),
     }
-    with open(os.path.join(workdir, "plan.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    _write_plan(out)
     return out
+
+
+def _write_plan(p: dict) -> None:
+    tmp = os.path.join(p["workdir"], ".plan.json.tmp")
+    with open(tmp, "w") as f:
+        json.dump(p, f, indent=1)
+    os.replace(tmp, os.path.join(p["workdir"], "plan.json"))
+
+
+#: Columns of a tile's statistics file (float64, one row per owned vertex).
+STATISTICS = ("jet_residual", "angle_along", "angle_against")
+
+
+def tile_statistics(p: dict, t: int) -> dict:
+    """The task of tile t in the recommended estimator's plan: its owned vertices' share of the
+    whole mesh's choices (focal::tile_statistics, with a halo of statistics_reach() rings). The
+    per-vertex values go to the tile's statistics file (.npy, columns STATISTICS); returns the
+    counts, the noise sample (whole-mesh ids and values) and the peak RSS."""
+    a = tile_arrays(p, t, int(_ext.statistics_reach()))
+    d = _ext.tile_statistics(a["V"], a["F"], a["N"], a["vertices"], a["owned"],
+                             p["vertex_count"], p["options"], p["choices"]["mean_edge_length"])
+    path = _tile_file(p["workdir"], "statistics", t)
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "wb") as f:
+        np.save(f, np.column_stack([d[k] for k in STATISTICS]))
+    os.replace(tmp, path)
+    return {"tile": t, "along": int(d["along"]), "against": int(d["against"]),
+            "sample": d["sample"].tolist(), "sample_noise": d["sample_noise"].tolist(),
+            "peak_rss": peak_rss()}
+
+
+def choose(p: dict, statistics: list) -> dict:
+    """The recommended estimator's whole-mesh choices from every tile's statistics (the tasks'
+    results and their files): exact medians over the files (_median, memory of one file and a
+    histogram), then focal::recommended_mesh_wide_from; the plan gets the choices and the halo
+    of the estimate they decide, and is written again. Returns the plan."""
+    files = [_tile_file(p["workdir"], "statistics", t) for t in range(p["tile_count"])]
+    sample = sorted((i, x) for r in statistics for i, x in zip(r["sample"], r["sample_noise"]))
+    medians = {
+        "jet_residual": _median(files, 0),
+        "angle_along": _median(files, 1), "angle_against": _median(files, 2),
+        "along": sum(r["along"] for r in statistics),
+        "against": sum(r["against"] for r in statistics),
+        "sample_noise": [x for _, x in sample], "has_normals": True,
+    }
+    p["choices"] = dict(_ext.recommended_choices(medians, p["choices"]["mean_edge_length"]))
+    p["halo_rings"] = int(_ext.estimate_reach(p["options"], p["choices"]))
+    _write_plan(p)
+    return p
+
+
+def _keys(x: np.ndarray) -> np.ndarray:
+    """Finite doubles -> uint64 keys in the same order (-0.0 as +0.0)."""
+    u = (x + 0.0).view(np.uint64)
+    top = np.uint64(1 << 63)
+    return np.where(u & top, ~u, u | top)
+
+
+def _value(key: int) -> float:
+    top = 1 << 63
+    bits = key & ~top if key & top else ~key & ((1 << 64) - 1)
+    return float(np.array([bits], np.uint64).view(np.float64)[0])
+
+
+#: _median reads and partitions the candidates once they number at most this many.
+_CANDIDATES = 1 << 22
+
+
+def _median(files: list, column: int) -> float:
+    """The median of the finite values of `column` over the statistics files, as the library's
+    finite_median takes it (the value at rank size / 2 in ascending order; NaN when none): an
+    exact radix selection on the values' bits, 16 at a time, each pass reading the files one at
+    a time; once the candidates number at most _CANDIDATES, they are read and partitioned."""
+    def finite_keys():
+        for f in files:
+            x = np.load(f, mmap_mode="r")[:, column]
+            yield _keys(np.ascontiguousarray(x[np.isfinite(x)]))
+
+    size = sum(k.size for k in finite_keys())
+    if size == 0:
+        return float("nan")
+    rank, prefix = size // 2, 0
+    for shift in (48, 32, 16, 0):
+        counts = np.zeros(1 << 16, np.int64)
+        for k in finite_keys():
+            if shift < 48:
+                k = k[(k >> np.uint64(shift + 16)) == np.uint64(prefix)]
+            counts += np.bincount((k >> np.uint64(shift) & np.uint64(0xFFFF)).astype(np.int64),
+                                  minlength=1 << 16)
+        below = np.cumsum(counts) - counts
+        digit = int(np.searchsorted(below + counts, rank, side="right"))
+        rank -= int(below[digit])
+        prefix = prefix << 16 | digit
+        if shift > 0 and counts[digit] <= _CANDIDATES:
+            shift_left = np.uint64(shift)
+            rest = np.concatenate([k[(k >> shift_left) == np.uint64(prefix)]
+                                   for k in finite_keys()])
+            return _value(int(np.partition(rest, rank)[rank]))
+    return _value(prefix)
 
 
 def _tile_file(workdir: str, kind: str, t: int) -> str:
@@ -366,10 +462,11 @@ def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.sort(np.concatenate([a, b]), kind="stable")
 
 
-def tile_arrays(p: dict, t: int) -> dict:
+def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     """Tile t's arrays, read from the plan's files and the mesh: its vertices within the halo's
-    rings of the owned ones and the faces with a corner within one ring less, sorted by global
-    id (as partition_mesh and extract_tile give them)."""
+    rings of the owned ones (the plan's halo, or `halo_rings`) and the faces with a corner
+    within one ring less, sorted by global id (as partition_mesh and extract_tile give them)."""
+    halo_rings = p["halo_rings"] if halo_rings is None else halo_rings
     mesh = PlyMesh(p["path"])
     tiles = TileMap(np.array(p["lo"]), np.array(p["hi"]),
                     np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"))
@@ -377,7 +474,7 @@ def tile_arrays(p: dict, t: int) -> dict:
     reached, frontier = owned, owned
     taken = [np.empty((0, 4), np.int32)]
     taken_ids = np.empty(0, np.int32)
-    for _ in range(p["halo_rings"]):
+    for _ in range(halo_rings):
         if frontier.size == 0:
             break
         found = []
@@ -401,7 +498,8 @@ def tile_arrays(p: dict, t: int) -> dict:
     return {
         "V": mesh.positions(reached), "N": mesh.normals(reached),
         "F": np.searchsorted(reached, faces[:, 1:]).astype(np.int32),
-        "vertices": reached, "faces": faces[:, 0], "owned": np.searchsorted(reached, owned),
+        "vertices": np.ascontiguousarray(reached, np.int32), "faces": faces[:, 0],
+        "owned": np.searchsorted(reached, owned).astype(np.int32),
     }
 
 
@@ -414,8 +512,11 @@ def estimate_tile(p: dict, t: int, parts: str) -> dict:
     rows = a["owned"]
     name = f"part-{t:06d}.npz"
     tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
+    fields = {k: d[k][rows] for k in FIELDS}
+    if d["crease"] is not None:  # the recommended estimator's crease flags
+        fields["crease"] = d["crease"][rows]
     with open(tmp, "wb") as f:
-        np.savez(f, ids=a["vertices"][rows], **{k: d[k][rows] for k in FIELDS})
+        np.savez(f, ids=a["vertices"][rows], **fields)
     os.replace(tmp, os.path.join(parts, name))
     return {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0]),
             "peak_rss": peak_rss()}
@@ -441,11 +542,11 @@ def concatenate(manifest: dict, parts: str, output: str) -> None:
     import zipfile
 
     n = manifest["vertex_count"]
-    columns = {k: os.path.join(parts, f".{k}.npy") for k in FIELDS}
+    columns = {k: os.path.join(parts, f".{k}.npy") for k in manifest["fields"]}
     for k, column in columns.items():
         shape = (n, 3) if k in ("d1", "d2") else (n,)
-        dtype = {"point_class": np.uint8, "rays_used": np.int32,
-                 "rays_excluded": np.int32}.get(k, np.float64)
+        dtype = {"point_class": np.uint8, "rays_used": np.int32, "rays_excluded": np.int32,
+                 "crease": np.uint8}.get(k, np.float64)
         np.lib.format.open_memmap(column, "w+", dtype, shape).flush()  # header, size
     for part in manifest["parts"]:
         with np.load(os.path.join(parts, part["part"])) as z:

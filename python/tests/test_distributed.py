@@ -298,6 +298,85 @@ def test_streamed_tiles_give_the_whole_mesh_bits(client, awkward_ply, tmp_path, 
     assert np.array_equal(np.sort(ids), np.arange(len(V)))  # every vertex in one part
 
 
+@pytest.fixture(scope="module")
+def streamed_meshes(tmp_path_factory, awkward_ply, awkward):
+    """Binary PLY meshes with normals for the recommended estimator: the awkward one (an
+    unreferenced and a NaN vertex too), its normals turned inward with some rows zero (the
+    majority side, rows filled from the faces), and a torus beside a monkey saddle with 5% and
+    10% vertex noise (2- and 3-ring plans)."""
+    folder = tmp_path_factory.mktemp("streamed")
+    out = {"awkward": awkward_ply[0]}
+    V, F, N = awkward
+    N = -N
+    N[::50] = 0.0
+    focal.write_mesh(folder / "inward.ply", V, F, N)
+    out["inward"] = folder / "inward.ply"
+    torus = focal.generate_surface("torus", 1500, triangulation="irregular", seed=6)
+    saddle = focal.generate_surface("monkey-saddle", 700, triangulation="irregular", seed=7)
+    V, F, N = joined((torus.V, torus.F, torus.N), (saddle.V + [3, 0, 0], saddle.F, saddle.N))
+    h = np.mean(np.linalg.norm(V[F[:, 0]] - V[F[:, 1]], axis=1))
+    rng = np.random.default_rng(8)
+    u = rng.uniform(-1, 1, len(V))[:, None]
+    for percent in (5, 10):
+        path = folder / f"noise{percent}.ply"
+        focal.write_mesh(path, V + percent / 100 * h * u * N, F, N)
+        out[f"noise{percent}"] = path
+    return out
+
+
+@pytest.mark.parametrize("mesh, tile_vertices, rings", [
+    ("awkward", 400, 1), ("awkward", 100_000, 1), ("inward", 350, 1), ("noise5", 300, 2),
+    ("noise10", 300, 3)])
+def test_streamed_recommended_estimate_gives_the_whole_mesh_bits(client, streamed_meshes,
+                                                                 tmp_path, mesh, tile_vertices,
+                                                                 rings):
+    """The default estimator streamed: its whole-mesh choices from a pass of tile statistics
+    (exact medians over the tiles' files), then the tiles; every field and the crease flags are
+    focal.curvature's of the whole file."""
+    path = streamed_meshes[mesh]
+    m = focal.read_mesh(path)
+    whole = focal.curvature(m.V, m.F, m.N)
+    assert whole.plan["rings"] == rings
+    out = tmp_path / "fields.npz"
+    manifest = fd.curvature_stream(path, tmp_path / "parts", client, output=out,
+                                   tile_vertices=tile_vertices, threads=1)
+    assert (manifest["tile_count"] > 1) == (tile_vertices < len(m.V))
+    saved = np.load(out)
+    for name in fd.FIELDS + ("crease",):
+        assert saved[name].tobytes() == getattr(whole, name).tobytes(), name
+    assert not np.isnan(saved["k1"]).all()
+    for name in ("noise", "position_noise"):
+        assert manifest["choices"][name] == whole.plan[name], name
+    assert manifest["choices"]["side"] == (-1.0 if mesh == "inward" else 1.0)
+    assert manifest["halo_rings"] == focal._focal_ext.estimate_reach(
+        focal._estimate_options("recommended", 1, focal._curvature_options({})[2]),
+        manifest["choices"])
+
+
+@pytest.mark.parametrize("candidates", [1 << 22, 3])
+def test_streamed_median_is_the_librarys(tmp_path, monkeypatch, candidates):
+    """The exact median over the tiles' statistics files (a radix selection on the values' bits,
+    here also down to the last 16 bits) is the value at rank size / 2 of the finite values, as
+    the library's median takes it: ties, negative values, zeros of both signs, NaN and infinite
+    values, an empty file."""
+    from focal import stream
+
+    monkeypatch.setattr(stream, "_CANDIDATES", candidates)
+    rng = np.random.default_rng(9)
+    values = np.concatenate([rng.normal(size=3000), np.full(500, 0.25), np.full(40, -0.0),
+                             np.zeros(40), [np.nan] * 30, [np.inf, -np.inf],
+                             np.nextafter(0.25, 1) + np.zeros(7)])
+    rng.shuffle(values)
+    files = []
+    for k, chunk in enumerate(np.array_split(values, [0, 1000, 1001, 2500])):
+        files.append(tmp_path / f"s{k}.npy")
+        np.save(files[-1], np.column_stack([chunk, -chunk, np.full(len(chunk), np.nan)]))
+    for column, x in ((0, values), (1, -values)):
+        finite = np.sort(x[np.isfinite(x)])
+        assert stream._median(files, column) == finite[finite.size // 2]
+    assert np.isnan(stream._median(files, 2))
+
+
 def test_streamed_halo_one_ring_short_changes_the_result(client, awkward_ply, tmp_path,
                                                           monkeypatch):
     """The halo is what makes the parts exact: short of the rings the fit reads, vertices near
@@ -322,13 +401,14 @@ def test_streamed_halo_one_ring_short_changes_the_result(client, awkward_ply, tm
 
 def test_streamed_input_errors(client, awkward, awkward_ply, tmp_path):
     path, _ = awkward_ply
-    with pytest.raises(focal.InvalidInputError, match="estimator='paper' only"):
-        fd.curvature_stream(path, tmp_path / "p1", client)
     V, F, _ = awkward
     no_normals = tmp_path / "no_normals.ply"
     focal.write_mesh(no_normals, V, F)
+    for estimator in ("recommended", "paper"):  # the closed components' orientation
+        with pytest.raises(focal.InvalidInputError, match="file's normals.*closed components"):
+            fd.curvature_stream(no_normals, tmp_path / "p2", client, estimator=estimator)
     with pytest.raises(focal.InvalidInputError, match="file's normals"):
-        fd.curvature_stream(no_normals, tmp_path / "p2", client, estimator="paper")
+        fd.curvature_stream(path, tmp_path / "p1", client, estimator="paper", normals="area")
     ascii_ply = tmp_path / "ascii.ply"
     ascii_ply.write_text("ply\nformat ascii 1.0\nelement vertex 0\nend_header\n")
     with pytest.raises(focal.FocalIOError, match="binary PLY only"):
@@ -362,9 +442,11 @@ def test_command_line_streams_parts_and_a_manifest(tmp_path, client, awkward_ply
     saved = np.load(out)
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
     assert (tmp_path / "parts" / "manifest.json").exists()
-    r = run_cli(str(path), "--parts", str(tmp_path / "p2"), "--scheduler",
+    no_normals = tmp_path / "no_normals.ply"
+    focal.write_mesh(no_normals, V, F)
+    r = run_cli(str(no_normals), "--parts", str(tmp_path / "p2"), "--scheduler",
                 client.scheduler.address)
-    assert r.returncode == 2 and "estimator='paper' only" in r.stderr
+    assert r.returncode == 2 and "needs the file's normals" in r.stderr
 
 
 def _vm_data_mb():
