@@ -503,23 +503,44 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     }
 
 
-def estimate_tile(p: dict, t: int, parts: str) -> dict:
+#: Formats of the parts: .npz (ids and the fields as arrays) or .csv (the rows of `focal
+#: curvature -o fields.csv`, by focal.write_fields, with the ids beside them in a .ids.npy).
+PART_FORMATS = ("npz", "csv")
+
+
+def estimate_tile(p: dict, t: int, parts: str, part_format: str = "npz") -> dict:
     """The task of tile t: its estimate with the whole mesh's choices, the owned rows written
-    to parts/part-NNNNNN.npz (ids and fields, through a temporary renamed); returns the part's
+    to parts/part-NNNNNN.npz (ids and fields) or, for part_format "csv", parts/part-NNNNNN.csv
+    (the bytes `focal curvature -o x.csv` writes for these rows, header included) and their ids
+    in parts/part-NNNNNN.ids.npy; each through a temporary file renamed. Returns the part's
     name, its row count and the process's peak RSS (bytes, peak_rss)."""
+    if part_format not in PART_FORMATS:
+        raise focal.InvalidInputError(f"part_format: {part_format!r}, expected one of "
+                                      f"{PART_FORMATS}")
     a = tile_arrays(p, t)
     d = _ext.estimate_tile(a["V"], a["F"], a["N"], p["options"], p["choices"])
     rows = a["owned"]
-    name = f"part-{t:06d}.npz"
-    tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
+    ids = a["vertices"][rows]
     fields = {k: d[k][rows] for k in FIELDS}
     if d["crease"] is not None:  # the recommended estimator's crease flags
         fields["crease"] = d["crease"][rows]
-    with open(tmp, "wb") as f:
-        np.savez(f, ids=a["vertices"][rows], **fields)
-    os.replace(tmp, os.path.join(parts, name))
-    return {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0]),
-            "peak_rss": peak_rss()}
+    name = f"part-{t:06d}.{part_format}"
+    out = {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0])}
+    if part_format == "npz":
+        tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
+        with open(tmp, "wb") as f:
+            np.savez(f, ids=ids, **fields)
+        os.replace(tmp, os.path.join(parts, name))
+    else:
+        out["ids"] = f"part-{t:06d}.ids.npy"
+        tmp = os.path.join(parts, f".{out['ids']}.{os.getpid()}.tmp")
+        with open(tmp, "wb") as f:
+            np.save(f, ids)
+        os.replace(tmp, os.path.join(parts, out["ids"]))
+        focal.write_fields(os.path.join(parts, name), focal.Curvature(**fields),
+                           threads=p["options"]["threads"])
+    out["peak_rss"] = peak_rss()
+    return out
 
 
 def peak_rss() -> int:
@@ -535,7 +556,61 @@ def peak_rss() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
+#: Rows of the concatenated CSV gathered in memory at a time.
+CSV_ROWS = 1 << 18
+
+
 def concatenate(manifest: dict, parts: str, output: str) -> None:
+    """The parts' rows in input order, as one file: a .npz of the fields from .npz parts, or
+    from .csv parts the CSV that `focal curvature -o fields.csv` writes (concatenate_csv)."""
+    formats = {os.path.splitext(part["part"])[1] for part in manifest["parts"]}
+    wanted = os.path.splitext(output)[1].lower()
+    if formats != {wanted}:
+        raise focal.InvalidInputError(
+            f"{output}: a {wanted} concatenation is made from {wanted} parts, these are "
+            f"{', '.join(sorted(formats))}")
+    if wanted == ".csv":
+        return concatenate_csv(manifest, parts, output)
+    _concatenate_npz(manifest, parts, output)
+
+
+def concatenate_csv(manifest: dict, parts: str, output: str) -> None:
+    """The .csv parts' rows in input order: the same bytes as the whole mesh's `focal curvature
+    -o fields.csv`. The rows are the writer's bytes, moved, not formatted again: each part's rows
+    are in ascending id order, so CSV_ROWS ids at a time, every part gives the next run of its
+    lines (memory: those lines, and each part's ids mapped)."""
+    n = manifest["vertex_count"]
+    files, ids, cursor, header = [], [], [], None
+    tmp = output + ".tmp"
+    try:
+        for part in manifest["parts"]:
+            files.append(open(os.path.join(parts, part["part"]), "rb"))
+            line = files[-1].readline()
+            if header is None:
+                header = line
+            elif line != header:
+                raise focal.FocalIOError(f"{part['part']}: its header is not the other parts'")
+            ids.append(np.load(os.path.join(parts, part["ids"]), mmap_mode="r"))
+            cursor.append(0)
+        with open(tmp, "wb") as out:
+            out.write(header or b"")
+            for begin, end in _ranges(n, CSV_ROWS):
+                lines = [b""] * (end - begin)
+                for k, f in enumerate(files):
+                    stop = int(np.searchsorted(ids[k], end))
+                    for i in ids[k][cursor[k]:stop].tolist():
+                        lines[i - begin] = f.readline()
+                    cursor[k] = stop
+                out.write(b"".join(lines))
+        os.replace(tmp, output)
+    finally:
+        for f in files:
+            f.close()
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def _concatenate_npz(manifest: dict, parts: str, output: str) -> None:
     """The parts' rows in input order, as one .npz of the fields: each part's rows are written
     by id into .npy columns mapped for that part only (the written pages then belong to the
     page cache, not to this process), then the columns are stored in the .npz."""

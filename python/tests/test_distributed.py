@@ -353,6 +353,58 @@ def test_streamed_recommended_estimate_gives_the_whole_mesh_bits(client, streame
         manifest["choices"])
 
 
+def focal_curvature_csv(mesh, out, *args):
+    """`focal curvature mesh -o out` (FOCAL_CLI, which `make test` sets), else the same writer
+    from Python (the bytes of test_command_line_writes_the_whole_mesh_fields)."""
+    cli = os.environ.get("FOCAL_CLI")
+    if cli:
+        subprocess.run([cli, "curvature", str(mesh), "-o", str(out), *args], check=True,
+                       capture_output=True)
+    else:
+        m = focal.read_mesh(mesh)
+        focal.write_fields(out, focal.curvature(m.V, m.F, m.N, estimator="paper" if args
+                                                else "recommended"))
+
+
+@pytest.mark.parametrize("mesh, estimator, tile_vertices", [
+    ("awkward", "recommended", 400), ("inward", "recommended", 350),
+    ("noise10", "recommended", 300), ("awkward", "paper", 500)])
+def test_streamed_csv_parts_and_their_concatenation_are_the_whole_runs_bytes(
+        client, streamed_meshes, tmp_path, mesh, estimator, tile_vertices):
+    """Parts as CSV: each the header and the rows of its vertices that `focal curvature -o
+    x.csv` writes for the whole mesh, and concatenated in input order, that file's bytes."""
+    path = streamed_meshes[mesh]
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected, *(["--paper"] if estimator == "paper" else []))
+    lines = expected.read_bytes().splitlines(keepends=True)
+    out = tmp_path / "fields.csv"
+    manifest = fd.curvature_stream(path, tmp_path / "parts", client, output=out,
+                                   tile_vertices=tile_vertices, threads=1, estimator=estimator,
+                                   part_format="csv")
+    assert out.read_bytes() == expected.read_bytes()
+    assert lines[0].endswith(b",class,crease\n") == (estimator == "recommended")
+    assert manifest["part_format"] == "csv" and manifest["tile_count"] > 3
+    seen = 0
+    for part in manifest["parts"]:
+        ids = np.load(tmp_path / "parts" / part["ids"])
+        rows = (tmp_path / "parts" / part["part"]).read_bytes()
+        assert rows == b"".join([lines[0]] + [lines[1 + i] for i in ids.tolist()])
+        seen += len(ids)
+    assert seen == len(lines) - 1
+
+
+def test_streamed_part_format_errors(client, awkward_ply, tmp_path):
+    path, _ = awkward_ply
+    with pytest.raises(focal.InvalidInputError, match="concatenation of csv parts is a .csv"):
+        fd.curvature_stream(path, tmp_path / "p1", client, output=tmp_path / "x.npz",
+                            part_format="csv")
+    with pytest.raises(focal.InvalidInputError, match="part_format"):
+        fd.curvature_stream(path, tmp_path / "p2", client, part_format="ply")
+    r = run_cli(str(path), "--parts", str(tmp_path / "p3"), "-o", str(tmp_path / "x.csv"),
+                "--part-format", "npz")
+    assert r.returncode == 1 and "concatenation of npz parts is .npz" in r.stderr
+
+
 @pytest.mark.parametrize("candidates", [1 << 22, 3])
 def test_streamed_median_is_the_librarys(tmp_path, monkeypatch, candidates):
     """The exact median over the tiles' statistics files (a radix selection on the values' bits,
@@ -442,6 +494,14 @@ def test_command_line_streams_parts_and_a_manifest(tmp_path, client, awkward_ply
     saved = np.load(out)
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
     assert (tmp_path / "parts" / "manifest.json").exists()
+    csv = tmp_path / "fields.csv"  # the default estimator, CSV parts for a CSV output
+    r = run_cli(str(path), "--parts", str(tmp_path / "p3"), "-o", str(csv), "--scheduler",
+                client.scheduler.address, "--tile-vertices", "700", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected)
+    assert csv.read_bytes() == expected.read_bytes()
+    assert (tmp_path / "p3" / "part-000000.csv").exists()
     no_normals = tmp_path / "no_normals.ply"
     focal.write_mesh(no_normals, V, F)
     r = run_cli(str(no_normals), "--parts", str(tmp_path / "p2"), "--scheduler",
