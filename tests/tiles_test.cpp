@@ -388,6 +388,31 @@ TEST(Tiles, ReachFollowsTheOptions) {
   EXPECT_EQ(estimate_reach(recommended), 11);
 }
 
+TEST(Tiles, IdsInIsMembershipInAnAscendingSet) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> id(0, 5000);
+  std::vector<int> set, x(20000);
+  for (int k = 0; k < 1500; ++k) set.push_back(id(rng) + 300);
+  std::sort(set.begin(), set.end());
+  set.erase(std::unique(set.begin(), set.end()), set.end());
+  for (int& v : x) v = id(rng) + 250;  // some below and above the set's span
+  for (const int threads : {1, 3}) {
+    const std::vector<char> in = ids_in(x, set, threads);
+    ASSERT_EQ(in.size(), x.size());
+    int hits = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const bool expected = std::binary_search(set.begin(), set.end(), x[i]);
+      ASSERT_EQ(in[i] != 0, expected) << "id " << x[i];
+      hits += expected;
+    }
+    EXPECT_GT(hits, 1000);
+  }
+  EXPECT_EQ(ids_in(x, {}), std::vector<char>(x.size(), 0));
+  const std::vector<int> unsorted{3, 1}, negative{-1, 2};
+  EXPECT_THROW((void)ids_in(x, unsorted), InvalidInput);
+  EXPECT_THROW((void)ids_in(x, negative), InvalidInput);
+}
+
 TEST(Tiles, RejectsBadArguments) {
   const Mesh m = surface(SurfaceKind::sphere, 100, 1, {0, 0, 0});
   EXPECT_THROW((void)partition_mesh(m.V, m.F, 0), InvalidInput);

@@ -439,21 +439,11 @@ def _distinct(x: np.ndarray) -> np.ndarray:
     return s[np.r_[True, s[1:] != s[:-1]]] if s.size else s
 
 
-def _member(x: np.ndarray, ascending: np.ndarray) -> np.ndarray:
-    """Whether each value of x (ids >= 0) is in `ascending`: a table of 2^24 bits by the ids' low
-    bits rules out most values, a binary search decides the rest (np.isin sorts both arrays;
-    a table over the whole id range would grow with the mesh)."""
-    out = np.zeros(x.shape, bool)
-    if ascending.size == 0:
-        return out
-    mask = (1 << 24) - 1
-    table = np.zeros(mask + 1, bool)
-    table[ascending & mask] = True
-    flat = x.ravel()
-    maybe = np.flatnonzero(table[flat & mask])
-    i = np.minimum(np.searchsorted(ascending, flat[maybe]), ascending.size - 1)
-    out.ravel()[maybe] = ascending[i] == flat[maybe]
-    return out
+def _member(x: np.ndarray, ascending: np.ndarray, threads: int = 1) -> np.ndarray:
+    """Whether each value of x (ids >= 0) is in `ascending`: focal::ids_in (tiles.h), a bitmap
+    over the span of `ascending` (at most vertex count / 8 bytes)."""
+    return _ext.ids_in(np.ascontiguousarray(x, np.int32),
+                       np.ascontiguousarray(ascending, np.int32), threads)
 
 
 def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -467,6 +457,7 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     rings of the owned ones (the plan's halo, or `halo_rings`) and the faces with a corner
     within one ring less, sorted by global id (as partition_mesh and extract_tile give them)."""
     halo_rings = p["halo_rings"] if halo_rings is None else halo_rings
+    threads = p["options"]["threads"]
     mesh = PlyMesh(p["path"])
     tiles = TileMap(np.array(p["lo"]), np.array(p["hi"]),
                     np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"))
@@ -481,9 +472,9 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
         for u in _distinct(tiles.tiles(mesh.positions(frontier))):
             r = _tile_records(p["workdir"], "faces", int(u), 4)
             if u != t or taken_ids.size:  # else: every face of t's file has an owned corner
-                m = _member(r[:, 1:], frontier)
+                m = _member(r[:, 1:], frontier, threads)
                 r = r[m[:, 0] | m[:, 1] | m[:, 2]]
-                r = r[~_member(r[:, 0], taken_ids)]
+                r = r[~_member(r[:, 0], taken_ids, threads)]
             found.append(r)
         new = np.concatenate(found)
         new = new[np.argsort(new[:, 0], kind="stable")]
@@ -491,7 +482,7 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
         taken.append(new)
         taken_ids = _merge(taken_ids, new[:, 0])
         corners = _distinct(new[:, 1:])
-        frontier = corners[~_member(corners, reached)]
+        frontier = corners[~_member(corners, reached, threads)]
         reached = _merge(reached, frontier)
     faces = np.concatenate(taken)
     faces = faces[np.argsort(faces[:, 0], kind="stable")]

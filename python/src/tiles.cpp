@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -156,6 +157,24 @@ nb::dict recommended_choices(const nb::dict& medians, double mean_edge_length) {
   return choices_dict(c);
 }
 
+/// focal::ids_in of int32 ids of any shape (C order): a bool array of x's shape.
+nb::ndarray<nb::numpy, bool> ids_in(
+    const nb::ndarray<const std::int32_t, nb::c_contig, nb::device::cpu>& x, const Ids& ascending,
+    int threads) {
+  std::vector<char> in;
+  {
+    nb::gil_scoped_release release;
+    in = focal::ids_in(std::span<const int>(x.data(), x.size()),
+                       std::span<const int>(ascending.data(), ascending.shape(0)), threads);
+  }
+  auto* data = new bool[in.size()];
+  for (std::size_t i = 0; i < in.size(); ++i) data[i] = in[i] != 0;
+  nb::capsule owner(data, [](void* p) noexcept { delete[] static_cast<bool*>(p); });
+  std::vector<std::size_t> shape(x.ndim());
+  for (std::size_t d = 0; d < x.ndim(); ++d) shape[d] = x.shape(d);
+  return nb::ndarray<nb::numpy, bool>(data, x.ndim(), shape.data(), owner);
+}
+
 /// mean_edge_length's partial sums of a run of whole blocks of faces (focal/core/mesh.h), for
 /// the streaming reader (focal/stream.py): (sums, counts) per block of edge_length_block() faces.
 nb::tuple edge_length_sums(const DoubleRows& V, const IntRows& F, int threads) {
@@ -188,6 +207,7 @@ void bind_tiles(nb::module_& m) {
         "N"_a.none().noconvert(), "ids"_a.noconvert(), "owned"_a.noconvert(),
         "whole_vertex_count"_a, "options"_a, "mean_edge_length"_a);
   m.def("recommended_choices", &recommended_choices, "medians"_a, "mean_edge_length"_a);
+  m.def("ids_in", &ids_in, "x"_a.noconvert(), "ascending"_a.noconvert(), "threads"_a);
   m.def("statistics_reach", [] { return focal::kRecommendedStatisticsReach; });
   m.def(
       "estimate_reach",

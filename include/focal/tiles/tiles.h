@@ -14,6 +14,7 @@
 /// mesh_wide_choices and given to every tile.
 
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "focal/core/fields.h"
@@ -89,6 +90,14 @@ struct TileEstimate {
     const TileMesh& tile, const std::vector<int>& ids, const std::vector<int>& owned,
     Eigen::Index whole_vertex_count, double mean_edge_length, const EstimateOptions& options,
     int threads = 0);
+
+/// Whether each id of `x` is one of `ascending` (ids >= 0, ascending): the set operations of a
+/// tile's halo rounds when the mesh is streamed from its file (python/focal/stream.py: which
+/// face records have a corner on the ring's frontier, which faces and vertices are new). A
+/// bitmap over the span of `ascending` (span / 8 bytes), looked up on `threads` threads.
+/// \throw InvalidInput when `ascending` is not ascending or holds a negative id.
+[[nodiscard]] std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending,
+                                       int threads = 0);
 
 /// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
 /// .curvature and .crease, with the memory of the largest tile in place of the whole mesh's.
