@@ -12,20 +12,27 @@ read a chunk at a time; the operating system's page cache, not the process, hold
   ``_focal_ext.edge_length_block()`` faces, writes each face (its id and corners) to the face file
   of every tile owning one of its corners, and adds up the edge lengths per block, added in
   block order as ``mean_edge_length`` does: the whole mesh's mean edge length, bit for bit.
+- **Choices** (the recommended estimator: a task per tile, ``tile_statistics``, then the driver,
+  ``choose``): each tile's share of the whole mesh's choices (focal::tile_statistics, a halo of
+  ``statistics_reach()`` rings), its per-vertex values in a file; the driver takes the exact
+  medians over the files (``_median``: a radix selection on the values' bits) and makes the
+  choices with focal::recommended_mesh_wide_from; they decide the estimate's halo.
 - **Tile** (a worker, ``estimate_tile``): the halo by rings from the face files: round r takes,
   from the face files of the tiles owning the vertices found in round r - 1, the faces incident
   to them, as ``partition_mesh`` does in memory (every face of a vertex is in the face file of
-  the tile owning it). Then the tile's vertices and faces, sorted by global id, are read from the
-  file and estimated with the whole mesh's choices; the owned rows are written to a part file.
+  the tile owning it; the set operations by focal::ids_in). Then the tile's vertices and faces,
+  sorted by global id, are read from the file and estimated with the whole mesh's choices; the
+  owned rows are written to a part file (.npz, or .csv by focal.write_fields).
 
 Memory: the driver holds the cell counts (8 bytes x 2^(3 x MORTON_BITS) = 16 MB), the cell ->
 tile table and one chunk; a worker holds one tile with its halo, its face files' records and
-one neighbouring tile's face file at a time (16 bytes per face record).
+one neighbouring tile's face file at a time (16 bytes per face record), and ids_in's bitmap
+(at most vertex count / 8 bytes).
 
-What the plan can take from the whole mesh in one streamed pass is the mean edge length; the
-other whole-mesh choices (the recommended estimator's noise and file-normal comparison, the
-orientation of closed components when the normals come from the faces) need the whole mesh, so
-streaming runs the paper's estimator with the file's normals only, and says so otherwise.
+What the plan cannot take from the whole mesh in streamed passes is the orientation of closed
+components, which the estimate does when the normals come from the faces (the paper's estimator
+with normals from the faces, either estimator on a file without normals): streaming needs the
+file's normals, and says so otherwise.
 """
 
 from __future__ import annotations
