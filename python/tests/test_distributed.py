@@ -509,6 +509,57 @@ def test_command_line_streams_parts_and_a_manifest(tmp_path, client, awkward_ply
     assert r.returncode == 2 and "needs the file's normals" in r.stderr
 
 
+
+def _dask(command, *args):
+    """A `dask scheduler` or `dask worker` process (the entry points' modules, from this
+    Python), as `docs/SCALE.md` starts a cluster by hand."""
+    module = f"distributed.cli.dask_{command}"
+    return subprocess.Popen([sys.executable, "-m", module, *args], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env=dict(os.environ))
+
+
+def test_command_line_on_a_scheduler_started_by_hand(tmp_path, awkward_ply):
+    """`dask scheduler` and `dask worker` in processes of their own, then the command with
+    --scheduler: the in-memory and the streamed runs write `focal curvature`'s CSV bytes."""
+    path, _ = awkward_ply
+    address_file = tmp_path / "scheduler.json"
+    processes = [_dask("scheduler", "--scheduler-file", str(address_file), "--port", "0",
+                       "--host", "127.0.0.1", "--no-dashboard")]
+    try:
+        processes.append(_dask("worker", "--scheduler-file", str(address_file), "--nworkers",
+                               "2", "--nthreads", "1", "--memory-limit", "1GB",
+                               "--no-dashboard", "--local-directory", str(tmp_path)))
+        with Client(scheduler_file=str(address_file), timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+            address = c.scheduler.address
+        expected = tmp_path / "whole.csv"
+        focal_curvature_csv(path, expected)
+        out = tmp_path / "fields.csv"
+        r = run_cli(str(path), "-o", str(out), "--scheduler", address, "--tile-vertices", "700")
+        assert r.returncode == 0, r.stderr
+        assert out.read_bytes() == expected.read_bytes()
+        streamed = tmp_path / "streamed.csv"
+        r = run_cli(str(path), "--parts", str(tmp_path / "parts"), "-o", str(streamed),
+                    "--scheduler", address, "--tile-vertices", "700")
+        assert r.returncode == 0, r.stderr
+        assert streamed.read_bytes() == expected.read_bytes()
+    finally:
+        for process in reversed(processes):
+            process.terminate()
+            process.wait(timeout=60)
+
+
+def test_command_line_starts_its_own_local_cluster(tmp_path, awkward_ply):
+    """Without --scheduler the command runs on a LocalCluster of --workers processes."""
+    path, _ = awkward_ply
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected, "--paper")
+    out = tmp_path / "fields.csv"
+    r = run_cli(str(path), "-o", str(out), "--workers", "1", "--memory-limit", "1GB",
+                "--tile-vertices", "700", "--paper")
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes() == expected.read_bytes()
+
 def _vm_data_mb():
     with open("/proc/self/status") as f:
         return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmData:"))
