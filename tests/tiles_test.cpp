@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -183,6 +185,120 @@ TEST(Tiles, CreaseFlagsOfTheRecommendedEstimatorAreTheWholeMeshs) {
   }
 }
 
+/// The finite median as the library takes it: nth_element at size / 2; NaN when none.
+double median_of(std::vector<double> v) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  if (v.empty()) return NAN;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// recommended_mesh_wide_from the statistics of every tile (halo `halo`, tiles of
+/// `tile_vertices`) of the mesh, with the whole mesh's mean edge length.
+RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertices, double mean_edge,
+                                       std::vector<double>* sample_noise) {
+  const Tiling tiling = partition_mesh(m.V, m.F, halo, {.tile_vertices = tile_vertices});
+  RecommendedMedians whole;
+  whole.has_normals = true;
+  std::vector<double> residual, along, against;
+  std::vector<std::pair<int, double>> sample;
+  for (const Tile& tile : tiling.tiles) {
+    const RecommendedStatistics s =
+        tile_statistics(extract_tile(m.V, m.F, m.normals(), tile), tile.vertices, tile.owned,
+                        m.V.rows(), mean_edge, EstimateOptions{});
+    EXPECT_EQ(s.jet_residual.size(), std::ssize(tile.owned));
+    residual.insert(residual.end(), s.jet_residual.begin(), s.jet_residual.end());
+    along.insert(along.end(), s.angle_along.begin(), s.angle_along.end());
+    against.insert(against.end(), s.angle_against.begin(), s.angle_against.end());
+    whole.along += s.along;
+    whole.against += s.against;
+    for (std::size_t k = 0; k < s.sample.size(); ++k) {
+      sample.emplace_back(s.sample[k], s.sample_noise[static_cast<Eigen::Index>(k)]);
+    }
+  }
+  std::sort(sample.begin(), sample.end());
+  sample_noise->clear();
+  for (const auto& [id, x] : sample) sample_noise->push_back(x);
+  whole.jet_residual = median_of(residual);
+  whole.angle_along = median_of(along);
+  whole.angle_against = median_of(against);
+  whole.sample_noise =
+      Eigen::Map<const Eigen::VectorXd>(sample_noise->data(), std::ssize(*sample_noise));
+  return recommended_mesh_wide_from(whole, mean_edge);
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(Tiles, TheTilesStatisticsGiveTheWholeMeshsRecommendedChoices) {
+  // What streaming measures per tile (tile_statistics, a halo of kRecommendedStatisticsReach):
+  // the medians over all tiles give recommended_mesh_wide of the whole mesh bit for bit, on the
+  // awkward mesh (boundaries, components, a fin, a bowtie, unreferenced and NaN vertices), with
+  // normals turned inward (the side), and on noisy positions (2- and 3-ring plans).
+  Mesh inward = awkward_mesh(3);
+  inward.N = -inward.N;
+  Mesh noisy5 = join(surface(SurfaceKind::torus, 1200, 2, {0, 0, 0}),
+                     surface(SurfaceKind::monkey_saddle, 600, 2, {3, 0, 0}));
+  Mesh noisy10 = noisy5;
+  add_vertex_noise(noisy5, 0.05, 2);
+  add_vertex_noise(noisy10, 0.1, 2);
+  const std::vector<std::pair<std::string, Mesh>> meshes{{"awkward", awkward_mesh(1)},
+                                                         {"inward", inward},
+                                                         {"noise 5%", noisy5},
+                                                         {"noise 10%", noisy10}};
+  for (const auto& [name, m] : meshes) {
+    const PreparedMesh mesh(m.V, m.F, m.normals());
+    const MeshWideChoices choices = mesh_wide_choices(mesh, {});
+    ASSERT_TRUE(choices.recommended) << name;
+    const RecommendedMeshWide& expected = *choices.recommended;
+    std::vector<double> sample_noise;
+    for (const int tile_vertices : {97, 400, static_cast<int>(m.V.rows())}) {
+      const RecommendedMeshWide got = mesh_wide_of_tiles(
+          m, kRecommendedStatisticsReach, tile_vertices, choices.mean_edge_length, &sample_noise);
+      const std::string what = name + ", tiles of " + std::to_string(tile_vertices);
+      EXPECT_TRUE(same_bits(got.noise, expected.noise)) << what << ": " << got.noise;
+      EXPECT_TRUE(same_bits(got.position_noise, expected.position_noise))
+          << what << ": " << got.position_noise << " vs " << expected.position_noise;
+      EXPECT_TRUE(same_bits(got.file_disagreement, expected.file_disagreement)) << what;
+      EXPECT_EQ(got.side, expected.side) << what;
+    }
+    EXPECT_TRUE(std::isfinite(expected.file_disagreement)) << name;
+    EXPECT_EQ(expected.side, name == "inward" ? -1.0 : 1.0) << name;
+    const int rings = recommended_plan_for_noise(expected.position_noise).rings;
+    EXPECT_EQ(rings, name == "noise 5%" ? 2 : name == "noise 10%" ? 3 : 1) << name;
+  }
+}
+
+TEST(Tiles, AStatisticsHaloOneRingShortChangesTheNoiseSample) {
+  // Under 8192 vertices every vertex is in the noise sample (a 3-ring jet each): with a halo of
+  // 2 rings the vertices near tile borders fit truncated 3-rings.
+  const Mesh m = awkward_mesh(2);
+  const double h = PreparedMesh(m.V, m.F, m.normals()).mean_edge_length();
+  std::vector<double> exact, short_halo;
+  (void)mesh_wide_of_tiles(m, kRecommendedStatisticsReach, 97, h, &exact);
+  (void)mesh_wide_of_tiles(m, kRecommendedStatisticsReach - 1, 97, h, &short_halo);
+  ASSERT_EQ(exact.size(), short_halo.size());
+  EXPECT_GT(exact.size(), m.V.rows() * 9 / 10);
+  int differ = 0;
+  for (std::size_t k = 0; k < exact.size(); ++k) differ += !same_bits(exact[k], short_halo[k]);
+  EXPECT_GT(differ, 0);
+}
+
+TEST(Tiles, TileStatisticsNeedTheRecommendedEstimatorAndTheMeshsNormals) {
+  const Mesh m = surface(SurfaceKind::sphere, 300, 1, {0, 0, 0});
+  const Tiling tiling = partition_mesh(m.V, m.F, kRecommendedStatisticsReach);
+  const Tile& tile = tiling.tiles[0];
+  EXPECT_THROW((void)tile_statistics(extract_tile(m.V, m.F, std::nullopt, tile), tile.vertices,
+                                     tile.owned, m.V.rows(), 0.1, {}),
+               InvalidInput);
+  const TileMesh with = extract_tile(m.V, m.F, m.normals(), tile);
+  EXPECT_THROW((void)tile_statistics(with, tile.vertices, tile.owned, m.V.rows(), 0.1,
+                                     {.estimator = Estimator::paper}),
+               InvalidInput);
+  EXPECT_THROW((void)tile_statistics(with, {0, 1}, tile.owned, m.V.rows(), 0.1, {}),
+               InvalidInput);  // not one id per vertex
+}
+
 TEST(Tiles, EveryVertexIsOwnedOnceAndItsReachIsInItsTile) {
   const Mesh m = awkward_mesh(4);
   const int reach = 4;
@@ -270,6 +386,31 @@ TEST(Tiles, ReachFollowsTheOptions) {
   EXPECT_EQ(estimate_reach(recommended), kRecommendedMaxReach);
   recommended.recommended.mesh_wide = RecommendedMeshWide{.noise = 1e-4, .position_noise = 1e-4};
   EXPECT_EQ(estimate_reach(recommended), 11);
+}
+
+TEST(Tiles, IdsInIsMembershipInAnAscendingSet) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> id(0, 5000);
+  std::vector<int> set, x(20000);
+  for (int k = 0; k < 1500; ++k) set.push_back(id(rng) + 300);
+  std::sort(set.begin(), set.end());
+  set.erase(std::unique(set.begin(), set.end()), set.end());
+  for (int& v : x) v = id(rng) + 250;  // some below and above the set's span
+  for (const int threads : {1, 3}) {
+    const std::vector<char> in = ids_in(x, set, threads);
+    ASSERT_EQ(in.size(), x.size());
+    int hits = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const bool expected = std::binary_search(set.begin(), set.end(), x[i]);
+      ASSERT_EQ(in[i] != 0, expected) << "id " << x[i];
+      hits += expected;
+    }
+    EXPECT_GT(hits, 1000);
+  }
+  EXPECT_EQ(ids_in(x, {}), std::vector<char>(x.size(), 0));
+  const std::vector<int> unsorted{3, 1}, negative{-1, 2};
+  EXPECT_THROW((void)ids_in(x, unsorted), InvalidInput);
+  EXPECT_THROW((void)ids_in(x, negative), InvalidInput);
 }
 
 TEST(Tiles, RejectsBadArguments) {

@@ -277,20 +277,26 @@ def curvature_stream(
     retries: int = 2,
     progress: bool = False,
     on_phase: Optional[Callable[[str, float], None]] = None,
+    part_format: str = "npz",
     **options: Any,
 ) -> dict:
     """``curvature`` of a binary PLY mesh that no process holds whole (focal/stream.py): the
     driver plans the tiles in streamed passes over the file; each task reads its tile (with its
     halo) from the file and the plan's files, and writes its owned rows to a part in `parts`
-    (part-NNNNNN.npz: ``ids`` and the fields); ``parts/manifest.json`` lists the parts. With
-    `output` (.npz), the parts are also concatenated in input order. The same bits as
-    ``focal.curvature`` on the whole mesh.
+    (part_format "npz": part-NNNNNN.npz, ``ids`` and the fields; "csv": part-NNNNNN.csv, the
+    rows `focal curvature -o x.csv` writes for those vertices, and their ids in
+    part-NNNNNN.ids.npy); ``parts/manifest.json`` lists the parts. With `output` (.npz from
+    npz parts, .csv from csv parts), the parts are also concatenated in input order: the
+    whole run's fields, and for .csv the bytes of `focal curvature -o output.csv`. The same bits
+    as ``focal.curvature`` on the whole mesh.
 
     The plan's files (the tiles' vertex and face ids, about 4 bytes per vertex and 16 to 48 per
     face) go to ``parts/plan``; `parts` must be a folder every worker can read and write (a
-    shared file system on a cluster). Runs estimator="paper" with the file's normals only (see
-    focal.stream). `on_phase(name, seconds)` is called after each phase ("plan", "tiles",
-    "concatenate"). Returns the manifest (a dict). Options as ``curvature``.
+    shared file system on a cluster). Needs the file's normals (see focal.stream); the
+    recommended estimator's whole-mesh choices come from a first pass of tasks (each tile's
+    statistics) and exact medians over them. `on_phase(name, seconds)` is called after each
+    phase ("plan", "choices" for the recommended estimator, "tiles", "concatenate"). Returns
+    the manifest (a dict). Options as ``curvature``.
     """
     import json
     import time
@@ -302,6 +308,13 @@ def curvature_stream(
         options["threads"] = 1
     estimator, threads, opts = focal._curvature_options(options)
     o = focal._estimate_options(estimator, threads, opts)
+    if part_format not in stream.PART_FORMATS:
+        raise focal.InvalidInputError(f"part_format: {part_format!r}, expected one of "
+                                      f"{stream.PART_FORMATS}")
+    if output is not None and not os.fspath(output).lower().endswith("." + part_format):
+        raise focal.InvalidInputError(
+            f"{os.fspath(output)}: the concatenation of {part_format} parts is a "
+            f".{part_format} file")
     parts = os.fspath(parts)
     os.makedirs(parts, exist_ok=True)
     phase = [time.perf_counter()]
@@ -317,15 +330,27 @@ def curvature_stream(
     cluster = None
     if own_cluster:
         client, cluster = _local_client(workers, memory_limit)
-    try:
-        futures = [client.submit(stream.estimate_tile, plan, t, parts, retries=retries,
-                                 key=f"focal-stream-tile-{t}-{uuid.uuid4().hex}")
+
+    def run(function, name: str, *arguments) -> list:
+        futures = [client.submit(function, plan, t, *arguments, retries=retries,
+                                 key=f"focal-stream-{name}-{t}-{uuid.uuid4().hex}")
                    for t in range(plan["tile_count"])]
         if progress:
             from distributed import progress as dask_progress
 
             dask_progress(futures)
-        done = [r for _, r in as_completed(futures, with_results=True)]
+        return sorted((r for _, r in as_completed(futures, with_results=True)),
+                      key=lambda r: r["tile"])
+
+    try:
+        statistics = None
+        if o["estimator"] == "recommended":
+            # The whole mesh's choices from every tile's statistics (a pass of tasks), then
+            # the tiles' estimates with them.
+            statistics = run(stream.tile_statistics, "statistics")
+            stream.choose(plan, statistics)
+            phase_done("choices")
+        done = run(stream.estimate_tile, "tile", parts, part_format)
     finally:
         if cluster is not None:
             client.close()
@@ -333,8 +358,11 @@ def curvature_stream(
     phase_done("tiles")
     manifest = {k: plan[k] for k in ("path", "vertex_count", "face_count", "tile_count",
                                       "halo_rings", "choices", "options")}
-    manifest["fields"] = list(stream.FIELDS)
-    manifest["parts"] = sorted(done, key=lambda r: r["tile"])
+    manifest["fields"] = list(stream.FIELDS) + (["crease"] if statistics is not None else [])
+    manifest["part_format"] = part_format
+    manifest["parts"] = done
+    if statistics is not None:
+        manifest["statistics_peak_rss"] = max(r["peak_rss"] for r in statistics)
     with open(os.path.join(parts, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
     if output is not None:
@@ -398,10 +426,12 @@ def main(argv: Optional[list] = None) -> int:
     p.add_argument("input", help="mesh or point cloud file (.ply, .obj, .off, .stl; clouds: "
                    ".xyz .pts .txt .csv, PLY/OBJ without faces)")
     p.add_argument("-o", "--output", help="fields, .npz or .csv (input order); with --parts, "
-                   "the parts concatenated (.npz)")
-    p.add_argument("--parts", help="stream the input (binary PLY, paper's estimator, file "
-                   "normals): no process holds the whole mesh; each tile's fields go to "
-                   "PARTS/part-NNNNNN.npz, listed in PARTS/manifest.json")
+                   "the parts concatenated (.npz or .csv, as the parts)")
+    p.add_argument("--parts", help="stream the input (binary PLY with normals): no process "
+                   "holds the whole mesh; each tile's fields go to PARTS/part-NNNNNN.npz (or "
+                   ".csv), listed in PARTS/manifest.json")
+    p.add_argument("--part-format", choices=stream.PART_FORMATS, default=None,
+                   help="with --parts: the parts' format (default: the output's, else npz)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler "
                    "(default: a LocalCluster here)")
     p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
@@ -418,8 +448,14 @@ def main(argv: Optional[list] = None) -> int:
         p.error("one of -o/--output and --parts is required")
     if args.output is not None and not args.output.endswith((".npz", ".csv")):
         p.error(f"{args.output}: the output must end in .npz or .csv")
-    if args.parts is not None and args.output is not None and not args.output.endswith(".npz"):
-        p.error(f"{args.output}: with --parts, the concatenated output is .npz")
+    if args.part_format is not None and args.parts is None:
+        p.error("--part-format is for --parts")
+    part_format = args.part_format or ("csv" if args.output and args.output.endswith(".csv")
+                                       else "npz")
+    if args.parts is not None and args.output is not None and \
+            not args.output.endswith("." + part_format):
+        p.error(f"{args.output}: with --parts, the concatenation of {part_format} parts is "
+                f".{part_format}")
     client = None
     try:
         if args.scheduler:
@@ -430,7 +466,8 @@ def main(argv: Optional[list] = None) -> int:
                       memory_limit=args.memory_limit, progress=args.progress,
                       threads=args.threads, estimator="paper" if args.paper else "recommended")
         if args.parts is not None:
-            curvature_stream(args.input, args.parts, client, output=args.output, **common)
+            curvature_stream(args.input, args.parts, client, output=args.output,
+                             part_format=part_format, **common)
         else:
             mesh = focal.read_mesh(args.input)
             if mesh.F.shape[0] == 0:

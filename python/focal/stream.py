@@ -12,20 +12,27 @@ read a chunk at a time; the operating system's page cache, not the process, hold
   ``_focal_ext.edge_length_block()`` faces, writes each face (its id and corners) to the face file
   of every tile owning one of its corners, and adds up the edge lengths per block, added in
   block order as ``mean_edge_length`` does: the whole mesh's mean edge length, bit for bit.
+- **Choices** (the recommended estimator: a task per tile, ``tile_statistics``, then the driver,
+  ``choose``): each tile's share of the whole mesh's choices (focal::tile_statistics, a halo of
+  ``statistics_reach()`` rings), its per-vertex values in a file; the driver takes the exact
+  medians over the files (``_median``: a radix selection on the values' bits) and makes the
+  choices with focal::recommended_mesh_wide_from; they decide the estimate's halo.
 - **Tile** (a worker, ``estimate_tile``): the halo by rings from the face files: round r takes,
   from the face files of the tiles owning the vertices found in round r - 1, the faces incident
   to them, as ``partition_mesh`` does in memory (every face of a vertex is in the face file of
-  the tile owning it). Then the tile's vertices and faces, sorted by global id, are read from the
-  file and estimated with the whole mesh's choices; the owned rows are written to a part file.
+  the tile owning it; the set operations by focal::ids_in). Then the tile's vertices and faces,
+  sorted by global id, are read from the file and estimated with the whole mesh's choices; the
+  owned rows are written to a part file (.npz, or .csv by focal.write_fields).
 
 Memory: the driver holds the cell counts (8 bytes x 2^(3 x MORTON_BITS) = 16 MB), the cell ->
 tile table and one chunk; a worker holds one tile with its halo, its face files' records and
-one neighbouring tile's face file at a time (16 bytes per face record).
+one neighbouring tile's face file at a time (16 bytes per face record), and ids_in's bitmap
+(at most vertex count / 8 bytes).
 
-What the plan can take from the whole mesh in one streamed pass is the mean edge length; the
-other whole-mesh choices (the recommended estimator's noise and file-normal comparison, the
-orientation of closed components when the normals come from the faces) need the whole mesh, so
-streaming runs the paper's estimator with the file's normals only, and says so otherwise.
+What the plan cannot take from the whole mesh in streamed passes is the orientation of closed
+components, which the estimate does when the normals come from the faces (the paper's estimator
+with normals from the faces, either estimator on a file without normals): streaming needs the
+file's normals, and says so otherwise.
 """
 
 from __future__ import annotations
@@ -241,15 +248,11 @@ class TileMap:
 
 
 def _uniform_options(options: dict, mesh: PlyMesh) -> None:
-    if options["estimator"] != "paper":
-        raise focal.InvalidInputError(
-            "streaming input runs estimator='paper' only: the recommended estimator's "
-            "whole-mesh choices (noise, file normals) need the whole mesh in memory "
-            "(focal.distributed.curvature without stream)")
     if options["normals"] not in ("auto", "file") or not mesh.has_normals:
         raise focal.InvalidInputError(
             f"{mesh.path}: streaming input needs the file's normals (nx, ny, nz): normals "
-            "from the faces are oriented per closed component over the whole mesh")
+            "from the faces, and the recommended estimator without normals, orient the faces "
+            "of closed components over the whole mesh, which streaming does not do")
 
 
 def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: int) -> dict:
@@ -311,12 +314,112 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
         "path": os.path.abspath(mesh.path), "workdir": os.path.abspath(workdir),
         "vertex_count": mesh.vertex_count, "face_count": mesh.face_count,
         "tile_count": tile_count, "lo": lo.tolist(), "hi": hi.tolist(),
-        "choices": {"mean_edge_length": mean_edge},
-        "halo_rings": int(_ext.estimate_reach(options)), "options": options,
+        "choices": {"mean_edge_length": mean_edge}, "options": options,
+        # The recommended estimator's reach depends on its whole-mesh choices (choose()).
+        "halo_rings": (None if options["estimator"] == "recommended"
+                       else int(_ext.estimate_reach(options))),
     }
-    with open(os.path.join(workdir, "plan.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    _write_plan(out)
     return out
+
+
+def _write_plan(p: dict) -> None:
+    tmp = os.path.join(p["workdir"], ".plan.json.tmp")
+    with open(tmp, "w") as f:
+        json.dump(p, f, indent=1)
+    os.replace(tmp, os.path.join(p["workdir"], "plan.json"))
+
+
+#: Columns of a tile's statistics file (float64, one row per owned vertex).
+STATISTICS = ("jet_residual", "angle_along", "angle_against")
+
+
+def tile_statistics(p: dict, t: int) -> dict:
+    """The task of tile t in the recommended estimator's plan: its owned vertices' share of the
+    whole mesh's choices (focal::tile_statistics, with a halo of statistics_reach() rings). The
+    per-vertex values go to the tile's statistics file (.npy, columns STATISTICS); returns the
+    counts, the noise sample (whole-mesh ids and values) and the peak RSS."""
+    a = tile_arrays(p, t, int(_ext.statistics_reach()))
+    d = _ext.tile_statistics(a["V"], a["F"], a["N"], a["vertices"], a["owned"],
+                             p["vertex_count"], p["options"], p["choices"]["mean_edge_length"])
+    path = _tile_file(p["workdir"], "statistics", t)
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "wb") as f:
+        np.save(f, np.column_stack([d[k] for k in STATISTICS]))
+    os.replace(tmp, path)
+    return {"tile": t, "along": int(d["along"]), "against": int(d["against"]),
+            "sample": d["sample"].tolist(), "sample_noise": d["sample_noise"].tolist(),
+            "peak_rss": peak_rss()}
+
+
+def choose(p: dict, statistics: list) -> dict:
+    """The recommended estimator's whole-mesh choices from every tile's statistics (the tasks'
+    results and their files): exact medians over the files (_median, memory of one file and a
+    histogram), then focal::recommended_mesh_wide_from; the plan gets the choices and the halo
+    of the estimate they decide, and is written again. Returns the plan."""
+    files = [_tile_file(p["workdir"], "statistics", t) for t in range(p["tile_count"])]
+    sample = sorted((i, x) for r in statistics for i, x in zip(r["sample"], r["sample_noise"]))
+    medians = {
+        "jet_residual": _median(files, 0),
+        "angle_along": _median(files, 1), "angle_against": _median(files, 2),
+        "along": sum(r["along"] for r in statistics),
+        "against": sum(r["against"] for r in statistics),
+        "sample_noise": [x for _, x in sample], "has_normals": True,
+    }
+    p["choices"] = dict(_ext.recommended_choices(medians, p["choices"]["mean_edge_length"]))
+    p["halo_rings"] = int(_ext.estimate_reach(p["options"], p["choices"]))
+    _write_plan(p)
+    return p
+
+
+def _keys(x: np.ndarray) -> np.ndarray:
+    """Finite doubles -> uint64 keys in the same order (-0.0 as +0.0)."""
+    u = (x + 0.0).view(np.uint64)
+    top = np.uint64(1 << 63)
+    return np.where(u & top, ~u, u | top)
+
+
+def _value(key: int) -> float:
+    top = 1 << 63
+    bits = key & ~top if key & top else ~key & ((1 << 64) - 1)
+    return float(np.array([bits], np.uint64).view(np.float64)[0])
+
+
+#: _median reads and partitions the candidates once they number at most this many.
+_CANDIDATES = 1 << 22
+
+
+def _median(files: list, column: int) -> float:
+    """The median of the finite values of `column` over the statistics files, as the library's
+    finite_median takes it (the value at rank size / 2 in ascending order; NaN when none): an
+    exact radix selection on the values' bits, 16 at a time, each pass reading the files one at
+    a time; once the candidates number at most _CANDIDATES, they are read and partitioned."""
+    def finite_keys():
+        for f in files:
+            x = np.load(f, mmap_mode="r")[:, column]
+            yield _keys(np.ascontiguousarray(x[np.isfinite(x)]))
+
+    size = sum(k.size for k in finite_keys())
+    if size == 0:
+        return float("nan")
+    rank, prefix = size // 2, 0
+    for shift in (48, 32, 16, 0):
+        counts = np.zeros(1 << 16, np.int64)
+        for k in finite_keys():
+            if shift < 48:
+                k = k[(k >> np.uint64(shift + 16)) == np.uint64(prefix)]
+            counts += np.bincount((k >> np.uint64(shift) & np.uint64(0xFFFF)).astype(np.int64),
+                                  minlength=1 << 16)
+        below = np.cumsum(counts) - counts
+        digit = int(np.searchsorted(below + counts, rank, side="right"))
+        rank -= int(below[digit])
+        prefix = prefix << 16 | digit
+        if shift > 0 and counts[digit] <= _CANDIDATES:
+            shift_left = np.uint64(shift)
+            rest = np.concatenate([k[(k >> shift_left) == np.uint64(prefix)]
+                                   for k in finite_keys()])
+            return _value(int(np.partition(rest, rank)[rank]))
+    return _value(prefix)
 
 
 def _tile_file(workdir: str, kind: str, t: int) -> str:
@@ -343,21 +446,11 @@ def _distinct(x: np.ndarray) -> np.ndarray:
     return s[np.r_[True, s[1:] != s[:-1]]] if s.size else s
 
 
-def _member(x: np.ndarray, ascending: np.ndarray) -> np.ndarray:
-    """Whether each value of x (ids >= 0) is in `ascending`: a table of 2^24 bits by the ids' low
-    bits rules out most values, a binary search decides the rest (np.isin sorts both arrays;
-    a table over the whole id range would grow with the mesh)."""
-    out = np.zeros(x.shape, bool)
-    if ascending.size == 0:
-        return out
-    mask = (1 << 24) - 1
-    table = np.zeros(mask + 1, bool)
-    table[ascending & mask] = True
-    flat = x.ravel()
-    maybe = np.flatnonzero(table[flat & mask])
-    i = np.minimum(np.searchsorted(ascending, flat[maybe]), ascending.size - 1)
-    out.ravel()[maybe] = ascending[i] == flat[maybe]
-    return out
+def _member(x: np.ndarray, ascending: np.ndarray, threads: int = 1) -> np.ndarray:
+    """Whether each value of x (ids >= 0) is in `ascending`: focal::ids_in (tiles.h), a bitmap
+    over the span of `ascending` (at most vertex count / 8 bytes)."""
+    return _ext.ids_in(np.ascontiguousarray(x, np.int32),
+                       np.ascontiguousarray(ascending, np.int32), threads)
 
 
 def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -366,10 +459,12 @@ def _merge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.sort(np.concatenate([a, b]), kind="stable")
 
 
-def tile_arrays(p: dict, t: int) -> dict:
+def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     """Tile t's arrays, read from the plan's files and the mesh: its vertices within the halo's
-    rings of the owned ones and the faces with a corner within one ring less, sorted by global
-    id (as partition_mesh and extract_tile give them)."""
+    rings of the owned ones (the plan's halo, or `halo_rings`) and the faces with a corner
+    within one ring less, sorted by global id (as partition_mesh and extract_tile give them)."""
+    halo_rings = p["halo_rings"] if halo_rings is None else halo_rings
+    threads = p["options"]["threads"]
     mesh = PlyMesh(p["path"])
     tiles = TileMap(np.array(p["lo"]), np.array(p["hi"]),
                     np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"))
@@ -377,16 +472,16 @@ def tile_arrays(p: dict, t: int) -> dict:
     reached, frontier = owned, owned
     taken = [np.empty((0, 4), np.int32)]
     taken_ids = np.empty(0, np.int32)
-    for _ in range(p["halo_rings"]):
+    for _ in range(halo_rings):
         if frontier.size == 0:
             break
         found = []
         for u in _distinct(tiles.tiles(mesh.positions(frontier))):
             r = _tile_records(p["workdir"], "faces", int(u), 4)
             if u != t or taken_ids.size:  # else: every face of t's file has an owned corner
-                m = _member(r[:, 1:], frontier)
+                m = _member(r[:, 1:], frontier, threads)
                 r = r[m[:, 0] | m[:, 1] | m[:, 2]]
-                r = r[~_member(r[:, 0], taken_ids)]
+                r = r[~_member(r[:, 0], taken_ids, threads)]
             found.append(r)
         new = np.concatenate(found)
         new = new[np.argsort(new[:, 0], kind="stable")]
@@ -394,31 +489,56 @@ def tile_arrays(p: dict, t: int) -> dict:
         taken.append(new)
         taken_ids = _merge(taken_ids, new[:, 0])
         corners = _distinct(new[:, 1:])
-        frontier = corners[~_member(corners, reached)]
+        frontier = corners[~_member(corners, reached, threads)]
         reached = _merge(reached, frontier)
     faces = np.concatenate(taken)
     faces = faces[np.argsort(faces[:, 0], kind="stable")]
     return {
         "V": mesh.positions(reached), "N": mesh.normals(reached),
         "F": np.searchsorted(reached, faces[:, 1:]).astype(np.int32),
-        "vertices": reached, "faces": faces[:, 0], "owned": np.searchsorted(reached, owned),
+        "vertices": np.ascontiguousarray(reached, np.int32), "faces": faces[:, 0],
+        "owned": np.searchsorted(reached, owned).astype(np.int32),
     }
 
 
-def estimate_tile(p: dict, t: int, parts: str) -> dict:
+#: Formats of the parts: .npz (ids and the fields as arrays) or .csv (the rows of `focal
+#: curvature -o fields.csv`, by focal.write_fields, with the ids beside them in a .ids.npy).
+PART_FORMATS = ("npz", "csv")
+
+
+def estimate_tile(p: dict, t: int, parts: str, part_format: str = "npz") -> dict:
     """The task of tile t: its estimate with the whole mesh's choices, the owned rows written
-    to parts/part-NNNNNN.npz (ids and fields, through a temporary renamed); returns the part's
+    to parts/part-NNNNNN.npz (ids and fields) or, for part_format "csv", parts/part-NNNNNN.csv
+    (the bytes `focal curvature -o x.csv` writes for these rows, header included) and their ids
+    in parts/part-NNNNNN.ids.npy; each through a temporary file renamed. Returns the part's
     name, its row count and the process's peak RSS (bytes, peak_rss)."""
+    if part_format not in PART_FORMATS:
+        raise focal.InvalidInputError(f"part_format: {part_format!r}, expected one of "
+                                      f"{PART_FORMATS}")
     a = tile_arrays(p, t)
     d = _ext.estimate_tile(a["V"], a["F"], a["N"], p["options"], p["choices"])
     rows = a["owned"]
-    name = f"part-{t:06d}.npz"
-    tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        np.savez(f, ids=a["vertices"][rows], **{k: d[k][rows] for k in FIELDS})
-    os.replace(tmp, os.path.join(parts, name))
-    return {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0]),
-            "peak_rss": peak_rss()}
+    ids = a["vertices"][rows]
+    fields = {k: d[k][rows] for k in FIELDS}
+    if d["crease"] is not None:  # the recommended estimator's crease flags
+        fields["crease"] = d["crease"][rows]
+    name = f"part-{t:06d}.{part_format}"
+    out = {"tile": t, "part": name, "rows": int(rows.size), "vertices": int(a["V"].shape[0])}
+    if part_format == "npz":
+        tmp = os.path.join(parts, f".{name}.{os.getpid()}.tmp")
+        with open(tmp, "wb") as f:
+            np.savez(f, ids=ids, **fields)
+        os.replace(tmp, os.path.join(parts, name))
+    else:
+        out["ids"] = f"part-{t:06d}.ids.npy"
+        tmp = os.path.join(parts, f".{out['ids']}.{os.getpid()}.tmp")
+        with open(tmp, "wb") as f:
+            np.save(f, ids)
+        os.replace(tmp, os.path.join(parts, out["ids"]))
+        focal.write_fields(os.path.join(parts, name), focal.Curvature(**fields),
+                           threads=p["options"]["threads"])
+    out["peak_rss"] = peak_rss()
+    return out
 
 
 def peak_rss() -> int:
@@ -434,18 +554,72 @@ def peak_rss() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
+#: Rows of the concatenated CSV gathered in memory at a time.
+CSV_ROWS = 1 << 18
+
+
 def concatenate(manifest: dict, parts: str, output: str) -> None:
+    """The parts' rows in input order, as one file: a .npz of the fields from .npz parts, or
+    from .csv parts the CSV that `focal curvature -o fields.csv` writes (concatenate_csv)."""
+    formats = {os.path.splitext(part["part"])[1] for part in manifest["parts"]}
+    wanted = os.path.splitext(output)[1].lower()
+    if formats != {wanted}:
+        raise focal.InvalidInputError(
+            f"{output}: a {wanted} concatenation is made from {wanted} parts, these are "
+            f"{', '.join(sorted(formats))}")
+    if wanted == ".csv":
+        return concatenate_csv(manifest, parts, output)
+    _concatenate_npz(manifest, parts, output)
+
+
+def concatenate_csv(manifest: dict, parts: str, output: str) -> None:
+    """The .csv parts' rows in input order: the same bytes as the whole mesh's `focal curvature
+    -o fields.csv`. The rows are the writer's bytes, moved, not formatted again: each part's rows
+    are in ascending id order, so CSV_ROWS ids at a time, every part gives the next run of its
+    lines (memory: those lines, and each part's ids mapped)."""
+    n = manifest["vertex_count"]
+    files, ids, cursor, header = [], [], [], None
+    tmp = output + ".tmp"
+    try:
+        for part in manifest["parts"]:
+            files.append(open(os.path.join(parts, part["part"]), "rb"))
+            line = files[-1].readline()
+            if header is None:
+                header = line
+            elif line != header:
+                raise focal.FocalIOError(f"{part['part']}: its header is not the other parts'")
+            ids.append(np.load(os.path.join(parts, part["ids"]), mmap_mode="r"))
+            cursor.append(0)
+        with open(tmp, "wb") as out:
+            out.write(header or b"")
+            for begin, end in _ranges(n, CSV_ROWS):
+                lines = [b""] * (end - begin)
+                for k, f in enumerate(files):
+                    stop = int(np.searchsorted(ids[k], end))
+                    for i in ids[k][cursor[k]:stop].tolist():
+                        lines[i - begin] = f.readline()
+                    cursor[k] = stop
+                out.write(b"".join(lines))
+        os.replace(tmp, output)
+    finally:
+        for f in files:
+            f.close()
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def _concatenate_npz(manifest: dict, parts: str, output: str) -> None:
     """The parts' rows in input order, as one .npz of the fields: each part's rows are written
     by id into .npy columns mapped for that part only (the written pages then belong to the
     page cache, not to this process), then the columns are stored in the .npz."""
     import zipfile
 
     n = manifest["vertex_count"]
-    columns = {k: os.path.join(parts, f".{k}.npy") for k in FIELDS}
+    columns = {k: os.path.join(parts, f".{k}.npy") for k in manifest["fields"]}
     for k, column in columns.items():
         shape = (n, 3) if k in ("d1", "d2") else (n,)
-        dtype = {"point_class": np.uint8, "rays_used": np.int32,
-                 "rays_excluded": np.int32}.get(k, np.float64)
+        dtype = {"point_class": np.uint8, "rays_used": np.int32, "rays_excluded": np.int32,
+                 "crease": np.uint8}.get(k, np.float64)
         np.lib.format.open_memmap(column, "w+", dtype, shape).flush()  # header, size
     for part in manifest["parts"]:
         with np.load(os.path.join(parts, part["part"])) as z:

@@ -5,9 +5,11 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/vector.h>
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -111,6 +113,68 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
   return d;
 }
 
+/// The recommended estimator's statistics of a tile's owned rows (focal::tile_statistics), for
+/// the streamed plan (focal/stream.py): the per-row values of the medians and the counts.
+nb::dict tile_statistics(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
+                         const Ids& ids, const Ids& owned, std::int64_t whole_vertex_count,
+                         const nb::dict& options, double mean_edge_length) {
+  const focal::EstimateOptions o = estimate_options(options);
+  const int threads = nb::cast<int>(options["threads"]);
+  focal::RecommendedStatistics r;
+  {
+    nb::gil_scoped_release release;
+    focal::TileMesh tile{view(V), view(F), std::nullopt};
+    if (N) tile.N = focal::RowMatrixX3d(view(*N));
+    r = focal::tile_statistics(tile, ids_from(ids), ids_from(owned), whole_vertex_count,
+                               mean_edge_length, o, threads);
+  }
+  nb::dict d;
+  d["jet_residual"] = to_numpy(std::move(r.jet_residual));
+  d["angle_along"] = to_numpy(std::move(r.angle_along));
+  d["angle_against"] = to_numpy(std::move(r.angle_against));
+  d["along"] = r.along;
+  d["against"] = r.against;
+  d["sample"] = ids_to_numpy(r.sample);
+  d["sample_noise"] = to_numpy(std::move(r.sample_noise));
+  return d;
+}
+
+/// The whole mesh's choices from the medians and counts over all tiles' statistics
+/// (focal::recommended_mesh_wide_from), as tile_plan's "choices".
+nb::dict recommended_choices(const nb::dict& medians, double mean_edge_length) {
+  focal::RecommendedMedians m;
+  m.jet_residual = nb::cast<double>(medians["jet_residual"]);
+  const auto noise = nb::cast<std::vector<double>>(medians["sample_noise"]);
+  m.sample_noise = Eigen::Map<const Eigen::VectorXd>(noise.data(), std::ssize(noise));
+  m.along = nb::cast<std::int64_t>(medians["along"]);
+  m.against = nb::cast<std::int64_t>(medians["against"]);
+  m.angle_along = nb::cast<double>(medians["angle_along"]);
+  m.angle_against = nb::cast<double>(medians["angle_against"]);
+  m.has_normals = nb::cast<bool>(medians["has_normals"]);
+  focal::MeshWideChoices c;
+  c.mean_edge_length = mean_edge_length;
+  c.recommended = focal::recommended_mesh_wide_from(m, mean_edge_length);
+  return choices_dict(c);
+}
+
+/// focal::ids_in of int32 ids of any shape (C order): a bool array of x's shape.
+nb::ndarray<nb::numpy, bool> ids_in(
+    const nb::ndarray<const std::int32_t, nb::c_contig, nb::device::cpu>& x, const Ids& ascending,
+    int threads) {
+  std::vector<char> in;
+  {
+    nb::gil_scoped_release release;
+    in = focal::ids_in(std::span<const int>(x.data(), x.size()),
+                       std::span<const int>(ascending.data(), ascending.shape(0)), threads);
+  }
+  auto* data = new bool[in.size()];
+  for (std::size_t i = 0; i < in.size(); ++i) data[i] = in[i] != 0;
+  nb::capsule owner(data, [](void* p) noexcept { delete[] static_cast<bool*>(p); });
+  std::vector<std::size_t> shape(x.ndim());
+  for (std::size_t d = 0; d < x.ndim(); ++d) shape[d] = x.shape(d);
+  return nb::ndarray<nb::numpy, bool>(data, x.ndim(), shape.data(), owner);
+}
+
 /// mean_edge_length's partial sums of a run of whole blocks of faces (focal/core/mesh.h), for
 /// the streaming reader (focal/stream.py): (sums, counts) per block of edge_length_block() faces.
 nb::tuple edge_length_sums(const DoubleRows& V, const IntRows& F, int threads) {
@@ -139,10 +203,20 @@ void bind_tiles(nb::module_& m) {
         "N"_a.none().noconvert(), "options"_a, "choices"_a);
   m.def("edge_length_sums", &edge_length_sums, "V"_a.noconvert(), "F"_a.noconvert(), "threads"_a);
   m.def("edge_length_block", [] { return focal::kEdgeLengthBlock; });
+  m.def("tile_statistics", &tile_statistics, "V"_a.noconvert(), "F"_a.noconvert(),
+        "N"_a.none().noconvert(), "ids"_a.noconvert(), "owned"_a.noconvert(),
+        "whole_vertex_count"_a, "options"_a, "mean_edge_length"_a);
+  m.def("recommended_choices", &recommended_choices, "medians"_a, "mean_edge_length"_a);
+  m.def("ids_in", &ids_in, "x"_a.noconvert(), "ascending"_a.noconvert(), "threads"_a);
+  m.def("statistics_reach", [] { return focal::kRecommendedStatisticsReach; });
   m.def(
       "estimate_reach",
-      [](const nb::dict& options) { return focal::estimate_reach(estimate_options(options)); },
-      "options"_a);
+      [](const nb::dict& options, const std::optional<nb::dict>& choices) {
+        const focal::EstimateOptions o = estimate_options(options);
+        if (!choices) return focal::estimate_reach(o);
+        return focal::estimate_reach(focal::options_for_part(o, choices_from(*choices)));
+      },
+      "options"_a, "choices"_a = nb::none());
 }
 
 }  // namespace focal_python

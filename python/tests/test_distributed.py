@@ -298,6 +298,137 @@ def test_streamed_tiles_give_the_whole_mesh_bits(client, awkward_ply, tmp_path, 
     assert np.array_equal(np.sort(ids), np.arange(len(V)))  # every vertex in one part
 
 
+@pytest.fixture(scope="module")
+def streamed_meshes(tmp_path_factory, awkward_ply, awkward):
+    """Binary PLY meshes with normals for the recommended estimator: the awkward one (an
+    unreferenced and a NaN vertex too), its normals turned inward with some rows zero (the
+    majority side, rows filled from the faces), and a torus beside a monkey saddle with 5% and
+    10% vertex noise (2- and 3-ring plans)."""
+    folder = tmp_path_factory.mktemp("streamed")
+    out = {"awkward": awkward_ply[0]}
+    V, F, N = awkward
+    N = -N
+    N[::50] = 0.0
+    focal.write_mesh(folder / "inward.ply", V, F, N)
+    out["inward"] = folder / "inward.ply"
+    torus = focal.generate_surface("torus", 1500, triangulation="irregular", seed=6)
+    saddle = focal.generate_surface("monkey-saddle", 700, triangulation="irregular", seed=7)
+    V, F, N = joined((torus.V, torus.F, torus.N), (saddle.V + [3, 0, 0], saddle.F, saddle.N))
+    h = np.mean(np.linalg.norm(V[F[:, 0]] - V[F[:, 1]], axis=1))
+    rng = np.random.default_rng(8)
+    u = rng.uniform(-1, 1, len(V))[:, None]
+    for percent in (5, 10):
+        path = folder / f"noise{percent}.ply"
+        focal.write_mesh(path, V + percent / 100 * h * u * N, F, N)
+        out[f"noise{percent}"] = path
+    return out
+
+
+@pytest.mark.parametrize("mesh, tile_vertices, rings", [
+    ("awkward", 400, 1), ("awkward", 100_000, 1), ("inward", 350, 1), ("noise5", 300, 2),
+    ("noise10", 300, 3)])
+def test_streamed_recommended_estimate_gives_the_whole_mesh_bits(client, streamed_meshes,
+                                                                 tmp_path, mesh, tile_vertices,
+                                                                 rings):
+    """The default estimator streamed: its whole-mesh choices from a pass of tile statistics
+    (exact medians over the tiles' files), then the tiles; every field and the crease flags are
+    focal.curvature's of the whole file."""
+    path = streamed_meshes[mesh]
+    m = focal.read_mesh(path)
+    whole = focal.curvature(m.V, m.F, m.N)
+    assert whole.plan["rings"] == rings
+    out = tmp_path / "fields.npz"
+    manifest = fd.curvature_stream(path, tmp_path / "parts", client, output=out,
+                                   tile_vertices=tile_vertices, threads=1)
+    assert (manifest["tile_count"] > 1) == (tile_vertices < len(m.V))
+    saved = np.load(out)
+    for name in fd.FIELDS + ("crease",):
+        assert saved[name].tobytes() == getattr(whole, name).tobytes(), name
+    assert not np.isnan(saved["k1"]).all()
+    for name in ("noise", "position_noise"):
+        assert manifest["choices"][name] == whole.plan[name], name
+    assert manifest["choices"]["side"] == (-1.0 if mesh == "inward" else 1.0)
+    assert manifest["halo_rings"] == focal._focal_ext.estimate_reach(
+        focal._estimate_options("recommended", 1, focal._curvature_options({})[2]),
+        manifest["choices"])
+
+
+def focal_curvature_csv(mesh, out, *args):
+    """`focal curvature mesh -o out` (FOCAL_CLI, which `make test` sets), else the same writer
+    from Python (the bytes of test_command_line_writes_the_whole_mesh_fields)."""
+    cli = os.environ.get("FOCAL_CLI")
+    if cli:
+        subprocess.run([cli, "curvature", str(mesh), "-o", str(out), *args], check=True,
+                       capture_output=True)
+    else:
+        m = focal.read_mesh(mesh)
+        focal.write_fields(out, focal.curvature(m.V, m.F, m.N, estimator="paper" if args
+                                                else "recommended"))
+
+
+@pytest.mark.parametrize("mesh, estimator, tile_vertices", [
+    ("awkward", "recommended", 400), ("inward", "recommended", 350),
+    ("noise10", "recommended", 300), ("awkward", "paper", 500)])
+def test_streamed_csv_parts_and_their_concatenation_are_the_whole_runs_bytes(
+        client, streamed_meshes, tmp_path, mesh, estimator, tile_vertices):
+    """Parts as CSV: each the header and the rows of its vertices that `focal curvature -o
+    x.csv` writes for the whole mesh, and concatenated in input order, that file's bytes."""
+    path = streamed_meshes[mesh]
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected, *(["--paper"] if estimator == "paper" else []))
+    lines = expected.read_bytes().splitlines(keepends=True)
+    out = tmp_path / "fields.csv"
+    manifest = fd.curvature_stream(path, tmp_path / "parts", client, output=out,
+                                   tile_vertices=tile_vertices, threads=1, estimator=estimator,
+                                   part_format="csv")
+    assert out.read_bytes() == expected.read_bytes()
+    assert lines[0].endswith(b",class,crease\n") == (estimator == "recommended")
+    assert manifest["part_format"] == "csv" and manifest["tile_count"] > 3
+    seen = 0
+    for part in manifest["parts"]:
+        ids = np.load(tmp_path / "parts" / part["ids"])
+        rows = (tmp_path / "parts" / part["part"]).read_bytes()
+        assert rows == b"".join([lines[0]] + [lines[1 + i] for i in ids.tolist()])
+        seen += len(ids)
+    assert seen == len(lines) - 1
+
+
+def test_streamed_part_format_errors(client, awkward_ply, tmp_path):
+    path, _ = awkward_ply
+    with pytest.raises(focal.InvalidInputError, match="concatenation of csv parts is a .csv"):
+        fd.curvature_stream(path, tmp_path / "p1", client, output=tmp_path / "x.npz",
+                            part_format="csv")
+    with pytest.raises(focal.InvalidInputError, match="part_format"):
+        fd.curvature_stream(path, tmp_path / "p2", client, part_format="ply")
+    r = run_cli(str(path), "--parts", str(tmp_path / "p3"), "-o", str(tmp_path / "x.csv"),
+                "--part-format", "npz")
+    assert r.returncode == 1 and "concatenation of npz parts is .npz" in r.stderr
+
+
+@pytest.mark.parametrize("candidates", [1 << 22, 3])
+def test_streamed_median_is_the_librarys(tmp_path, monkeypatch, candidates):
+    """The exact median over the tiles' statistics files (a radix selection on the values' bits,
+    here also down to the last 16 bits) is the value at rank size / 2 of the finite values, as
+    the library's median takes it: ties, negative values, zeros of both signs, NaN and infinite
+    values, an empty file."""
+    from focal import stream
+
+    monkeypatch.setattr(stream, "_CANDIDATES", candidates)
+    rng = np.random.default_rng(9)
+    values = np.concatenate([rng.normal(size=3000), np.full(500, 0.25), np.full(40, -0.0),
+                             np.zeros(40), [np.nan] * 30, [np.inf, -np.inf],
+                             np.nextafter(0.25, 1) + np.zeros(7)])
+    rng.shuffle(values)
+    files = []
+    for k, chunk in enumerate(np.array_split(values, [0, 1000, 1001, 2500])):
+        files.append(tmp_path / f"s{k}.npy")
+        np.save(files[-1], np.column_stack([chunk, -chunk, np.full(len(chunk), np.nan)]))
+    for column, x in ((0, values), (1, -values)):
+        finite = np.sort(x[np.isfinite(x)])
+        assert stream._median(files, column) == finite[finite.size // 2]
+    assert np.isnan(stream._median(files, 2))
+
+
 def test_streamed_halo_one_ring_short_changes_the_result(client, awkward_ply, tmp_path,
                                                           monkeypatch):
     """The halo is what makes the parts exact: short of the rings the fit reads, vertices near
@@ -322,13 +453,14 @@ def test_streamed_halo_one_ring_short_changes_the_result(client, awkward_ply, tm
 
 def test_streamed_input_errors(client, awkward, awkward_ply, tmp_path):
     path, _ = awkward_ply
-    with pytest.raises(focal.InvalidInputError, match="estimator='paper' only"):
-        fd.curvature_stream(path, tmp_path / "p1", client)
     V, F, _ = awkward
     no_normals = tmp_path / "no_normals.ply"
     focal.write_mesh(no_normals, V, F)
+    for estimator in ("recommended", "paper"):  # the closed components' orientation
+        with pytest.raises(focal.InvalidInputError, match="file's normals.*closed components"):
+            fd.curvature_stream(no_normals, tmp_path / "p2", client, estimator=estimator)
     with pytest.raises(focal.InvalidInputError, match="file's normals"):
-        fd.curvature_stream(no_normals, tmp_path / "p2", client, estimator="paper")
+        fd.curvature_stream(path, tmp_path / "p1", client, estimator="paper", normals="area")
     ascii_ply = tmp_path / "ascii.ply"
     ascii_ply.write_text("ply\nformat ascii 1.0\nelement vertex 0\nend_header\n")
     with pytest.raises(focal.FocalIOError, match="binary PLY only"):
@@ -362,10 +494,71 @@ def test_command_line_streams_parts_and_a_manifest(tmp_path, client, awkward_ply
     saved = np.load(out)
     assert all(saved[n].tobytes() == getattr(whole, n).tobytes() for n in fd.FIELDS)
     assert (tmp_path / "parts" / "manifest.json").exists()
-    r = run_cli(str(path), "--parts", str(tmp_path / "p2"), "--scheduler",
+    csv = tmp_path / "fields.csv"  # the default estimator, CSV parts for a CSV output
+    r = run_cli(str(path), "--parts", str(tmp_path / "p3"), "-o", str(csv), "--scheduler",
+                client.scheduler.address, "--tile-vertices", "700", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected)
+    assert csv.read_bytes() == expected.read_bytes()
+    assert (tmp_path / "p3" / "part-000000.csv").exists()
+    no_normals = tmp_path / "no_normals.ply"
+    focal.write_mesh(no_normals, V, F)
+    r = run_cli(str(no_normals), "--parts", str(tmp_path / "p2"), "--scheduler",
                 client.scheduler.address)
-    assert r.returncode == 2 and "estimator='paper' only" in r.stderr
+    assert r.returncode == 2 and "needs the file's normals" in r.stderr
 
+
+
+def _dask(command, *args):
+    """A `dask scheduler` or `dask worker` process (the entry points' modules, from this
+    Python), as `docs/SCALE.md` starts a cluster by hand."""
+    module = f"distributed.cli.dask_{command}"
+    return subprocess.Popen([sys.executable, "-m", module, *args], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env=dict(os.environ))
+
+
+def test_command_line_on_a_scheduler_started_by_hand(tmp_path, awkward_ply):
+    """`dask scheduler` and `dask worker` in processes of their own, then the command with
+    --scheduler: the in-memory and the streamed runs write `focal curvature`'s CSV bytes."""
+    path, _ = awkward_ply
+    address_file = tmp_path / "scheduler.json"
+    processes = [_dask("scheduler", "--scheduler-file", str(address_file), "--port", "0",
+                       "--host", "127.0.0.1", "--no-dashboard")]
+    try:
+        processes.append(_dask("worker", "--scheduler-file", str(address_file), "--nworkers",
+                               "2", "--nthreads", "1", "--memory-limit", "1GB",
+                               "--no-dashboard", "--local-directory", str(tmp_path)))
+        with Client(scheduler_file=str(address_file), timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+            address = c.scheduler.address
+        expected = tmp_path / "whole.csv"
+        focal_curvature_csv(path, expected)
+        out = tmp_path / "fields.csv"
+        r = run_cli(str(path), "-o", str(out), "--scheduler", address, "--tile-vertices", "700")
+        assert r.returncode == 0, r.stderr
+        assert out.read_bytes() == expected.read_bytes()
+        streamed = tmp_path / "streamed.csv"
+        r = run_cli(str(path), "--parts", str(tmp_path / "parts"), "-o", str(streamed),
+                    "--scheduler", address, "--tile-vertices", "700")
+        assert r.returncode == 0, r.stderr
+        assert streamed.read_bytes() == expected.read_bytes()
+    finally:
+        for process in reversed(processes):
+            process.terminate()
+            process.wait(timeout=60)
+
+
+def test_command_line_starts_its_own_local_cluster(tmp_path, awkward_ply):
+    """Without --scheduler the command runs on a LocalCluster of --workers processes."""
+    path, _ = awkward_ply
+    expected = tmp_path / "whole.csv"
+    focal_curvature_csv(path, expected, "--paper")
+    out = tmp_path / "fields.csv"
+    r = run_cli(str(path), "-o", str(out), "--workers", "1", "--memory-limit", "1GB",
+                "--tile-vertices", "700", "--paper")
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes() == expected.read_bytes()
 
 def _vm_data_mb():
     with open("/proc/self/status") as f:

@@ -3,9 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -180,17 +182,20 @@ RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
   return out;
 }
 
-/// The position noise of recommended_plan (recommended.h): the 2-ring cubic jets' residuals
-/// `r2` with their truncation error taken out, by the 3-ring jets' residuals on a sample. A
-/// cubic's truncation error grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's:
-/// its squared residual grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are
-/// per degree of freedom). Median over the sample, over the mean edge length.
-double position_noise(const Context& c, const Eigen::VectorXd& r2) {
-  const Eigen::Index n = r2.size(), step = std::max<Eigen::Index>(1, n / kNoiseSamples);
-  std::vector<int> sample;
-  for (Eigen::Index i = 0; i < n; i += step) {
-    if (std::isfinite(r2[i])) sample.push_back(static_cast<int>(i));
-  }
+/// Whether vertex i (of n) is in the sample of position_noise: every step-th vertex by index,
+/// about kNoiseSamples of them, where the 2-ring jet's residual `r2` is finite.
+bool in_noise_sample(Eigen::Index i, Eigen::Index n, double r2) {
+  const Eigen::Index step = std::max<Eigen::Index>(1, n / kNoiseSamples);
+  return i % step == 0 && std::isfinite(r2);
+}
+
+/// The position noise of recommended_plan (recommended.h) at the listed vertices (entry k:
+/// vertex sample[k], length units): the 2-ring cubic jets' residuals `r2` (of every vertex) with
+/// their truncation error taken out, by the 3-ring jets' residuals. A cubic's truncation error
+/// grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's: its squared residual
+/// grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are per degree of freedom).
+Eigen::VectorXd noise_at(const Context& c, const Eigen::VectorXd& r2,
+                         const std::vector<int>& sample) {
   const Eigen::VectorXd r3 =
       detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(c, 3, 3), sample);
   constexpr double kGrowth = 5.0625 - 1.0;  // (3/2)^4 - 1
@@ -200,7 +205,16 @@ double position_noise(const Context& c, const Eigen::VectorXd& r2) {
     const double truncation = std::max(0.0, b * b - a * a) / kGrowth;
     noise[k] = std::isfinite(b) ? std::sqrt(std::max(0.0, a * a - truncation)) : NAN;
   }
-  return finite_median(noise) / c.edge_length;
+  return noise;
+}
+
+/// The median of noise_at on the sample (in_noise_sample), length units.
+double position_noise(const Context& c, const Eigen::VectorXd& r2) {
+  std::vector<int> sample;
+  for (Eigen::Index i = 0; i < r2.size(); ++i) {
+    if (in_noise_sample(i, r2.size(), r2[i])) sample.push_back(static_cast<int>(i));
+  }
+  return finite_median(noise_at(c, r2, sample));
 }
 
 /// The plan for the mesh from its measured (or given) per-mesh choices: rings from the position
@@ -299,25 +313,38 @@ RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormal
 
 /// +1 when most usable rows of `file` point to the side of `estimated`, -1 when most point
 /// against it (a file whose normals point inward while the faces turn outward).
-double majority_side(NormalsRef file, NormalsRef estimated) {
-  Eigen::Index along = 0, against = 0;
+/// The rows of `file` that point to the side of `estimated` (first) and against it (second).
+std::pair<std::int64_t, std::int64_t> sides(NormalsRef file, NormalsRef estimated) {
+  std::int64_t along = 0, against = 0;
   for (Eigen::Index i = 0; i < file.rows(); ++i) {
     const double d = file.row(i).dot(estimated.row(i));
     along += d > 0.0;
     against += d < 0.0;
   }
-  return against > along ? -1.0 : 1.0;
+  return {along, against};
 }
 
-/// Angle (radians) between the rows of A and side * B: NaN where a row is zero or not finite.
+double side_of(std::int64_t along, std::int64_t against) { return against > along ? -1.0 : 1.0; }
+
+double majority_side(NormalsRef file, NormalsRef estimated) {
+  const auto [along, against] = sides(file, estimated);
+  return side_of(along, against);
+}
+
+/// Angle (radians) between row i of A and side * row i of B: NaN where a row is zero or not
+/// finite.
+double angle_between(NormalsRef A, NormalsRef B, double side, Eigen::Index i) {
+  const Eigen::Vector3d a = A.row(i).transpose(), b = side * B.row(i).transpose();
+  const bool usable = a.allFinite() && b.allFinite() && a != Eigen::Vector3d::Zero() &&
+                      b != Eigen::Vector3d::Zero();
+  return usable ? std::atan2(a.cross(b).norm(), a.dot(b)) : NAN;
+}
+
+/// angle_between at every row.
 Eigen::VectorXd angles_between(NormalsRef A, NormalsRef B, double side, int threads) {
   Eigen::VectorXd angle(A.rows());
-  detail::parallel_for(A.rows(), threads, [&](std::int64_t i) {
-    const Eigen::Vector3d a = A.row(i).transpose(), b = side * B.row(i).transpose();
-    const bool usable = a.allFinite() && b.allFinite() && a != Eigen::Vector3d::Zero() &&
-                        b != Eigen::Vector3d::Zero();
-    angle[i] = usable ? std::atan2(a.cross(b).norm(), a.dot(b)) : NAN;
-  });
+  detail::parallel_for(A.rows(), threads,
+                       [&](std::int64_t i) { angle[i] = angle_between(A, B, side, i); });
   return angle;
 }
 
@@ -401,15 +428,24 @@ FileComparison compare_file_normals(const Context& c, const JetNormals& jets) {
   return {side, angles_between(*file, jets.N, side, c.threads)};
 }
 
+/// The per-mesh choices from their medians over the whole mesh (length units; radians) and the
+/// side: measured on one mesh (measure_mesh_wide) or over its parts (recommended_mesh_wide_from).
+RecommendedMeshWide mesh_wide_of(double jet_residual, double sample_noise, double file_angle,
+                                 double side, double edge_length) {
+  RecommendedMeshWide m;
+  m.noise = jet_residual / edge_length;
+  m.position_noise = sample_noise / edge_length;
+  m.file_disagreement = file_angle;
+  m.side = side;
+  return m;
+}
+
 /// The per-mesh choices measured on the context's mesh: medians over all its vertices.
 RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
                                       const FileComparison& file) {
-  RecommendedMeshWide m;
-  m.noise = finite_median(jets.residual) / c.edge_length;
-  m.position_noise = position_noise(c, jets.residual);
-  m.file_disagreement = c.mesh.has_normals() ? finite_median(file.disagreement) : NAN;
-  m.side = file.side;
-  return m;
+  return mesh_wide_of(finite_median(jets.residual), position_noise(c, jets.residual),
+                      c.mesh.has_normals() ? finite_median(file.disagreement) : NAN, file.side,
+                      c.edge_length);
 }
 
 /// The robust fit (curvature/robust_fit.h) of the listed vertices over `rings` rings, Gaussian
@@ -663,6 +699,66 @@ RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
   const Context c = make_context(mesh, measured);
   const JetNormals jets = local_jets(c, 2, 3);
   return measure_mesh_wide(c, jets, compare_file_normals(c, jets));
+}
+
+RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std::vector<int>& rows,
+                                             const std::vector<int>& ids,
+                                             Eigen::Index whole_vertex_count,
+                                             const RecommendedOptions& options) {
+  validate_options(options, "recommended_statistics");
+  const auto n = part.vertex_count();
+  if (ids.size() != static_cast<std::size_t>(n)) {
+    throw InvalidInput("recommended_statistics: ids must name every vertex of the part (" +
+                       std::to_string(n) + "), got " + std::to_string(ids.size()));
+  }
+  for (const int r : rows) {
+    if (r < 0 || r >= n) {
+      throw InvalidInput("recommended_statistics: row " + std::to_string(r) +
+                         " is out of range [0, " + std::to_string(n) + ")");
+    }
+  }
+  RecommendedOptions measured = options;
+  measured.mesh_wide.reset();
+  const Context c = make_context(part, measured);
+  // The jets of the listed vertices (detail::jet_normals_at: the bits of local_jets' rows).
+  const JetNormals jets =
+      detail::jet_normals_at(part.V(), *c.one_ring, c.max, jet_options(c, 2, 3), rows);
+  RecommendedStatistics out;
+  out.jet_residual = jets.residual;
+  // position_noise's sample, by whole-mesh index; noise_at reads r2 by part row.
+  Eigen::VectorXd r2 = Eigen::VectorXd::Constant(n, NAN);
+  std::vector<int> sample;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const int r = rows[k];
+    r2[r] = jets.residual[static_cast<Eigen::Index>(k)];
+    if (in_noise_sample(ids[static_cast<std::size_t>(r)], whole_vertex_count, r2[r])) {
+      sample.push_back(r);
+      out.sample.push_back(ids[static_cast<std::size_t>(r)]);
+    }
+  }
+  out.sample_noise = noise_at(c, r2, sample);
+  if (const std::optional<NormalsRef> file = part.normals()) {
+    const auto m = static_cast<Eigen::Index>(rows.size());
+    RowMatrixX3d file_rows(m, 3);
+    for (Eigen::Index k = 0; k < m; ++k) file_rows.row(k) = file->row(rows[std::size_t(k)]);
+    std::tie(out.along, out.against) = sides(file_rows, jets.N);
+    out.angle_along.resize(m);
+    out.angle_against.resize(m);
+    detail::parallel_for(m, c.threads, [&](std::int64_t k) {
+      out.angle_along[k] = angle_between(file_rows, jets.N, 1.0, k);
+      out.angle_against[k] = angle_between(file_rows, jets.N, -1.0, k);
+    });
+  }
+  return out;
+}
+
+RecommendedMeshWide recommended_mesh_wide_from(const RecommendedMedians& whole,
+                                               double mean_edge_length) {
+  const double side = side_of(whole.along, whole.against);
+  const double file_angle =
+      whole.has_normals ? (side < 0.0 ? whole.angle_against : whole.angle_along) : NAN;
+  return mesh_wide_of(whole.jet_residual, finite_median(whole.sample_noise), file_angle,
+                      whole.has_normals ? side : 1.0, mean_edge_length);
 }
 
 int recommended_reach(const RecommendedPlan& plan) {

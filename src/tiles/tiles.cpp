@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -268,6 +269,54 @@ TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
                           {.threads = threads, .mean_edge_length = choices.mean_edge_length});
   Estimate e = estimate(mesh, options_for_part(options, choices));
   return {std::move(e.curvature), std::move(e.crease)};
+}
+
+std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending, int threads) {
+  std::vector<char> out(x.size(), 0);
+  if (ascending.empty() || x.empty()) return out;
+  for (std::size_t k = 1; k < ascending.size(); ++k) {
+    if (ascending[k] < ascending[k - 1]) {
+      throw InvalidInput("ids_in: the set is not ascending at " + std::to_string(k));
+    }
+  }
+  const int lo = ascending.front(), hi = ascending.back();
+  if (lo < 0) throw InvalidInput("ids_in: ids must be >= 0, got " + std::to_string(lo));
+  // One bit per id of the span [lo, hi]: the lookups are the cost (millions per halo round).
+  const auto span = static_cast<std::size_t>(hi - lo) + 1;
+  std::vector<std::uint64_t> bits((span + 63) / 64, 0);
+  for (const int id : ascending) {
+    const auto b = static_cast<std::size_t>(id - lo);
+    bits[b / 64] |= std::uint64_t{1} << (b % 64);
+  }
+  detail::parallel_for(static_cast<std::int64_t>(x.size()), threads, [&](std::int64_t i) {
+    const int v = x[static_cast<std::size_t>(i)];
+    if (v < lo || v > hi) return;
+    const auto b = static_cast<std::size_t>(v - lo);
+    out[static_cast<std::size_t>(i)] = static_cast<char>((bits[b / 64] >> (b % 64)) & 1);
+  });
+  return out;
+}
+
+RecommendedStatistics tile_statistics(const TileMesh& tile, const std::vector<int>& ids,
+                                      const std::vector<int>& owned,
+                                      Eigen::Index whole_vertex_count, double mean_edge_length,
+                                      const EstimateOptions& options, int threads) {
+  if (options.estimator != Estimator::recommended) {
+    throw InvalidInput("tile_statistics: measures the recommended estimator's choices only");
+  }
+  if (!tile.N ||
+      (options.normals != NormalsSource::automatic && options.normals != NormalsSource::file)) {
+    throw InvalidInput(
+        "tile_statistics: needs the mesh's own normals (nx, ny, nz): without them the "
+        "recommended estimate orients the faces of closed components over the whole mesh, "
+        "which a tile cannot decide");
+  }
+  const PreparedMesh mesh(tile.V, tile.F, NormalsRef(*tile.N),
+                          {.threads = threads, .mean_edge_length = mean_edge_length});
+  // The rows fixed as the whole mesh's are (filled, made unit: per row, from its faces).
+  const PreparedNormals prepared = prepare_normals(mesh, options);
+  const PreparedMesh fit = prepared.N ? mesh.with_normals(NormalsRef(*prepared.N)) : mesh;
+  return recommended_statistics(fit, owned, ids, whole_vertex_count, options.recommended);
 }
 
 void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,

@@ -62,7 +62,9 @@
 /// in estimate_curvature.
 
 #include <cmath>
+#include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/prepared.h"
@@ -88,7 +90,7 @@ inline constexpr int kMaxExtraRings = 2;
 /// a majority): given in RecommendedOptions::mesh_wide instead of measured, they let a part of a
 /// mesh (a tile with its halo, focal/tiles/tiles.h) be estimated exactly as in the whole mesh.
 struct RecommendedMeshWide {
-  double noise = NAN;           ///< RecommendedPlan::noise: judges the file's normals
+  double noise = NAN;  ///< RecommendedPlan::noise: judges the file's normals
   /// RecommendedPlan::position_noise: decides the plan (measured on a sample of the vertices
   /// chosen by index, so a tile could not measure it alone).
   double position_noise = NAN;
@@ -167,16 +169,65 @@ struct RecommendedPlan {
 [[nodiscard]] RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
                                                         const RecommendedOptions& options = {});
 
+/// Rings around a vertex that its share of recommended_statistics reads: the 3-ring jet of a
+/// sampled vertex (positions 3 rings out, the 1-rings of the vertices 2 rings out). A part
+/// holding every face within this many rings minus one of its listed vertices (a tile with this
+/// halo, focal/tiles/tiles.h) gives them the whole mesh's values.
+inline constexpr int kRecommendedStatisticsReach = 3;
+
+/// A part's share of what recommended_mesh_wide measures over a whole mesh, for a mesh that no
+/// process holds whole (streamed tile by tile, python/focal/stream.py): per listed vertex the
+/// values the medians run over, and the counts of the majority. The whole mesh's choices are
+/// then recommended_mesh_wide_from the medians over all parts.
+struct RecommendedStatistics {
+  /// Per listed vertex: the residual of its 2-ring cubic jet (length units; NaN: no fit).
+  Eigen::VectorXd jet_residual;
+  /// Per listed vertex, with mesh normals (else empty): the angle (radians) between its normal
+  /// and the jet normal (along), and the jet normal turned round (against); NaN where either is
+  /// unusable.
+  Eigen::VectorXd angle_along, angle_against;
+  /// Listed vertices whose normal points along / against the jet normal.
+  std::int64_t along = 0, against = 0;
+  /// Whole-mesh ids of the listed vertices in the position noise's sample (recommended_plan) ...
+  std::vector<int> sample;
+  Eigen::VectorXd sample_noise;  ///< ... and their position noise (length units)
+};
+
+/// recommended_statistics of the vertices `rows` of `part` (a piece of a mesh with its vertices
+/// in the whole mesh's order and the whole mesh's mean edge length, PrepareOptions; its normals
+/// as the estimator takes them: prepare_normals'). `ids`: the whole-mesh id of every vertex of
+/// the part; `whole_vertex_count`: the whole mesh's. 	hrow InvalidInput when ids is not one per
+/// vertex, a row is out of range, or an option is out of range.
+[[nodiscard]] RecommendedStatistics recommended_statistics(const PreparedMesh& part,
+                                                           const std::vector<int>& rows,
+                                                           const std::vector<int>& ids,
+                                                           Eigen::Index whole_vertex_count,
+                                                           const RecommendedOptions& options = {});
+
+/// The medians and counts of recommended_statistics over every vertex of a whole mesh.
+struct RecommendedMedians {
+  double jet_residual = NAN;     ///< median of the finite jet_residual (nth_element at size / 2)
+  Eigen::VectorXd sample_noise;  ///< every part's sample_noise (any order)
+  std::int64_t along = 0, against = 0;            ///< summed over the parts
+  double angle_along = NAN, angle_against = NAN;  ///< medians of the finite angles
+  bool has_normals = false;                       ///< whether the mesh has normals
+};
+
+/// recommended_mesh_wide of the whole mesh from its medians: the same values (bit for bit) when
+/// the medians are of every vertex's recommended_statistics.
+[[nodiscard]] RecommendedMeshWide recommended_mesh_wide_from(const RecommendedMedians& whole,
+                                                             double mean_edge_length);
+
 /// How far the recommended estimate of one vertex reads the mesh, in rings, for a plan: a tile
 /// needs a halo this wide (focal/tiles/tiles.h) for its owned vertices to get the whole-mesh
 /// result (the plan and the verdict on the file's normals are global: RecommendedMeshWide, decided
 /// once and passed). A vertex's normal reads at most max(5, jet_rings + 2) rings (2-ring jets,
-/// 3-ring within a ring of a boundary, from Max's normals, rated by 1-ring fits; noisy: jet_rings-ring jets from Max's normals, turned
-/// with the 1-ring); the fit reads the normals of rings + kMaxExtraRings rings, and the normals
-/// that the refit of undefined vertices replaced by their neighbours' mean one ring further; on
-/// clean positions every position read may be a spike's repaired one, which reads 2 rings
-/// further. 11 on clean positions, 12 at most (kRecommendedMaxReach). Derived in
-/// recommended.cpp.
+/// 3-ring within a ring of a boundary, from Max's normals, rated by 1-ring fits; noisy:
+/// jet_rings-ring jets from Max's normals, turned with the 1-ring); the fit reads the normals of
+/// rings + kMaxExtraRings rings, and the normals that the refit of undefined vertices replaced by
+/// their neighbours' mean one ring further; on clean positions every position read may be a spike's
+/// repaired one, which reads 2 rings further. 11 on clean positions, 12 at most
+/// (kRecommendedMaxReach). Derived in recommended.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
 /// recommended_reach of the widest plan (3 rings, 4-ring jets).

@@ -14,6 +14,7 @@
 /// mesh_wide_choices and given to every tile.
 
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "focal/core/fields.h"
@@ -76,6 +77,27 @@ struct TileEstimate {
 /// vertices are the whole mesh's.
 [[nodiscard]] TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
                                          const EstimateOptions& options, int threads = 0);
+
+/// The recommended estimator's recommended_statistics of a tile's owned vertices (rows `owned`,
+/// whole-mesh ids `ids`, one per tile vertex), on the tile's normals prepared as the estimate
+/// prepares them (prepare_normals), with the whole mesh's mean edge length: the tile's share of
+/// the whole mesh's RecommendedMeshWide, for a mesh that no process holds whole (the medians
+/// over all tiles, recommended_mesh_wide_from). The tile needs a halo of
+/// kRecommendedStatisticsReach rings. 	hrow InvalidInput when `options` is not the recommended
+/// estimator on the mesh's own normals, or the tile has none: without them the whole mesh's
+/// closed components are oriented (prepare_normals), which a tile cannot decide.
+[[nodiscard]] RecommendedStatistics tile_statistics(
+    const TileMesh& tile, const std::vector<int>& ids, const std::vector<int>& owned,
+    Eigen::Index whole_vertex_count, double mean_edge_length, const EstimateOptions& options,
+    int threads = 0);
+
+/// Whether each id of `x` is one of `ascending` (ids >= 0, ascending): the set operations of a
+/// tile's halo rounds when the mesh is streamed from its file (python/focal/stream.py: which
+/// face records have a corner on the ring's frontier, which faces and vertices are new). A
+/// bitmap over the span of `ascending` (span / 8 bytes), looked up on `threads` threads.
+/// \throw InvalidInput when `ascending` is not ascending or holds a negative id.
+[[nodiscard]] std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending,
+                                       int threads = 0);
 
 /// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
 /// .curvature and .crease, with the memory of the largest tile in place of the whole mesh's.
