@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "focal/image_space/image_space.h"
+#include "focal/cuda/image_state.h"
 #include "kernels/pixel.h"
 
 namespace focal::detail {
@@ -21,7 +21,7 @@ namespace focal::detail {
 void image_curvature_on_device(const image_kernel::ImageView& image, float discontinuity_ratio,
                                int window, const image_kernel::ImageFields& out, int device);
 
-/// A state (ImageDeviceState, focal/image_space/image_space.h) for width x height frames on
+/// A state (ImageDeviceState, focal/cuda/image_state.h) for width x height frames on
 /// `device`: the G-buffer's and the fields' device buffers, the window's operators (window > 0),
 /// a stream and, where `pinned`, page-locked host buffers the transfers go through. Every call
 /// below makes the state's device current and restores the caller's.

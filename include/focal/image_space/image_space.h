@@ -16,8 +16,9 @@
 /// on where the surface lies. docs/IMAGE_SPACE.md states the measured accuracy.
 
 #include <cstdint>
-#include <memory>
 #include <vector>
+
+#include "focal/cuda/image_state.h"
 
 namespace focal {
 
@@ -77,14 +78,6 @@ struct ImageCurvature {
 [[nodiscard]] ImageCurvature estimate_image_curvature_cuda(const GBuffer& gbuffer,
                                                            const ImageSpaceOptions& options = {},
                                                            int device = 0);
-
-namespace detail {
-struct ImageDeviceState;  ///< defined by the CUDA backend (src/cuda/image_space.cu)
-struct ImageDeviceStateDeleter {
-  void operator()(ImageDeviceState* state) const noexcept;
-};
-using ImageDeviceStatePtr = std::unique_ptr<ImageDeviceState, ImageDeviceStateDeleter>;
-}  // namespace detail
 
 /// Image space on CUDA device `device` for a stream of frames of one size (an interactive
 /// viewer, a video): the device buffers of the G-buffer, of the fields and of the window's
