@@ -1,4 +1,5 @@
-// The lane kernels of the closed-form fit and of the per-triangle solve (src/core/simd_lanes.h):
+// The lane kernels of the closed-form fit, of the per-triangle solve and of the jets
+// (src/core/simd_lanes.h):
 // the same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
 // (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).
@@ -6,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <random>
 #include <span>
 #include <vector>
 
@@ -17,7 +20,9 @@
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/curvature/two_slit_fit.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "normals/jets_detail.h"
 #include "test_meshes.h"
 
 namespace focal {
@@ -208,6 +213,111 @@ TEST(SimdKernels, TriangleIsBitIdenticalForEveryInstructionSetAndThreadCount) {
                     identical(t.shape_operator, reference.shape_operator) &&
                     (t.point_class.array() == reference.point_class.array()).all())
             << "isa " << static_cast<int>(isa) << " threads " << threads;
+      }
+    }
+  }
+}
+
+/// A mesh on which the jets take every path of their lanes: a noisy 9 x 9 grid (its corners and
+/// edges hold too few points for a cubic or quartic: lower degrees, by the scalar path), a fan of
+/// 12 triangles whose rim lies on a circle around its centre (the cubic's normal equations there
+/// are singular: x (x^2 + y^2 - r^2) vanishes at every point of the 1-ring, and the rim vertices'
+/// rings are no better), a vertex at NaN (its neighbours skip it; its faces' vertices start
+/// from NaN normals: no jet) and a vertex in no face (no jet). 81 + 13 + 1 vertices: the last
+/// batch of every lane width is cut short.
+struct DegenerateRings {
+  RowMatrixX3d V;
+  Neighbourhoods one;
+  RowMatrixX3d start;  ///< Max's normals, NaN around the NaN vertex
+};
+
+DegenerateRings degenerate_rings() {
+  constexpr int kGrid = 9, kRim = 12;
+  RowMatrixX3d V(kGrid * kGrid + 1 + kRim + 1, 3);
+  std::mt19937 random(19);
+  std::uniform_real_distribution<double> noise(-0.05, 0.05);
+  for (int i = 0; i < kGrid; ++i) {
+    for (int j = 0; j < kGrid; ++j) {
+      const double x = i + noise(random), y = j + noise(random);
+      V.row(i * kGrid + j) << x, y, 0.05 * x * x - 0.03 * x * y * y / kGrid + noise(random);
+    }
+  }
+  const int centre = kGrid * kGrid;
+  V.row(centre) << 20.0, 0.0, 0.0;
+  for (int k = 0; k < kRim; ++k) {
+    const double t = 2.0 * M_PI * k / kRim;
+    V.row(centre + 1 + k) << 20.0 + std::cos(t), std::sin(t), 0.0;
+  }
+  V.row(V.rows() - 1) << 5.0, 5.0, 5.0;  // in no face
+  std::vector<Eigen::RowVector3i> faces;
+  for (int i = 0; i + 1 < kGrid; ++i) {
+    for (int j = 0; j + 1 < kGrid; ++j) {
+      const int a = i * kGrid + j, b = a + kGrid;
+      faces.push_back({a, b, a + 1});
+      faces.push_back({a + 1, b, b + 1});
+    }
+  }
+  for (int k = 0; k < kRim; ++k)
+    faces.push_back({centre, centre + 1 + k, centre + 1 + (k + 1) % kRim});
+  RowMatrixX3i F(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t f = 0; f < faces.size(); ++f) F.row(static_cast<Eigen::Index>(f)) = faces[f];
+  RowMatrixX3d start = vertex_normals(V, F, NormalWeighting::max);
+  const int lost = 4 * kGrid + 4;  // the grid's middle vertex
+  V.row(lost).setConstant(std::nan(""));
+  Neighbourhoods one = vertex_adjacency(static_cast<int>(V.rows()), F);
+  for (const int* j = one.begin(lost); j != one.end(lost); ++j)
+    start.row(*j).setConstant(std::nan(""));
+  return {V, std::move(one), start};
+}
+
+bool identical(const JetNormals& a, const JetNormals& b) {
+  return identical(a.N, b.N) && identical(a.residual, b.residual) && a.degree == b.degree;
+}
+
+TEST(SimdKernels, JetLanesEqualTheScalarPathVertexByVertex) {
+  const DegenerateRings m = degenerate_rings();
+  const int centre = 81;
+  JetOptions cubic;
+  cubic.degree = 3;
+  cubic.rings = 2;
+  cubic.iterations = 1;
+  std::vector<JetOptions> cases(6, cubic);  // the default's jets first
+  cases[1].rings = 3;
+  cases[2].degree = 4;
+  cases[3].degree = 2, cases[3].rings = 1;
+  cases[4].degree = 1, cases[4].rings = 1;
+  cases[5].iterations = 2;
+  for (JetOptions o : cases) {
+    o.threads = 1;
+    const JetNormals scalar = detail::jet_normals_from(m.V, m.one, m.start, o, std::nullopt);
+    const auto with_degree = [&](auto predicate) {
+      return (scalar.degree.array().unaryExpr(predicate)).count();
+    };
+    // Every path is taken: the degree asked for, lower degrees, no jet.
+    EXPECT_GT(with_degree([&](int d) { return d == o.degree; }), 20);
+    if (o.degree > 1) {
+      EXPECT_GT(with_degree([&](int d) { return d > 0 && d < o.degree; }), 3);
+    }
+    EXPECT_GE(with_degree([](int d) { return d == 0; }), 2);
+    if (o.degree == 3) {
+      EXPECT_EQ(scalar.degree[centre], 2) << "the fan's cubic is singular";
+    }
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        o.threads = threads;
+        EXPECT_TRUE(identical(detail::jet_normals_from(m.V, m.one, m.start, o, isa), scalar))
+            << "degree " << o.degree << " rings " << o.rings << " isa " << static_cast<int>(isa)
+            << " threads " << threads;
+      }
+      // Other batches: the vertices listed backwards, every third.
+      std::vector<int> some;
+      for (int v = static_cast<int>(m.V.rows()) - 1; v >= 0; v -= 3) some.push_back(v);
+      const JetNormals at = detail::jet_normals_at(m.V, m.one, m.start, o, some, isa);
+      for (std::size_t k = 0; k < some.size(); ++k) {
+        const auto row = static_cast<Eigen::Index>(k);
+        EXPECT_EQ(at.degree[row], scalar.degree[some[k]]);
+        EXPECT_TRUE(identical(RowMatrixX3d(at.N.row(row)), RowMatrixX3d(scalar.N.row(some[k]))))
+            << "vertex " << some[k];
       }
     }
   }

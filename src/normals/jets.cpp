@@ -10,10 +10,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/simd_lanes.h"
 #include "focal/core/error.h"
 #include "focal/core/point_class.h"
 #include "focal/mesh/neighbourhood.h"
@@ -29,6 +32,7 @@
 namespace focal {
 namespace {
 
+using detail::SimdIsa;
 using kernels::eigen_of;
 
 constexpr int kMaxDegree = 4;
@@ -78,27 +82,19 @@ struct Point {
   double x, y, z;
 };
 
-/// Two doubles as one SSE2 register: the moments (and x.q, y.q in gather_points) are sums of
-/// independent entries, added pairwise with the same per-entry operations (and bits) as one at a
-/// time.
+/// Two doubles as one SSE2 register: x.q and y.q in gather_points, with the same products and
+/// sums per entry (and bits) as one at a time.
 using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
-/// A thread's scratch, reused across its vertices: no allocation per vertex once warm.
-struct JetScratch {
-  /// One bit per vertex, allocated on first use (#V / 8 bytes: it stays in cache): set while
-  /// the vertex is in the neighbourhood being gathered, cleared after it.
-  std::vector<std::uint64_t> in_ring;
-  std::vector<int> ring;  ///< v and the vertices within `rings` edges, sorted
-  std::vector<Point> points;
-  std::vector<double> terms;  ///< each point's monomials (moments_of)
-};
-
-/// The vertices within `rings` edges of v (v included), sorted: breadth-first over the 1-ring
-/// with marks, then sorted so that the points, and hence the sums of the fit, keep the same
-/// order as when the rings were merged as sorted lists (which cost 3.5 times as much).
-void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
-  if (s.in_ring.empty()) s.in_ring.assign(static_cast<std::size_t>(one.vertex_count()) / 64 + 1, 0);
-  std::uint64_t* bits = s.in_ring.data();
+/// The vertices within `rings` edges of v (v included), sorted, into `ring`: breadth-first over
+/// the 1-ring with marks (`in_ring`: one bit per vertex, allocated on first use, #V / 8 bytes: it
+/// stays in cache; set while the vertex is in the neighbourhood being gathered, cleared after
+/// it), then sorted so that the points, and hence the sums of the fit, keep the same order as
+/// when the rings were merged as sorted lists (which cost 3.5 times as much).
+void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::uint64_t>& in_ring,
+                 std::vector<int>& ring) {
+  if (in_ring.empty()) in_ring.assign(static_cast<std::size_t>(one.vertex_count()) / 64 + 1, 0);
+  std::uint64_t* bits = in_ring.data();
   const auto test_and_set = [bits](int w) {
     std::uint64_t& word = bits[static_cast<std::size_t>(w) / 64];
     const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(w) % 64);
@@ -106,30 +102,31 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, JetScratch& s) {
     word |= bit;
     return was;
   };
-  s.ring.assign(1, v);
+  ring.assign(1, v);
   test_and_set(v);
   // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
   const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
   std::size_t begin = 0;
-  for (int depth = 0; depth < rings && begin < s.ring.size(); ++depth) {
-    const std::size_t end = s.ring.size();
-    for (std::size_t k = begin; k < end && s.ring.size() <= cap; ++k) {
-      const int u = s.ring[k];
-      for (const int* w = one.begin(u); w != one.end(u) && s.ring.size() <= cap; ++w) {
-        if (!test_and_set(*w)) s.ring.push_back(*w);
+  for (int depth = 0; depth < rings && begin < ring.size(); ++depth) {
+    const std::size_t end = ring.size();
+    for (std::size_t k = begin; k < end && ring.size() <= cap; ++k) {
+      const int u = ring[k];
+      for (const int* w = one.begin(u); w != one.end(u) && ring.size() <= cap; ++w) {
+        if (!test_and_set(*w)) ring.push_back(*w);
       }
     }
     begin = end;
   }
-  for (const int w : s.ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
-  if (s.ring.size() > cap) s.ring.resize(1);
-  detail::sort_small(s.ring.data(), s.ring.data() + s.ring.size(), std::less<>());
+  for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
+  if (ring.size() > cap) ring.resize(1);
+  detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
 }
 
-/// The vertex itself (zero) and its ring in the frame, scaled by the largest offset; non-finite
-/// neighbours are skipped. Returns the scale (0 when no usable neighbour).
-double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f, JetScratch& s) {
-  s.points.assign(1, Point{0.0, 0.0, 0.0});
+/// The vertex itself (zero) and its ring in the frame, scaled by the largest offset, into
+/// `points`; non-finite neighbours are skipped. Returns the scale (0 when no usable neighbour).
+double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
+                     const std::vector<int>& ring, std::vector<Point>& points) {
+  points.assign(1, Point{0.0, 0.0, 0.0});
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
   // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
   // GCC paired them by itself or not, depending on how the frame was built.
@@ -137,36 +134,21 @@ double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f, Jet
   const Pair frame_x = {f.x.x, f.y.x}, frame_y = {f.x.y, f.y.y}, frame_z = {f.x.z, f.y.z};
   const double nx = f.n.x, ny = f.n.y, nz = f.n.z;
   double scale_sq = 0.0;
-  for (const int j : s.ring) {
+  for (const int j : ring) {
     if (j == i) continue;
     const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
     if (!std::isfinite(qx) || !std::isfinite(qy) || !std::isfinite(qz)) continue;
     const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
-    s.points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
+    points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
     scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
   }
   const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
   if (scale > 0.0) {
     const double inv = 1.0 / scale;
-    for (Point& q : s.points) q = {q.x * inv, q.y * inv, q.z * inv};
+    for (Point& q : points) q = {q.x * inv, q.y * inv, q.z * inv};
   }
   return scale;
 }
-
-/// The normal equations of every degree up to D at once, from moments: entry (j, k) of the
-/// degree-d system is sum_i m_j(x_i) m_k(x_i) = the moment of the product monomial, and the
-/// degree-d system is the leading block of the degree-D one (monomials are numbered by degree).
-/// 28 moments per point for a cubic instead of 55 products, and a failed cubic falls back to
-/// lower degrees without another pass over the points.
-template <int D>
-struct Moments {
-  static constexpr int kProducts = coefficient_count(2 * D);
-  static constexpr int kCoefficients = coefficient_count(D);
-  double xy[kProducts] = {};     ///< sum x^a y^b, a + b <= 2D
-  double z[kCoefficients] = {};  ///< sum z x^a y^b, a + b <= D
-};
-
-constexpr int pairs_for(int count) { return (count + 1) / 2; }
 
 /// Powers of x and y of every monomial of degree <= 2 kMaxDegree (the moments' numbering).
 struct PowerTable {
@@ -183,177 +165,351 @@ constexpr PowerTable kPowers = [] {
   return p;
 }();
 
-/// The moments of the points; `terms` receives each point's monomials of degree <= D (the
-/// residuals reuse them: same products, so the same bits as evaluating them again).
-template <int D>
-Moments<D> moments_of(const std::vector<Point>& points, std::vector<double>& terms) {
-  constexpr int kProducts = Moments<D>::kProducts, kTerms = Moments<D>::kCoefficients;
-  constexpr int kProductPairs = pairs_for(kProducts), kTermPairs = pairs_for(kTerms);
-  terms.resize(points.size() * kTerms);
-  Pair xy[kProductPairs] = {}, z[kTermPairs] = {};
-  double* out = terms.data();
-  for (const Point& p : points) {
-    double xp[2 * D + 1], yp[2 * D + 1];
-    xp[0] = yp[0] = 1.0;
-    for (int k = 1; k <= 2 * D; ++k) xp[k] = xp[k - 1] * p.x, yp[k] = yp[k - 1] * p.y;
-    // Each pair is assembled in registers from its two products: storing the products one by
-    // one and loading them back as pairs would stall on store forwarding (8-byte stores read
-    // by a 16-byte load), which cost more than the arithmetic.
-    Pair term[kProductPairs];
-#pragma GCC unroll 32
-    for (int q = 0; q < kProductPairs; ++q) {
-      const int lo = 2 * q, hi = 2 * q + 1;  // hi == kProducts: the zero padding entry
-      term[q] = Pair{xp[kPowers.x[lo]] * yp[kPowers.y[lo]],
-                     hi < kProducts ? xp[kPowers.x[hi]] * yp[kPowers.y[hi]] : 0.0};
-    }
-#pragma GCC unroll 32
-    for (int q = 0; q < kProductPairs; ++q) xy[q] += term[q];
-    const Pair pz = {p.z, p.z};
-#pragma GCC unroll 32
-    for (int q = 0; q < kTermPairs; ++q) z[q] += pz * term[q];
-#pragma GCC unroll 32
-    for (int k = 0; k < kTerms; ++k) out[k] = term[k / 2][k % 2];
-    out += kTerms;
+constexpr int kMaxLanes = 8;
+
+/// The fits of up to kMaxLanes vertices side by side, as plain data for the lane kernels (lane l:
+/// the l-th vertex of a batch). Arrays of lanes are lane-minor: entry k of lane l at k * W + l,
+/// W the kernel's lane count (1 for the scalar path).
+///
+/// The fit of degree D solves the normal equations of every degree up to D from moments: entry
+/// (j, k) of the degree-d system is sum_i m_j(x_i) m_k(x_i) = the moment of the product
+/// monomial, and the degree-d system is the leading block of the degree-D one (monomials are
+/// numbered by degree). 28 moments per point for a cubic instead of 55 products, and a failed
+/// cubic falls back to lower degrees without another pass over the points.
+struct JetBatch {
+  const Point* points[kMaxLanes] = {};  ///< count[l] points of lane l (0: an idle lane)
+  int count[kMaxLanes] = {};
+  int points_max = 0;  ///< the largest count
+  /// Per point p, terms_stride(D) lane vectors from terms + p * terms_stride(D) * W: the
+  /// monomials of degree <= D (the residuals reuse them: same products, so the same bits as
+  /// evaluating them again), then the height z; zero for a lane's points past its count.
+  double* terms = nullptr;
+  double xy[coefficient_count(2 * kMaxDegree) * kMaxLanes];  ///< sum x^a y^b, a + b <= 2D
+  double z[kMaxCoefficients * kMaxLanes];                    ///< sum z x^a y^b, a + b <= D
+  double c[kMaxCoefficients * kMaxLanes];                    ///< the degree-D fit, where solved
+  double ssr[kMaxLanes];   ///< its sum of squared height residuals
+  bool solved[kMaxLanes];  ///< count >= coefficient_count(D), well conditioned
+};
+
+constexpr int terms_stride(int degree) { return coefficient_count(degree) + 1; }
+
+// Lane helpers that also take plain doubles (one lane): the scalar path is the same code.
+template <class L>
+constexpr int width = detail::lane_count<L>;
+
+template <class L, class F>
+FOCAL_LANE_INLINE L lanes_from(F f) {
+  if constexpr (std::is_same_v<L, double>) {
+    return f(0);
+  } else {
+    return detail::lanes_of<L>(f);
   }
-  Moments<D> m;  // the pairs are the entries in order, and a possible padding entry last
-  std::memcpy(m.xy, xy, sizeof m.xy);
-  std::memcpy(m.z, z, sizeof m.z);
-  return m;
 }
 
-/// Solves the m x m normal equations A c = rhs, A[j][k] = xy[kProductMoment[j][k]], by LDL^T;
-/// false when A is not well conditioned. The pivot order is Eigen's LDLT's (the solver this
-/// replaced): at step k the largest |diagonal entry| of the rows left, as stored before their
-/// update. Same order, same pivots D, so the same vertices pass the rank test: a relative pivot
-/// below 1e-12 (a relative singular value below 1e-6) means nearly collinear or conic points,
-/// whose polynomial would be fitted to rounding or noise. Fixed size and unrolled: Eigen's LDLT
-/// runs dynamic-size block code even for a fixed 10 x 10 matrix (a fifth of the jets' time).
+template <class L>
+FOCAL_LANE_INLINE auto lane_of(L x, int l) {
+  if constexpr (std::is_arithmetic_v<L>) {
+    return x;
+  } else {
+    return x[l];
+  }
+}
+
+template <class L>
+FOCAL_LANE_INLINE L abs_of(L x) {
+  if constexpr (std::is_same_v<L, double>) {
+    return std::abs(x);
+  } else {
+    return detail::lane_abs(x);
+  }
+}
+
+/// The moments of every lane's points into b.xy, b.z, and their terms into b.terms. A lane's
+/// points past its count are (0, 0, 0) with the constant monomial 0: each of their products is
+/// +0, which leaves every sum's bits as they are (no sum of these starts at or reaches -0).
+template <class L, int D>
+FOCAL_LANE_INLINE void accumulate_moments(JetBatch& b) {
+  constexpr int W = width<L>, kProducts = coefficient_count(2 * D), kTerms = coefficient_count(D);
+  L xy[kProducts] = {}, z[kTerms] = {};
+  double* out = b.terms;
+  for (int p = 0; p < b.points_max; ++p) {
+    const auto field = [&](double Point::*f) FOCAL_LANE_LAMBDA {
+      return lanes_from<L>([&](int l) { return p < b.count[l] ? b.points[l][p].*f : 0.0; });
+    };
+    const L x = field(&Point::x), y = field(&Point::y), height = field(&Point::z);
+    L xp[2 * D + 1], yp[2 * D + 1];
+    xp[0] = lanes_from<L>([&](int l) { return p < b.count[l] ? 1.0 : 0.0; });
+    yp[0] = detail::broadcast<L>(1.0);
+#pragma GCC unroll 16
+    for (int k = 1; k <= 2 * D; ++k) xp[k] = xp[k - 1] * x, yp[k] = yp[k - 1] * y;
+#pragma GCC unroll 64
+    for (int q = 0; q < kProducts; ++q) {
+      const L term = xp[kPowers.x[q]] * yp[kPowers.y[q]];
+      xy[q] += term;
+      if (q < kTerms) {
+        z[q] += height * term;
+        detail::store_lanes(out + q * W, term);
+      }
+    }
+    detail::store_lanes(out + kTerms * W, height);
+    out += terms_stride(D) * W;
+  }
+  for (int q = 0; q < kProducts; ++q) detail::store_lanes(b.xy + q * W, xy[q]);
+  for (int q = 0; q < kTerms; ++q) detail::store_lanes(b.z + q * W, z[q]);
+}
+
+/// Eigen's LDLT's pivot order (the solver this replaced) for the m x m normal equations of one
+/// lane (moment k at xy[k * stride]): at step k the largest |diagonal entry| of the rows left, as
+/// stored before their update.
 template <int m>
-bool solve_normal_equations(const double* xy, const double* rhs, double* c) {
-  int perm[m];
+void pivot_order(const double* xy, int stride, int* perm) {
   double magnitude[m];
-  for (int i = 0; i < m; ++i) perm[i] = i, magnitude[i] = std::abs(xy[kProductMoment.index[i][i]]);
+  for (int i = 0; i < m; ++i)
+    perm[i] = i, magnitude[i] = std::abs(xy[kProductMoment.index[i][i] * stride]);
   for (int k = 0; k < m; ++k) {
     int best = k;
     for (int j = k + 1; j < m; ++j) best = magnitude[j] > magnitude[best] ? j : best;
     std::swap(magnitude[k], magnitude[best]);
     std::swap(perm[k], perm[best]);
   }
-  double L[m][m];  // the permuted A on and below the diagonal, overwritten by L column by column
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j <= i; ++j) L[i][j] = xy[kProductMoment.index[perm[i]][perm[j]]];
-  }
-  double d[m];
+}
+
+/// LDL^T of the permuted normal equations A y = r (A on and below the diagonal, overwritten by L
+/// column by column), in the same operations per lane whatever the pivots: true per lane where
+/// every pivot is non-zero, the smallest relative pivot is at least 1e-12 (a relative singular
+/// value of 1e-6: below it the points are nearly collinear or conic, and their polynomial would
+/// be fitted to rounding or noise) and y is finite. A failed lane computes on (NaN, inf) and is
+/// reported, never used.
+template <class L, int m>
+FOCAL_LANE_INLINE auto solve_ldlt(L (&A)[m][m], const L (&r)[m], L (&y)[m]) {
+  auto ok = L{} == L{};
+  L d[m];
 #pragma GCC unroll 16
   for (int k = 0; k < m; ++k) {
-    double ld[m];  // L(k, j) d(j)
-    double pivot = L[k][k];
+    L ld[m];  // L(k, j) d(j)
+    L pivot = A[k][k];
 #pragma GCC unroll 16
     for (int j = 0; j < k; ++j) {
-      ld[j] = L[k][j] * d[j];
-      pivot -= L[k][j] * ld[j];
+      ld[j] = A[k][j] * d[j];
+      pivot -= A[k][j] * ld[j];
     }
-    if (!(std::abs(pivot) > 0.0)) return false;  // also NaN
+    ok = ok & (abs_of(pivot) > L{});  // also NaN
     d[k] = pivot;
-    const double inverse = 1.0 / pivot;
+    const L inverse = 1.0 / pivot;
 #pragma GCC unroll 16
     for (int i = k + 1; i < m; ++i) {
-      double s = L[i][k];
+      L s = A[i][k];
 #pragma GCC unroll 16
-      for (int j = 0; j < k; ++j) s -= L[i][j] * ld[j];
-      L[i][k] = s * inverse;
+      for (int j = 0; j < k; ++j) s -= A[i][j] * ld[j];
+      A[i][k] = s * inverse;
     }
   }
-  double smallest = std::abs(d[0]), largest = std::abs(d[0]);
+  L smallest = abs_of(d[0]), largest = abs_of(d[0]);
   for (int k = 1; k < m; ++k) {
-    smallest = std::min(smallest, std::abs(d[k]));
-    largest = std::max(largest, std::abs(d[k]));
+    const L e = abs_of(d[k]);
+    smallest = e < smallest ? e : smallest;  // std::min and std::max, lane by lane
+    largest = largest < e ? e : largest;
   }
-  if (!(smallest > 1e-12 * largest)) return false;
-  double y[m];
+  ok = ok & (smallest > 1e-12 * largest);
 #pragma GCC unroll 16
   for (int i = 0; i < m; ++i) {
-    y[i] = rhs[perm[i]];
+    y[i] = r[i];
 #pragma GCC unroll 16
-    for (int j = 0; j < i; ++j) y[i] -= L[i][j] * y[j];
+    for (int j = 0; j < i; ++j) y[i] -= A[i][j] * y[j];
   }
   for (int i = 0; i < m; ++i) y[i] /= d[i];
 #pragma GCC unroll 16
   for (int i = m - 1; i >= 0; --i) {
 #pragma GCC unroll 16
-    for (int j = i + 1; j < m; ++j) y[i] -= L[j][i] * y[j];
+    for (int j = i + 1; j < m; ++j) y[i] -= A[j][i] * y[j];
   }
-  bool finite = true;
-  for (int i = 0; i < m; ++i) {
-    c[perm[i]] = y[i];
-    finite = finite && std::isfinite(y[i]);
-  }
-  return finite;
+  for (int i = 0; i < m; ++i)
+    ok = ok & (abs_of(y[i]) <= detail::broadcast<L>(std::numeric_limits<double>::max()));
+  return ok;
 }
 
-/// Sum of squared height residuals of the degree-d polynomial c over the points, from their
-/// first m = coefficient_count(d) monomials (stored `stride` apart).
-template <int d>
-double squared_residuals(const std::vector<Point>& points, const std::vector<double>& terms,
-                         int stride, const double* c) {
-  constexpr int m = coefficient_count(d);
-  double ssr = 0.0;
-  const double* term = terms.data();
-  for (const Point& p : points) {
-    double height = 0.0;
-    for (int k = 0; k < m; ++k) height += c[k] * term[k];
-    const double r = height - p.z;
+/// Solves every lane's m x m normal equations A c = rhs, A[j][k] = xy[kProductMoment[j][k]], by
+/// LDL^T in its own pivot order (pivot_order): the matrix and right-hand side are gathered per
+/// lane in that order, then factored in lanes. Fixed size and unrolled: Eigen's LDLT runs
+/// dynamic-size block code even for a fixed 10 x 10 matrix (a fifth of the jets' time).
+template <class L, int m>
+FOCAL_LANE_INLINE auto solve_normal_equations(const double* xy, const double* rhs, double* c) {
+  constexpr int W = width<L>;
+  int perm[W][m];
+  for (int l = 0; l < W; ++l) pivot_order<m>(xy + l, W, perm[l]);
+  L A[m][m], r[m], y[m];
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      A[i][j] = lanes_from<L>(
+          [&](int l) { return xy[kProductMoment.index[perm[l][i]][perm[l][j]] * W + l]; });
+    }
+    r[i] = lanes_from<L>([&](int l) { return rhs[perm[l][i] * W + l]; });
+  }
+  const auto ok = solve_ldlt<L, m>(A, r, y);
+  for (int l = 0; l < W; ++l) {
+    for (int i = 0; i < m; ++i) c[perm[l][i] * W + l] = lane_of(y[i], l);
+  }
+  return ok;
+}
+
+/// Sum of squared height residuals of the degree-d polynomial c (lane-minor) over every lane's
+/// points, from the first coefficient_count(d) of their degree-D terms.
+template <class L, int d, int D>
+FOCAL_LANE_INLINE L squared_residuals(const JetBatch& b, const double* c) {
+  constexpr int W = width<L>, m = coefficient_count(d), kTerms = coefficient_count(D);
+  L coefficient[m];
+  for (int k = 0; k < m; ++k) coefficient[k] = detail::load_lanes<L>(c + k * W);
+  L ssr = {};
+  const double* term = b.terms;
+  for (int p = 0; p < b.points_max; ++p) {
+    L height = {};
+#pragma GCC unroll 16
+    for (int k = 0; k < m; ++k) height += coefficient[k] * detail::load_lanes<L>(term + k * W);
+    const L r = height - detail::load_lanes<L>(term + kTerms * W);
     ssr += r * r;
-    term += stride;
+    term += terms_stride(D) * W;
   }
   return ssr;
 }
 
-/// Least-squares fit of degree d from the moments if the points determine it.
-template <int d, int D>
-bool solve_degree(const Moments<D>& moments, const std::vector<Point>& points,
-                  const std::vector<double>& terms, LocalJet& jet) {
+/// The degree-d fit of every lane from b's moments into c (lane-minor) and its squared
+/// residuals; true per lane where the lane has enough points and the system is well conditioned.
+template <class L, int d, int D>
+FOCAL_LANE_INLINE auto solve_degree(const JetBatch& b, double* c, L& ssr) {
   constexpr int m = coefficient_count(d);
-  const auto n = static_cast<int>(points.size());
-  if (n < m || !solve_normal_equations<m>(moments.xy, moments.z, jet.c)) return false;
-  jet.degree = d;
-  jet.points = n;
-  jet.residual =
-      n > m ? std::sqrt(squared_residuals<d>(points, terms, Moments<D>::kCoefficients, jet.c) /
-                        (n - m)) *
-                  jet.scale
-            : std::numeric_limits<double>::quiet_NaN();
-  return true;
+  auto ok = solve_normal_equations<L, m>(b.xy, b.z, c);
+  ok = ok & (lanes_from<L>([&](int l) { return static_cast<double>(b.count[l]); }) >= m);
+  ssr = squared_residuals<L, d, D>(b, c);
+  return ok;
 }
 
-/// The fit of the highest degree <= D that succeeds (too few points or a singular system
-/// lowers the degree).
+/// The lane kernel: moments and the degree-D fit of every lane of b.
+template <class L, int D>
+FOCAL_LANE_INLINE void fit_top_degree(JetBatch& b) {
+  accumulate_moments<L, D>(b);
+  L ssr;
+  const auto ok = solve_degree<L, D, D>(b, b.c, ssr);
+  for (int l = 0; l < width<L>; ++l) {
+    b.ssr[l] = lane_of(ssr, l);
+    b.solved[l] = lane_of(ok, l) != 0;
+  }
+}
+
 template <int D>
-bool solve_heights(const std::vector<Point>& points, std::vector<double>& terms, LocalJet& jet) {
-  const Moments<D> m = moments_of<D>(points, terms);
-  if constexpr (D >= 4) {
-    if (solve_degree<4>(m, points, terms, jet)) return true;
-  }
-  if constexpr (D >= 3) {
-    if (solve_degree<3>(m, points, terms, jet)) return true;
-  }
-  if constexpr (D >= 2) {
-    if (solve_degree<2>(m, points, terms, jet)) return true;
-  }
-  return solve_degree<1>(m, points, terms, jet);
+FOCAL_TARGET_AVX512 void fit_top_degree_avx512(JetBatch& b) {
+  fit_top_degree<detail::Lanes8, D>(b);
+}
+template <int D>
+FOCAL_TARGET_AVX2 void fit_top_degree_avx2(JetBatch& b) {
+  fit_top_degree<detail::Lanes4, D>(b);
+}
+template <int D>
+void fit_top_degree_baseline(JetBatch& b) {
+  fit_top_degree<detail::Lanes2, D>(b);
+}
+template <int D>
+void fit_top_degree_scalar(JetBatch& b) {
+  fit_top_degree<double, D>(b);
 }
 
-bool solve_heights(int degree, const std::vector<Point>& points, std::vector<double>& terms,
-                   LocalJet& jet) {
+using TopDegreeKernel = void (*)(JetBatch&);
+
+template <int D>
+TopDegreeKernel top_degree_kernel(std::optional<SimdIsa> isa) {
+  if (!isa) return fit_top_degree_scalar<D>;
+  return detail::kernel_for(*isa, fit_top_degree_avx512<D>, fit_top_degree_avx2<D>,
+                            fit_top_degree_baseline<D>);
+}
+
+TopDegreeKernel top_degree_kernel(std::optional<SimdIsa> isa, int degree) {
   switch (degree) {
     case 4:
-      return solve_heights<4>(points, terms, jet);
+      return top_degree_kernel<4>(isa);
     case 3:
-      return solve_heights<3>(points, terms, jet);
+      return top_degree_kernel<3>(isa);
     case 2:
-      return solve_heights<2>(points, terms, jet);
+      return top_degree_kernel<2>(isa);
     default:
-      return solve_heights<1>(points, terms, jet);
+      return top_degree_kernel<1>(isa);
+  }
+}
+
+/// The kernel's lane count: 1 without lanes.
+int batch_width(std::optional<SimdIsa> isa) {
+  if (!isa) return 1;
+  switch (detail::simd_isa(*isa)) {
+    case SimdIsa::avx512:
+      return static_cast<int>(sizeof(detail::Lanes8) / sizeof(double));
+    case SimdIsa::avx2:
+      return static_cast<int>(sizeof(detail::Lanes4) / sizeof(double));
+    default:
+      return static_cast<int>(sizeof(detail::Lanes2) / sizeof(double));
+  }
+}
+
+/// The jet's residual from the squared residuals of its fit of m coefficients to n points.
+double residual_of(double ssr, int n, int m, double scale) {
+  return n > m ? std::sqrt(ssr / (n - m)) * scale : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// One vertex's scratch in a batch.
+struct LaneScratch {
+  std::vector<int> ring;  ///< v and the vertices within `rings` edges, sorted
+  std::vector<Point> points;
+  Eigen::Vector3d n;   ///< the normal of the next fit's frame
+  bool alive = false;  ///< every fit so far succeeded
+};
+
+/// A thread's scratch, reused across its batches: no allocation per vertex once warm.
+struct JetScratch {
+  std::vector<std::uint64_t> in_ring;  ///< gather_ring's marks
+  LaneScratch lanes[kMaxLanes];
+  std::vector<double> terms;
+  JetBatch batch;
+  std::vector<double> scalar_terms;  ///< the scalar path's, for a lane that failed degree D
+  JetBatch scalar;
+};
+
+/// The fit of the highest degree < D that succeeds, one lane alone, where degree D failed in
+/// its batch: the scalar path (moments and degree D again, the same bits, then lower degrees).
+template <int D>
+bool fit_lower_degrees(const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+  JetBatch& b = s.scalar;
+  const auto n = static_cast<int>(points.size());
+  b.points[0] = points.data();
+  b.count[0] = b.points_max = n;
+  s.scalar_terms.resize(static_cast<std::size_t>(n) * terms_stride(D));
+  b.terms = s.scalar_terms.data();
+  fit_top_degree<double, D>(b);
+  const auto try_degree = [&](auto degree) {
+    constexpr int d = decltype(degree)::value;
+    double ssr = 0.0;
+    if (!solve_degree<double, d, D>(b, jet.c, ssr)) return false;
+    jet.degree = d;
+    jet.points = n;
+    jet.residual = residual_of(ssr, n, coefficient_count(d), jet.scale);
+    return true;
+  };
+  if constexpr (D > 3) {
+    if (try_degree(std::integral_constant<int, 3>{})) return true;
+  }
+  if constexpr (D > 2) {
+    if (try_degree(std::integral_constant<int, 2>{})) return true;
+  }
+  if constexpr (D > 1) return try_degree(std::integral_constant<int, 1>{});
+  return false;
+}
+
+bool fit_lower_degrees(int degree, const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+  switch (degree) {
+    case 4:
+      return fit_lower_degrees<4>(points, s, jet);
+    case 3:
+      return fit_lower_degrees<3>(points, s, jet);
+    case 2:
+      return fit_lower_degrees<2>(points, s, jet);
+    default:
+      return fit_lower_degrees<1>(points, s, jet);
   }
 }
 
@@ -362,19 +518,76 @@ Eigen::Vector3d jet_normal(const LocalJet& jet) {
   return (eigen_of(f.n) - jet.c[1] * eigen_of(f.x) - jet.c[2] * eigen_of(f.y)).normalized();
 }
 
-/// Fits `iterations` jets at vertex i starting from the unit normal n0.
-LocalJet fit_vertex(PositionsRef V, const Neighbourhoods& one, int i, Eigen::Vector3d n,
-                    const JetOptions& o, JetScratch& s) {
-  gather_ring(one, i, o.rings, s);
-  LocalJet jet;
-  for (int it = 0; it < o.iterations; ++it) {
-    jet = LocalJet{};
-    jet.frame = kernels::frame_of(kernels::vec3_of(n));
-    jet.scale = gather_points(V, i, jet.frame, s);
-    if (!(jet.scale > 0.0) || !solve_heights(o.degree, s.points, s.terms, jet)) return LocalJet{};
-    n = jet_normal(jet);
+/// The jets' inputs: the mesh, the starting normals (unit or non-finite rows: no jet), the
+/// options and the kernel of their degree.
+struct JetInput {
+  const PositionsRef& V;
+  const Neighbourhoods& one;
+  const NormalsRef& start;
+  const JetOptions& o;
+  TopDegreeKernel kernel;
+  int width;  ///< the kernel's lanes
+};
+
+/// Each lane's degree-D fit from the kernel where it succeeded, the scalar path's lower degrees
+/// where not; a lane with no fit is no longer alive.
+void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
+  JetBatch& b = s.batch;
+  b.points_max = 0;
+  for (int l = 0; l < in.width; ++l) {
+    const LaneScratch& lane = s.lanes[l];
+    b.points[l] = lane.points.data();
+    b.count[l] = lane.alive ? static_cast<int>(lane.points.size()) : 0;
+    b.points_max = std::max(b.points_max, b.count[l]);
   }
-  return jet;
+  const int D = in.o.degree, m = coefficient_count(D);
+  s.terms.resize(static_cast<std::size_t>(b.points_max) * terms_stride(D) * in.width);
+  b.terms = s.terms.data();
+  in.kernel(b);
+  for (int l = 0; l < in.width; ++l) {
+    LaneScratch& lane = s.lanes[l];
+    if (!lane.alive) continue;
+    LocalJet& jet = jets[l];
+    if (!b.solved[l]) {
+      lane.alive = fit_lower_degrees(D, lane.points, s, jet);
+      continue;
+    }
+    for (int k = 0; k < m; ++k) jet.c[k] = b.c[k * in.width + l];
+    jet.degree = D;
+    jet.points = b.count[l];
+    jet.residual = residual_of(b.ssr[l], b.count[l], m, jet.scale);
+  }
+}
+
+/// Fits `iterations` jets at each of the `count` vertices v[l] (count <= in.width) side by side,
+/// starting from their rows of in.start; jets[l] receives the last (degree 0: none).
+void fit_batch(const JetInput& in, const int* v, int count, JetScratch& s, LocalJet* jets) {
+  for (int l = 0; l < in.width; ++l) {
+    LaneScratch& lane = s.lanes[l];
+    jets[l] = LocalJet{};
+    lane.alive = l < count;
+    if (!lane.alive) continue;
+    lane.n = in.start.row(v[l]).transpose();
+    lane.alive = lane.n.allFinite();
+    if (lane.alive) gather_ring(in.one, v[l], in.o.rings, s.in_ring, lane.ring);
+  }
+  for (int it = 0; it < in.o.iterations; ++it) {
+    for (int l = 0; l < in.width; ++l) {
+      LaneScratch& lane = s.lanes[l];
+      if (!lane.alive) continue;
+      jets[l] = LocalJet{};
+      jets[l].frame = kernels::frame_of(kernels::vec3_of(lane.n));
+      jets[l].scale = gather_points(in.V, v[l], jets[l].frame, lane.ring, lane.points);
+      lane.alive = jets[l].scale > 0.0;
+    }
+    fit_heights(in, s, jets);
+    for (int l = 0; l < in.width; ++l) {
+      if (s.lanes[l].alive) s.lanes[l].n = jet_normal(jets[l]);
+    }
+  }
+  for (int l = 0; l < in.width; ++l) {
+    if (!s.lanes[l].alive) jets[l] = LocalJet{};
+  }
 }
 
 void validate_options(const JetOptions& o) {
@@ -416,40 +629,56 @@ void validate_start(PositionsRef V, NormalsRef start) {
   }
 }
 
-/// Runs body(i, jet) for every vertex with its final jet (degree 0 where there is none), the
-/// first fit in the frame of `start` (validated unit rows; non-finite rows: no jet).
+/// Runs body(k, jet) with the final jet (degree 0 where there is none) of vertex k, or of
+/// vertex (*vertices)[k] when a list is given, the first fit in the frame of `start` (unit rows;
+/// non-finite rows: no jet), in batches of the lane kernel of `isa` (none: one at a time). Every
+/// lane is computed alone, so neither the batches nor the thread count change a bit.
 template <class Body>
 void for_each_jet(PositionsRef V, const Neighbourhoods& one, NormalsRef start, const JetOptions& o,
-                  Body&& body) {
+                  const std::vector<int>* vertices, std::optional<SimdIsa> isa, Body&& body) {
   if (one.vertex_count() != V.rows())
     throw InvalidInput("jet_normals: the 1-ring has " + std::to_string(one.vertex_count()) +
                        " vertices, the mesh " + std::to_string(V.rows()));
+  const JetInput in{V, one, start, o, top_degree_kernel(isa, o.degree), batch_width(isa)};
+  const std::int64_t n = vertices ? static_cast<std::int64_t>(vertices->size()) : V.rows();
   detail::PerThread<JetScratch> scratch(o.threads);
-  detail::parallel_for_blocks(V.rows(), 256, o.threads, [&](std::int64_t begin, std::int64_t end) {
-    JetScratch& s = scratch.local();
-    for (auto i = begin; i < end; ++i) {
-      const Eigen::Vector3d n0 = start.row(i).transpose();
-      const int v = static_cast<int>(i);
-      body(v, n0.allFinite() ? fit_vertex(V, one, v, n0, o, s) : LocalJet{});
-    }
-  });
+  detail::parallel_for_blocks(
+      n, vertices ? 64 : 256, o.threads, [&](std::int64_t begin, std::int64_t end) {
+        JetScratch& s = scratch.local();
+        int v[kMaxLanes];
+        LocalJet jets[kMaxLanes];
+        for (std::int64_t first = begin; first < end; first += in.width) {
+          const int count = static_cast<int>(std::min<std::int64_t>(in.width, end - first));
+          for (int l = 0; l < count; ++l)
+            v[l] = vertices ? (*vertices)[static_cast<std::size_t>(first + l)]
+                            : static_cast<int>(first + l);
+          fit_batch(in, v, count, s, jets);
+          for (int l = 0; l < count; ++l) body(first + l, jets[l]);
+        }
+      });
+}
+
+/// Row k of `out` from `jet`.
+void store_normal(const LocalJet& jet, Eigen::Index k, JetNormals& out) {
+  out.degree[k] = jet.degree;
+  out.residual[k] = jet.residual;
+  if (jet.degree == 0) {
+    out.N.row(k).setConstant(std::numeric_limits<double>::quiet_NaN());
+  } else {
+    out.N.row(k) = jet_normal(jet).transpose();
+  }
 }
 
 JetNormals collect_normals(PositionsRef V, const Neighbourhoods& one, NormalsRef start,
-                           const JetOptions& options) {
+                           const JetOptions& options, const std::vector<int>* vertices,
+                           std::optional<SimdIsa> isa) {
   JetNormals out;
-  out.N.resize(V.rows(), 3);
-  out.residual.resize(V.rows());
-  out.degree.resize(V.rows());
-  for_each_jet(V, one, start, options, [&out](int i, const LocalJet& jet) {
-    out.degree[i] = jet.degree;
-    out.residual[i] = jet.residual;
-    if (jet.degree == 0) {
-      out.N.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-    } else {
-      out.N.row(i) = jet_normal(jet).transpose();
-    }
-  });
+  const Eigen::Index n = vertices ? static_cast<Eigen::Index>(vertices->size()) : V.rows();
+  out.N.resize(n, 3);
+  out.residual.resize(n);
+  out.degree.resize(n);
+  for_each_jet(V, one, start, options, vertices, isa,
+               [&out](std::int64_t k, const LocalJet& jet) { store_normal(jet, k, out); });
   return out;
 }
 
@@ -486,7 +715,8 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
 JetNormals jet_normals(const PreparedMesh& mesh, const JetOptions& options) {
   validate_options(options);
   const JetOptions o = for_mesh(mesh, options);
-  return collect_normals(mesh.V(), *detail::one_ring(mesh), max_normals(mesh, o.threads), o);
+  return collect_normals(mesh.V(), *detail::one_ring(mesh), max_normals(mesh, o.threads), o,
+                         nullptr, SimdIsa::best);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const JetOptions& options) {
@@ -500,20 +730,21 @@ JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_rin
                        const JetOptions& options) {
   validate(V, F, options);
   return collect_normals(V, one_ring, vertex_normals(V, F, NormalWeighting::max, options.threads),
-                         options);
+                         options, nullptr, SimdIsa::best);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring, NormalsRef start,
                        const JetOptions& options) {
   validate(V, F, options);
   validate_start(V, start);
-  return collect_normals(V, one_ring, start, options);
+  return collect_normals(V, one_ring, start, options, nullptr, SimdIsa::best);
 }
 
 JetNormals detail::jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring,
-                                    NormalsRef start, const JetOptions& options) {
+                                    NormalsRef start, const JetOptions& options,
+                                    std::optional<SimdIsa> isa) {
   validate_options(options);
-  return collect_normals(V, one_ring, start, options);
+  return collect_normals(V, one_ring, start, options, nullptr, isa);
 }
 
 Eigen::VectorXd detail::jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring,
@@ -521,45 +752,16 @@ Eigen::VectorXd detail::jet_residuals_at(PositionsRef V, const Neighbourhoods& o
                                          const std::vector<int>& vertices) {
   validate_options(options);
   Eigen::VectorXd out(static_cast<Eigen::Index>(vertices.size()));
-  detail::PerThread<JetScratch> scratch(options.threads);
-  detail::parallel_for_blocks(
-      out.size(), 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
-        JetScratch& s = scratch.local();
-        for (auto k = begin; k < end; ++k) {
-          const int v = vertices[static_cast<std::size_t>(k)];
-          const Eigen::Vector3d n0 = start.row(v).transpose();
-          out[k] = n0.allFinite() ? fit_vertex(V, one_ring, v, n0, options, s).residual
-                                  : std::numeric_limits<double>::quiet_NaN();
-        }
-      });
+  for_each_jet(V, one_ring, start, options, &vertices, SimdIsa::best,
+               [&out](std::int64_t k, const LocalJet& jet) { out[k] = jet.residual; });
   return out;
 }
 
 JetNormals detail::jet_normals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
-                                  const JetOptions& options, const std::vector<int>& vertices) {
+                                  const JetOptions& options, const std::vector<int>& vertices,
+                                  std::optional<SimdIsa> isa) {
   validate_options(options);
-  JetNormals out;
-  const auto n = static_cast<Eigen::Index>(vertices.size());
-  out.N.resize(n, 3);
-  out.residual.resize(n);
-  out.degree.resize(n);
-  detail::PerThread<JetScratch> scratch(options.threads);
-  detail::parallel_for_blocks(n, 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
-    JetScratch& s = scratch.local();
-    for (auto k = begin; k < end; ++k) {
-      const int v = vertices[static_cast<std::size_t>(k)];
-      const Eigen::Vector3d n0 = start.row(v).transpose();
-      const LocalJet jet = n0.allFinite() ? fit_vertex(V, one_ring, v, n0, options, s) : LocalJet{};
-      out.degree[k] = jet.degree;
-      out.residual[k] = jet.residual;
-      if (jet.degree == 0) {
-        out.N.row(k).setConstant(std::numeric_limits<double>::quiet_NaN());
-      } else {
-        out.N.row(k) = jet_normal(jet).transpose();
-      }
-    }
-  });
-  return out;
+  return collect_normals(V, one_ring, start, options, &vertices, isa);
 }
 
 CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& options) {
@@ -571,7 +773,7 @@ CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& option
   const double zero = default_zero_tolerance / mesh.mean_edge_length();
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RowMatrixX3d start = max_normals(mesh, o.threads);
-  for_each_jet(V, *one, start, o, [&](int i, const LocalJet& jet) {
+  for_each_jet(V, *one, start, o, nullptr, SimdIsa::best, [&](std::int64_t i, const LocalJet& jet) {
     if (jet.degree < 2) {
       r.rays_used[i] = r.rays_excluded[i] = 0;
       return detail::store_undefined(r, i);

@@ -1,8 +1,10 @@
 #pragma once
 // Internal: the jets of jets.cpp with their inputs at hand, for the recommended estimator.
 
+#include <optional>
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/jets.h"
@@ -11,10 +13,12 @@ namespace focal::detail {
 
 /// jet_normals of the mesh whose positions are V and 1-ring `one_ring`, the first fit of each
 /// vertex in the frame of `start`, whose rows must be unit or non-finite (not checked: Max's
-/// normals are, by construction). options.threads is used as given.
+/// normals are, by construction). options.threads is used as given. The fits run side by side
+/// in the lanes of `isa`'s kernel (the same bits for every instruction set); std::nullopt: one
+/// vertex at a time, the reference the lanes are tested against.
 /// \throw InvalidInput when an option is out of range or one_ring does not have #V vertices.
 JetNormals jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
-                            const JetOptions& options);
+                            const JetOptions& options, std::optional<SimdIsa> isa = SimdIsa::best);
 
 /// The residuals (JetNormals::residual) of the jets of the listed vertices only, as
 /// jet_normals_from computes them: for measurements on a sample of the vertices.
@@ -23,6 +27,7 @@ Eigen::VectorXd jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring,
 
 /// jet_normals_from at the listed vertices only (row k: vertex vertices[k]; the same bits).
 JetNormals jet_normals_at(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
-                          const JetOptions& options, const std::vector<int>& vertices);
+                          const JetOptions& options, const std::vector<int>& vertices,
+                          std::optional<SimdIsa> isa = SimdIsa::best);
 
 }  // namespace focal::detail
