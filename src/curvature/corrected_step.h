@@ -54,7 +54,8 @@ void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods&
 
 /// The rows prefer_corrected_measures would write: the measures, and per vertex whether they
 /// replace the row of `fit` (known before `fit`'s rows from the per-triangle pass are, which
-/// then need computing only where this is 0: `fit` is read for its residual only).
+/// then need computing only where this is 0: `fit` is read for its residual only). `values` is
+/// empty (0 rows) when no row replaces for want of a ball (every stencil symmetric).
 struct CorrectedRows {
   CurvatureResult values;
   std::vector<char> replace;

@@ -728,15 +728,19 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
   if (out.plan.rings == 1) {
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
-    // judge the fit's residual (whether it is exact), before either writes a row.
-    std::optional<detail::CorrectedRows> measures;
-    if (out.file_normals_used) measures = corrected(c, fitted, out.crease, out.curvature);
+    // judge the fit's residual (whether it is exact) of rows the other does not write, so the
+    // measures are written (and their whole-mesh result freed) before the pass runs.
+    std::vector<char> replaced;
+    if (out.file_normals_used) {
+      detail::CorrectedRows measures = corrected(c, fitted, out.crease, out.curvature);
+      detail::apply_corrected_rows(measures, c.threads, out.curvature);
+      replaced = std::move(measures.replace);
+    }
     // Memory the per-triangle pass can use (the peak of a run is in it).
     c.one_ring.reset();
     c.max.resize(0, 3);
-    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{}, out.curvature);
-    if (measures) detail::apply_corrected_rows(*measures, c.threads, out.curvature);
-    measures.reset();
+    prefer_triangles(c, fitted, replaced, out.curvature);
+    replaced = {};
     refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
