@@ -51,7 +51,7 @@ struct Context {
   int threads;
   double edge_length;
   mutable std::shared_ptr<const Neighbourhoods> one_ring;  ///< dropped and rebuilt on demand
-  RowMatrixX3d max;
+  RowMatrixX3d max;                                        ///< freed once the normals are chosen
 };
 
 Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options) {
@@ -722,6 +722,8 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
       return estimate(repaired, o, false);
     }
   }
+  // Max's normals served the choice of normals only: their memory is the later steps'.
+  c.max.resize(0, 3);
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
@@ -736,9 +738,8 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
       detail::apply_corrected_rows(measures, c.threads, out.curvature);
       replaced = std::move(measures.replace);
     }
-    // Memory the per-triangle pass can use (the peak of a run is in it).
+    // The 1-ring's memory is the per-triangle pass's (later steps rebuild it if they need it).
     c.one_ring.reset();
-    c.max.resize(0, 3);
     prefer_triangles(c, fitted, replaced, out.curvature);
     replaced = {};
     refit_beside_creases(c, fitted, out.crease, out.curvature);
