@@ -623,7 +623,10 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
 /// Spikes on trusted file normals (spike_repair.h): the positions with each spike moved back
 /// onto the surface its neighbours and the normals describe, or nothing when there is none.
 std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
-  const RowMatrixX3d& N = detail::unit_normals(c.mesh).N;
+  // Unit rows of its own, not the mesh's kept ones: nothing after this step reads them, and kept
+  // they would stay alive through the fit and the per-triangle pass (24 B a vertex).
+  std::vector<char> ok;
+  const RowMatrixX3d N = detail::unit_rows(*c.mesh.normals(), ok, c.threads);
   const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
   const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
   if (spikes.empty()) return std::nullopt;
