@@ -65,10 +65,18 @@ Eigen::VectorXd stencil_asymmetry(PositionsRef V, const RowMatrixX3d& N,
 CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
                              const CurvatureOptions& options, const std::vector<char>& keep,
                              double exact_residual, const CurvatureResult& fit) {
+  return corrected_rows(
+      fitted, one_ring, options, keep, exact_residual, fit,
+      stencil_asymmetry(fitted.V(), unit_normals(fitted).N, one_ring, options.threads));
+}
+
+CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                             const CurvatureOptions& options, const std::vector<char>& keep,
+                             double exact_residual, const CurvatureResult& fit,
+                             Eigen::VectorXd asymmetry) {
   const UnitNormals& unit = unit_normals(fitted);
-  const Eigen::VectorXd asymmetry =
-      stencil_asymmetry(fitted.V(), unit.N, one_ring, options.threads);
-  Eigen::VectorXd radius(fitted.vertex_count());
+  // Each vertex's radius from its own asymmetry: written in place, no second array.
+  Eigen::VectorXd& radius = asymmetry;
   parallel_for(fitted.vertex_count(), options.threads, [&](std::int64_t i) {
     const bool replaceable = !(fit.residual[i] <= exact_residual) &&
                              (keep.empty() || !keep[static_cast<std::size_t>(i)]);

@@ -64,6 +64,14 @@ CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& o
                              const CurvatureOptions& options, const std::vector<char>& keep,
                              double exact_residual, const CurvatureResult& fit);
 
+/// corrected_rows with `asymmetry` = stencil_asymmetry of `fitted`'s unit normals given: the
+/// recommended estimator computes it before the fit, whose whole-mesh result would otherwise be
+/// alive beside the asymmetry's two arrays (the peak of its run). Its memory becomes the radii.
+CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                             const CurvatureOptions& options, const std::vector<char>& keep,
+                             double exact_residual, const CurvatureResult& fit,
+                             Eigen::VectorXd asymmetry);
+
 /// Writes the rows of `rows` that replace into `fit`.
 void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResult& fit);
 

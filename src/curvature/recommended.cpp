@@ -545,8 +545,10 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
 /// Trusted file normals on clean positions: the corrected curvature measures
 /// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
 /// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
+/// `asymmetry`: detail::stencil_asymmetry of the fitted normals.
 detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
-                                const VectorXu8& crease, const CurvatureResult& fit) {
+                                const VectorXu8& crease, Eigen::VectorXd asymmetry,
+                                const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
   if (!keep.empty()) {
@@ -559,8 +561,8 @@ detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
   for (int v = 0; v < c.mesh.vertex_count(); ++v) {
     if (incidence->size(v) < 2) keep[static_cast<std::size_t>(v)] = 1;
   }
-  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual,
-                                fit);
+  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual, fit,
+                                std::move(asymmetry));
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -731,13 +733,21 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
+    // The corrected step's stencil asymmetry before the fit: its two arrays are then not alive
+    // beside the fit's result (the peak of a run at 1M).
+    Eigen::VectorXd asymmetry;
+    if (out.file_normals_used) {
+      asymmetry = detail::stencil_asymmetry(fitted.V(), detail::unit_normals(fitted).N, *c.one_ring,
+                                            c.threads);
+    }
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
     // judge the fit's residual (whether it is exact) of rows the other does not write, so the
     // measures are written (and their whole-mesh result freed) before the pass runs.
     std::vector<char> replaced;
     if (out.file_normals_used) {
-      detail::CorrectedRows measures = corrected(c, fitted, out.crease, out.curvature);
+      detail::CorrectedRows measures =
+          corrected(c, fitted, out.crease, std::move(asymmetry), out.curvature);
       detail::apply_corrected_rows(measures, c.threads, out.curvature);
       replaced = std::move(measures.replace);
     }
