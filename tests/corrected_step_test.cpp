@@ -1,14 +1,16 @@
 // The recommended estimator's corrected step (src/curvature/corrected_step.h): the stencil
 // asymmetry that picks the ball, the step's values on analytic truth (exact on the sphere,
 // second order on the torus) and what it gains over the per-triangle pass it replaces.
+#include "curvature/corrected_step.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "core/fields_detail.h"
-#include "curvature/corrected_step.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/recommended.h"
 #include "focal/evaluation/evaluation.h"
@@ -39,8 +41,8 @@ double rel_h(const AnalyticSurface& s, const CurvatureResult& r) {
 TEST(CorrectedStep, StencilAsymmetrySeparatesGridsFromRandomSamplings) {
   // A flat regular grid: every edge has its opposite twin.
   const Mesh grid = flat_grid(12, 0.1);
-  const RowMatrixX3d up = RowMatrixX3d::Zero(grid.V.rows(), 3).rowwise() +
-                          Eigen::RowVector3d(0.0, 0.0, 1.0);
+  const RowMatrixX3d up =
+      RowMatrixX3d::Zero(grid.V.rows(), 3).rowwise() + Eigen::RowVector3d(0.0, 0.0, 1.0);
   const Eigen::VectorXd flat = asymmetry_of(grid, up);
   for (int i : interior_vertices(grid, 2)) EXPECT_LT(flat[i], 1e-12) << i;
   // Regular and random samplings of the same torus, exact normals.
@@ -55,6 +57,28 @@ TEST(CorrectedStep, StencilAsymmetrySeparatesGridsFromRandomSamplings) {
     // takes the other ball, a small change, see corrected_step.h).
     EXPECT_LT(a.maxCoeff(), detail::kSymmetricStencil);
     EXPECT_GT(b.minCoeff(), detail::kSymmetricStencil);
+  }
+}
+
+// A regular grid has no ball anywhere: the step computes no measures (0 rows, none of their
+// whole-mesh memory) and replaces no row; a random sampling of the same torus replaces rows.
+TEST(CorrectedStep, NoMeasuresWithoutABall) {
+  for (Triangulation t : {Triangulation::regular, Triangulation::irregular}) {
+    const AnalyticSurface s = surface(SurfaceKind::torus, t, 4000);
+    const PreparedMesh mesh(s.mesh.V, s.mesh.F, s.mesh.N);
+    CurvatureResult fit = detail::undefined_result(s.mesh.V.rows());
+    fit.residual.setConstant(1.0);  // no row exact
+    const detail::CorrectedRows rows =
+        detail::corrected_rows(mesh, mesh.one_ring(), CurvatureOptions{}, {}, 1e-9, fit);
+    ASSERT_EQ(rows.replace.size(), static_cast<std::size_t>(s.mesh.V.rows()));
+    const auto replaced = std::count(rows.replace.begin(), rows.replace.end(), 1);
+    if (t == Triangulation::regular) {
+      EXPECT_EQ(rows.values.H.size(), 0);
+      EXPECT_EQ(replaced, 0);
+    } else {
+      EXPECT_EQ(rows.values.H.size(), s.mesh.V.rows());
+      EXPECT_GT(replaced, s.mesh.V.rows() / 2);
+    }
   }
 }
 

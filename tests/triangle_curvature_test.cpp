@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <random>
+#include <utility>
 #include <vector>
 
 #include "focal/core/error.h"
@@ -170,6 +173,47 @@ TEST(TriangleCurvature, FieldSelectionFillsOnlyTheAskedFieldsWithTheSameValues) 
   }
   const auto undefined = static_cast<std::uint8_t>(PointClass::undefined);
   EXPECT_GT((all.point_class.array() == undefined).count(), 0);  // the faces at vertex 0
+}
+
+// The vertex average solves the faces of one block of vertices at a time (a face at most once
+// per block, its row the same bits in any block): on a mesh of three blocks whose vertices are
+// shuffled (so most faces are solved in two or three blocks) every row has the same bits as the
+// row of the same vertex in the original order, a vertex without a normal included.
+TEST(TriangleCurvature, VertexAverageDoesNotDependOnTheVertexOrder) {
+  const AnalyticSurface s = surface(SurfaceKind::torus, Triangulation::regular, 140000);
+  Mesh m = s.mesh;
+  m.N.row(5).setZero();
+  const auto n = static_cast<int>(m.V.rows());
+  ASSERT_GT(n, 2 * 65536);
+  std::vector<int> to(static_cast<std::size_t>(n));
+  std::iota(to.begin(), to.end(), 0);
+  std::shuffle(to.begin(), to.end(), std::mt19937(3));
+  Mesh p = m;
+  for (int i = 0; i < n; ++i) {
+    p.V.row(to[static_cast<std::size_t>(i)]) = m.V.row(i);
+    p.N.row(to[static_cast<std::size_t>(i)]) = m.N.row(i);
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) p.F(f, c) = to[static_cast<std::size_t>(m.F(f, c))];
+  }
+  CurvatureOptions o;
+  o.method = Method::triangle;
+  const CurvatureResult a = estimate_curvature(m.V, m.F, m.N, o);
+  const CurvatureResult b = estimate_curvature(p.V, p.F, p.N, o);
+  const auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  int differing = 0;
+  for (int i = 0; i < n; ++i) {
+    const int j = to[static_cast<std::size_t>(i)];
+    bool equal = a.point_class[i] == b.point_class[j] && a.rays_used[i] == b.rays_used[j];
+    for (const auto& [x, y] :
+         {std::pair{&a.k1, &b.k1}, {&a.k2, &b.k2}, {&a.residual, &b.residual}}) {
+      equal = equal && same((*x)[i], (*y)[j]);
+    }
+    for (int c = 0; c < 3; ++c) equal = equal && same(a.d1(i, c), b.d1(j, c));
+    differing += equal ? 0 : 1;
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_EQ(a.class_of(5), PointClass::undefined);
 }
 
 }  // namespace

@@ -54,7 +54,8 @@ void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods&
 
 /// The rows prefer_corrected_measures would write: the measures, and per vertex whether they
 /// replace the row of `fit` (known before `fit`'s rows from the per-triangle pass are, which
-/// then need computing only where this is 0: `fit` is read for its residual only).
+/// then need computing only where this is 0: `fit` is read for its residual only). `values` is
+/// empty (0 rows) when no row replaces for want of a ball (every stencil symmetric).
 struct CorrectedRows {
   CurvatureResult values;
   std::vector<char> replace;
@@ -62,6 +63,14 @@ struct CorrectedRows {
 CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
                              const CurvatureOptions& options, const std::vector<char>& keep,
                              double exact_residual, const CurvatureResult& fit);
+
+/// corrected_rows with `asymmetry` = stencil_asymmetry of `fitted`'s unit normals given: the
+/// recommended estimator computes it before the fit, whose whole-mesh result would otherwise be
+/// alive beside the asymmetry's two arrays (the peak of its run). Its memory becomes the radii.
+CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
+                             const CurvatureOptions& options, const std::vector<char>& keep,
+                             double exact_residual, const CurvatureResult& fit,
+                             Eigen::VectorXd asymmetry);
 
 /// Writes the rows of `rows` that replace into `fit`.
 void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResult& fit);

@@ -53,7 +53,7 @@ struct Context {
   int threads;
   double edge_length;
   mutable std::shared_ptr<const Neighbourhoods> one_ring;  ///< dropped and rebuilt on demand
-  RowMatrixX3d max;
+  RowMatrixX3d max;                                        ///< freed once the normals are chosen
 };
 
 Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options) {
@@ -581,8 +581,10 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
 /// Trusted file normals on clean positions: the corrected curvature measures
 /// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
 /// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
+/// `asymmetry`: detail::stencil_asymmetry of the fitted normals.
 detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
-                                const VectorXu8& crease, const CurvatureResult& fit) {
+                                const VectorXu8& crease, Eigen::VectorXd asymmetry,
+                                const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
   if (!keep.empty()) {
@@ -595,8 +597,8 @@ detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
   for (int v = 0; v < c.mesh.vertex_count(); ++v) {
     if (incidence->size(v) < 2) keep[static_cast<std::size_t>(v)] = 1;
   }
-  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual,
-                                fit);
+  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual, fit,
+                                std::move(asymmetry));
 }
 
 /// Steps 1 to 3 of recommended.h: the plan (from the jets' residuals), whether the file's
@@ -659,7 +661,10 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
 /// Spikes on trusted file normals (spike_repair.h): the positions with each spike moved back
 /// onto the surface its neighbours and the normals describe, or nothing when there is none.
 std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
-  const RowMatrixX3d& N = detail::unit_normals(c.mesh).N;
+  // Unit rows of its own, not the mesh's kept ones: nothing after this step reads them, and kept
+  // they would stay alive through the fit and the per-triangle pass (24 B a vertex).
+  std::vector<char> ok;
+  const RowMatrixX3d N = detail::unit_rows(*c.mesh.normals(), ok, c.threads);
   const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
   const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
   if (spikes.empty()) return std::nullopt;
@@ -818,21 +823,34 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
       return estimate(repaired, o, false);
     }
   }
+  // Max's normals served the choice of normals only: their memory is the later steps'.
+  c.max.resize(0, 3);
   // The mesh with the chosen normals: the fit and the per-triangle pass share their unit rows.
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
+    // The corrected step's stencil asymmetry before the fit: its two arrays are then not alive
+    // beside the fit's result (the peak of a run at 1M).
+    Eigen::VectorXd asymmetry;
+    if (out.file_normals_used) {
+      asymmetry = detail::stencil_asymmetry(fitted.V(), detail::unit_normals(fitted).N, *c.one_ring,
+                                            c.threads);
+    }
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
-    // judge the fit's residual (whether it is exact), before either writes a row.
-    std::optional<detail::CorrectedRows> measures;
-    if (out.file_normals_used) measures = corrected(c, fitted, out.crease, out.curvature);
-    // Memory the per-triangle pass can use (the peak of a run is in it).
+    // judge the fit's residual (whether it is exact) of rows the other does not write, so the
+    // measures are written (and their whole-mesh result freed) before the pass runs.
+    std::vector<char> replaced;
+    if (out.file_normals_used) {
+      detail::CorrectedRows measures =
+          corrected(c, fitted, out.crease, std::move(asymmetry), out.curvature);
+      detail::apply_corrected_rows(measures, c.threads, out.curvature);
+      replaced = std::move(measures.replace);
+    }
+    // The 1-ring's memory is the per-triangle pass's (later steps rebuild it if they need it).
     c.one_ring.reset();
-    c.max.resize(0, 3);
-    prefer_triangles(c, fitted, measures ? measures->replace : std::vector<char>{}, out.curvature);
-    if (measures) detail::apply_corrected_rows(*measures, c.threads, out.curvature);
-    measures.reset();
+    prefer_triangles(c, fitted, replaced, out.curvature);
+    replaced = {};
     refit_beside_creases(c, fitted, out.crease, out.curvature);
   } else {
     // Noisy positions: where rays lie far off the fit (wild normals), it is repeated without.
