@@ -38,54 +38,48 @@ class DeviceScope {
   int previous_ = 0;
 };
 
-/// n elements of T in device memory, freed on scope exit.
-template <class T>
-class DeviceBuffer {
- public:
-  DeviceBuffer() = default;
-  explicit DeviceBuffer(std::size_t n) : size_(n) {
-    if (n > 0) check(cudaMalloc(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMalloc");
+/// Where an OwnedBuffer's memory lives: device memory.
+struct DeviceMemory {
+  static void* allocate(std::size_t bytes) {
+    void* p = nullptr;
+    check(cudaMalloc(&p, bytes), "cudaMalloc");
+    return p;
   }
-  DeviceBuffer(const DeviceBuffer&) = delete;
-  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  DeviceBuffer(DeviceBuffer&& o) noexcept : data_(o.data_), size_(o.size_) {
+  static void release(void* p) { cudaFree(p); }  // no throw: errors surface at the next call
+};
+
+/// Page-locked host memory (cudaMallocHost): copies from and to it run at the bus's rate and
+/// can be asynchronous, unlike pageable memory.
+struct PinnedMemory {
+  static void* allocate(std::size_t bytes) {
+    void* p = nullptr;
+    check(cudaMallocHost(&p, bytes), "cudaMallocHost");
+    return p;
+  }
+  static void release(void* p) { cudaFreeHost(p); }
+};
+
+/// n elements of T in `Memory`, freed on scope exit; movable, not copyable.
+template <class T, class Memory>
+class OwnedBuffer {
+ public:
+  OwnedBuffer() = default;
+  explicit OwnedBuffer(std::size_t n) : size_(n) {
+    if (n > 0) data_ = static_cast<T*>(Memory::allocate(n * sizeof(T)));
+  }
+  OwnedBuffer(const OwnedBuffer&) = delete;
+  OwnedBuffer& operator=(const OwnedBuffer&) = delete;
+  OwnedBuffer(OwnedBuffer&& o) noexcept : data_(o.data_), size_(o.size_) {
     o.data_ = nullptr;
     o.size_ = 0;
   }
-  DeviceBuffer& operator=(DeviceBuffer&& o) noexcept {
+  OwnedBuffer& operator=(OwnedBuffer&& o) noexcept {
     std::swap(data_, o.data_);
     std::swap(size_, o.size_);
     return *this;
   }
-  ~DeviceBuffer() {
-    if (data_ != nullptr) cudaFree(data_);  // no throw from a destructor; errors surface later
-  }
-
-  /// A buffer holding a copy of `host`.
-  static DeviceBuffer from_host(const std::vector<T>& host) {
-    DeviceBuffer b(host.size());
-    b.upload(host.data(), host.size());
-    return b;
-  }
-  void upload(const T* host, std::size_t n) {
-    check(cudaMemcpy(data_, host, n * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy to device");
-  }
-  void download(T* host, std::size_t n) const {
-    check(cudaMemcpy(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to host");
-  }
-  /// Queued on `stream`: asynchronous where `host` is pinned.
-  void upload_async(const T* host, std::size_t n, cudaStream_t stream) {
-    check(cudaMemcpyAsync(data_, host, n * sizeof(T), cudaMemcpyHostToDevice, stream),
-          "cudaMemcpyAsync to device");
-  }
-  void download_async(T* host, std::size_t n, cudaStream_t stream) const {
-    check(cudaMemcpyAsync(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost, stream),
-          "cudaMemcpyAsync to host");
-  }
-  [[nodiscard]] std::vector<T> to_host() const {
-    std::vector<T> host(size_);
-    download(host.data(), size_);
-    return host;
+  ~OwnedBuffer() {
+    if (data_ != nullptr) Memory::release(data_);
   }
 
   [[nodiscard]] T* data() const { return data_; }
@@ -96,37 +90,44 @@ class DeviceBuffer {
   std::size_t size_ = 0;
 };
 
-/// n elements of T in page-locked host memory (cudaMallocHost), freed on scope exit: copies
-/// from and to it run at the bus's rate and can be asynchronous, unlike pageable memory.
+/// n elements of T in page-locked host memory.
 template <class T>
-class PinnedBuffer {
+using PinnedBuffer = OwnedBuffer<T, PinnedMemory>;
+
+/// n elements of T in device memory, with the copies to and from the host.
+template <class T>
+class DeviceBuffer : public OwnedBuffer<T, DeviceMemory> {
  public:
-  PinnedBuffer() = default;
-  explicit PinnedBuffer(std::size_t n) : size_(n) {
-    if (n > 0)
-      check(cudaMallocHost(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMallocHost");
-  }
-  PinnedBuffer(const PinnedBuffer&) = delete;
-  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
-  PinnedBuffer(PinnedBuffer&& o) noexcept : data_(o.data_), size_(o.size_) {
-    o.data_ = nullptr;
-    o.size_ = 0;
-  }
-  PinnedBuffer& operator=(PinnedBuffer&& o) noexcept {
-    std::swap(data_, o.data_);
-    std::swap(size_, o.size_);
-    return *this;
-  }
-  ~PinnedBuffer() {
-    if (data_ != nullptr) cudaFreeHost(data_);  // no throw from a destructor
-  }
+  using OwnedBuffer<T, DeviceMemory>::OwnedBuffer;
+  using OwnedBuffer<T, DeviceMemory>::data;
+  using OwnedBuffer<T, DeviceMemory>::size;
 
-  [[nodiscard]] T* data() const { return data_; }
-  [[nodiscard]] std::size_t size() const { return size_; }
-
- private:
-  T* data_ = nullptr;
-  std::size_t size_ = 0;
+  /// A buffer holding a copy of `host`.
+  static DeviceBuffer from_host(const std::vector<T>& host) {
+    DeviceBuffer b(host.size());
+    b.upload(host.data(), host.size());
+    return b;
+  }
+  void upload(const T* host, std::size_t n) {
+    check(cudaMemcpy(data(), host, n * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy to device");
+  }
+  void download(T* host, std::size_t n) const {
+    check(cudaMemcpy(host, data(), n * sizeof(T), cudaMemcpyDeviceToHost), "cudaMemcpy to host");
+  }
+  /// Queued on `stream`: asynchronous where `host` is pinned.
+  void upload_async(const T* host, std::size_t n, cudaStream_t stream) {
+    check(cudaMemcpyAsync(data(), host, n * sizeof(T), cudaMemcpyHostToDevice, stream),
+          "cudaMemcpyAsync to device");
+  }
+  void download_async(T* host, std::size_t n, cudaStream_t stream) const {
+    check(cudaMemcpyAsync(host, data(), n * sizeof(T), cudaMemcpyDeviceToHost, stream),
+          "cudaMemcpyAsync to host");
+  }
+  [[nodiscard]] std::vector<T> to_host() const {
+    std::vector<T> host(size());
+    download(host.data(), size());
+    return host;
+  }
 };
 
 /// A CUDA stream of the current device, destroyed on scope exit.
