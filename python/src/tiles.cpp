@@ -95,6 +95,13 @@ nb::dict extract_tile(const DoubleRows& V, const IntRows& F, const std::optional
   return d;
 }
 
+/// A tile's arrays as the library's TileMesh (the normals copied, when given).
+focal::TileMesh tile_of(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N) {
+  focal::TileMesh tile{view(V), view(F), std::nullopt};
+  if (N) tile.N = focal::RowMatrixX3d(view(*N));
+  return tile;
+}
+
 /// The estimate of every vertex of a tile, with the whole mesh's choices.
 nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                        const nb::dict& options, const nb::dict& choices) {
@@ -104,8 +111,7 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
   focal::TileEstimate r;
   {
     nb::gil_scoped_release release;
-    focal::TileMesh tile{view(V), view(F), std::nullopt};
-    if (N) tile.N = focal::RowMatrixX3d(view(*N));
+    const focal::TileMesh tile = tile_of(V, F, N);
     r = focal::estimate_tile(tile, c, o, threads);
   }
   nb::dict d = curvature_dict(std::move(r.curvature));
@@ -123,8 +129,7 @@ nb::dict tile_statistics(const DoubleRows& V, const IntRows& F, const std::optio
   focal::RecommendedStatistics r;
   {
     nb::gil_scoped_release release;
-    focal::TileMesh tile{view(V), view(F), std::nullopt};
-    if (N) tile.N = focal::RowMatrixX3d(view(*N));
+    const focal::TileMesh tile = tile_of(V, F, N);
     r = focal::tile_statistics(tile, ids_from(ids), ids_from(owned), whole_vertex_count,
                                mean_edge_length, o, threads);
   }
