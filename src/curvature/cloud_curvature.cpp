@@ -211,4 +211,28 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
   return out;
 }
 
+RowMatrixX3d estimate_cloud_normals(PositionsRef V, std::optional<NormalsRef> N,
+                                    const CloudOptions& options) {
+  validate(V, N, options);
+  if (!uses_plan(options)) {
+    // Neighbourhoods as given: every point's estimate over them, on the side of its given normal.
+    CloudNormalOptions normals = normal_options(options);
+    RowMatrixX3d out = cloud_normals(V, cloud_neighbourhoods(V, options), normals);
+    if (N && !normals.viewpoint) {
+      for (Eigen::Index i = 0; i < out.rows(); ++i) {
+        if (out.row(i).dot(N->row(i)) < 0.0) out.row(i) *= -1.0;
+      }
+    }
+    return out;
+  }
+  CloudCurvature plan = adaptive_plan(V, N, options);
+  if (!plan.file_normals_used) return std::move(plan.N);  // jet normals: unit or NaN rows
+  std::vector<char> ok;
+  RowMatrixX3d out = detail::unit_rows(plan.N, ok, options.threads);
+  for (Eigen::Index i = 0; i < out.rows(); ++i) {
+    if (!ok[static_cast<std::size_t>(i)]) out.row(i).setConstant(NAN);
+  }
+  return out;
+}
+
 }  // namespace focal

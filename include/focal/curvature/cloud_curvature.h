@@ -99,6 +99,18 @@ struct CloudCurvature {
                                                       std::optional<NormalsRef> N = std::nullopt,
                                                       const CloudOptions& options = {});
 
+/// The normals estimate_cloud_curvature fits with, without the fit (`focal normals` on a cloud).
+/// With the default's plan (k, radius and adaptive_radius 0): its normals (steps 1-3 above: jet
+/// normals over the 16 nearest, or quadratic jets over 64 where the positions are noisy; N
+/// itself where it agrees with them, else the jets on N's side), unit, NaN rows for the outliers
+/// left out and for points without a normal. With k, radius or adaptive_radius: cloud_normals
+/// over those neighbourhoods (every point; no outlier test), each turned to the side of its row
+/// of N where N is given and options.normals has no viewpoint.
+/// \throw InvalidInput as estimate_cloud_curvature.
+[[nodiscard]] RowMatrixX3d estimate_cloud_normals(PositionsRef V,
+                                                  std::optional<NormalsRef> N = std::nullopt,
+                                                  const CloudOptions& options = {});
+
 /// The neighbourhoods CloudOptions select (k nearest or radius).
 /// \throw InvalidInput when k < 0, radius < 0 or threads < 0.
 [[nodiscard]] Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options);
