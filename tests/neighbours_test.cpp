@@ -202,6 +202,32 @@ TEST(Neighbours, OutlierPointsAreTheIsolatedOnes) {
   EXPECT_THROW((void)outlier_points(V.topRows(10), nearest_neighbours(V, 16), 2.0), InvalidInput);
 }
 
+// The same plane (exactly flat: the floor of the spread) with three points one spacing above
+// or below it, inside: as close to their neighbours as the plane's points are, the statistical
+// test keeps them; the off-surface test flags them and no point of the plane.
+TEST(Neighbours, OffSurfacePointsAreOffTheirNeighboursPlane) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  RowMatrixX3d V(40 * 40 + 3, 3);
+  int r = 0;
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 40; ++y) V.row(r++) << x + jitter(rng), y + jitter(rng), 0.0;
+  }
+  V.row(r++) << 10.5, 10.5, 1.0;
+  V.row(r++) << 30.5, 5.5, -1.0;
+  V.row(r++) << 20.5, 30.5, 1.0;
+  const Neighbourhoods nearest = nearest_neighbours(V, 16);
+  const std::vector<char> isolated = outlier_points(V, nearest, 2.0);
+  const std::vector<char> off = off_surface_points(V, nearest, 10.0);
+  for (int i = 0; i < 1600; ++i) ASSERT_FALSE(off[static_cast<std::size_t>(i)]) << i;
+  for (int i = 1600; i < 1603; ++i) {
+    EXPECT_FALSE(isolated[static_cast<std::size_t>(i)]) << i;
+    EXPECT_TRUE(off[static_cast<std::size_t>(i)]) << i;
+  }
+  EXPECT_THROW((void)off_surface_points(V, nearest, 1.0), InvalidInput);
+  EXPECT_THROW((void)off_surface_points(V.topRows(10), nearest, 10.0), InvalidInput);
+}
+
 TEST(Neighbours, RejectInvalidArguments) {
   const RowMatrixX3d V = random_cloud(10, 1);
   EXPECT_THROW((void)nearest_neighbours(V, 0), InvalidInput);

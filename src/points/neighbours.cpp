@@ -1,5 +1,6 @@
 #include "focal/points/neighbours.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -346,6 +347,49 @@ std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbour
     }
   });
   return outlier;
+}
+
+std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
+                                     int threads) {
+  if (!(ratio > 1.0) || !std::isfinite(ratio)) {
+    throw InvalidInput("off_surface_points: ratio must be finite and > 1, got " +
+                       std::to_string(ratio));
+  }
+  check_threads(threads);
+  const int n = neighbours.vertex_count();
+  if (n != V.rows()) throw InvalidInput("off_surface_points: the neighbourhoods are not V's");
+  std::vector<char> off(static_cast<std::size_t>(n), 0);
+  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const int p = static_cast<int>(i);
+      const int count = neighbours.size(p);
+      if (count < 3 || !V.row(p).allFinite()) continue;
+      // Offsets from the point keep the plane accurate far from the origin.
+      const Eigen::RowVector3d origin = V.row(p);
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+      double reach = 0.0;
+      for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+        const Eigen::RowVector3d q = V.row(*j) - origin;
+        sum += q;
+        moment += q.transpose() * q;
+        reach += q.norm();
+      }
+      const Eigen::RowVector3d centroid = sum / count;
+      const Eigen::Matrix3d covariance = moment / count - centroid.transpose() * centroid;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+      eig.computeDirect(covariance);
+      const Eigen::RowVector3d normal = eig.eigenvectors().col(0).transpose();
+      if (!normal.allFinite()) continue;
+      // The point is not among its neighbours, so neither their plane nor their spread about it
+      // moves with the point. A floor far below any sampling's scale: on exactly flat
+      // neighbours (spread 0) only a distance above rounding counts.
+      const double spread =
+          std::max(std::sqrt(std::max(eig.eigenvalues()[0], 0.0)), 1e-9 * reach / count);
+      off[static_cast<std::size_t>(i)] = std::abs(centroid.dot(normal)) > ratio * spread;
+    }
+  });
+  return off;
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {
