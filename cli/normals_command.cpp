@@ -36,8 +36,8 @@ void run_normals(NormalsFlags& f, const Log& log) {
     const Eigen::Index missing = (!N.array().isFinite()).rowwise().any().count();
     if (missing > 0) {
       log.warning(std::to_string(missing) + " of " + std::to_string(N.rows()) +
-                  " points have no normal (NaN): outliers left out (--outlier-ratio 0 keeps "
-                  "every point) or points without neighbours");
+                  " points have no normal (NaN): outliers left out (--outlier-ratio 0 "
+                  "--off-surface-ratio 0 keep every point) or points without neighbours");
     }
   } else {
     Estimate e = run_estimate(input, f.input, f.estimator, log);

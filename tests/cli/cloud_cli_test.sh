@@ -58,6 +58,13 @@ check "--adaptive-radius 0: exit 1 (must be positive)" bash -c '[[ $1 -eq 1 && !
 
 # Without normals (estimated, MST-oriented), and the same points as PLY and OBJ without faces.
 cut -d' ' -f1-3 sphere.xyz >bare.xyz
+# A point 0.15 (about 2 spacings) above the sphere, the statistical test off: the off-surface
+# test leaves it out (its row NaN), --off-surface-ratio 0 keeps it.
+{ cat bare.xyz; echo '0 0 1.15'; } >near.xyz
+run curvature near.xyz -o near.csv --outlier-ratio 0
+check "a point off the surface: its row undefined" grep -q '^nan,nan' <(tail -n 1 near.csv)
+run curvature near.xyz -o near-kept.csv --outlier-ratio 0 --off-surface-ratio 0
+check "--off-surface-ratio 0: the point kept" bash -c '! tail -n 1 "$1" | grep -q nan' _ near-kept.csv
 run curvature bare.xyz -o bare.csv
 # Jet normals over 16 neighbours at 2000 points: measured max |H - 1| 0.00026; bound 0.01.
 check "no normals: H = 1 within 0.01 (normals estimated and oriented outward)" \
@@ -125,6 +132,9 @@ printf '# nothing\n' >empty.xyz
 expect_error "no points" "no points" empty.csv curvature empty.xyz -o empty.csv
 expect_error "--outlier-ratio 1: what is wrong named" "outlier_ratio must be 0 (off) or finite and > 1" \
   ratio.csv curvature bare.xyz -o ratio.csv --outlier-ratio 1
+expect_error "--off-surface-ratio 1: what is wrong named" \
+  "off_surface_ratio must be 0 (off) or finite and > 1" ratio.csv curvature bare.xyz -o ratio.csv \
+  --off-surface-ratio 1
 printf '1 2\n3 4\n' >two.xyz
 expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two.csv
 printf 'k1,k2,H\n1,2,3\n' >table.csv
