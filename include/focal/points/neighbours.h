@@ -69,10 +69,14 @@ namespace focal {
 /// times the RMS distance of those neighbours to that plane (the sampling noise plus the
 /// surface's bending over the neighbourhood). The point being in neither, an outlier does not
 /// raise its own yardstick; another outlier among its neighbours raises it (the test errs
-/// towards keeping points). It catches what outlier_points does not: a point a spacing or more
-/// off the surface, as close to its neighbours as they are to theirs; not a point off the
-/// surface's edge within its tangent plane. Points with fewer than 3 neighbours are not flagged;
-/// an RMS below 1e-9 x the mean neighbour distance counts as that (exactly flat neighbourhoods).
+/// towards keeping points). A point so flagged is kept again when its distance is at most
+/// ratio / 2 times the median over its neighbours of their own distance to their neighbours'
+/// plane, the point left out of those: a regular sampling (the pole of a sphere sampled in
+/// rings has one ring as its nearest, spread ~0). It catches what outlier_points does not: a
+/// point a spacing or more off the surface, as close to its neighbours as they are to theirs;
+/// not a point off the surface's edge within its tangent plane. Points with fewer than 3
+/// neighbours are not flagged; an RMS below 1e-9 x the mean neighbour distance counts as that
+/// (exactly flat neighbourhoods).
 /// \throw InvalidInput when ratio is not finite and > 1, threads < 0, or the neighbourhoods
 /// are not V's.
 [[nodiscard]] std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
