@@ -235,6 +235,12 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
                   "times their neighbours' median (0 = keep every point; docs/POINTS.md)")
       ->default_str(std::to_string(default_outlier_ratio).substr(0, 3));
   command
+      .add_option("--off-surface-ratio", cloud.off_surface_ratio,
+                  "point clouds: leave out points farther from the plane of their 16 nearest "
+                  "than this many times those neighbours' median distance to it (0 = off; "
+                  "docs/POINTS.md)")
+      ->default_str(std::to_string(default_off_surface_ratio).substr(0, 4));
+  command
       .add_option("--viewpoint", viewpoint,
                   "point clouds without normals: orient estimated normals towards X,Y,Z (the "
                   "scanner) instead of by a minimum spanning tree")

@@ -1,17 +1,20 @@
 // `focal normals IN -o OUT`: estimated, oriented normals written with the positions (and faces).
 // Meshes: the normals focal's estimator fits (the recommended estimator's choice: file normals
 // where they agree with the positions, else jet normals; or the paper's with --paper ...).
-// Point clouds: PCA + jet normals over the k nearest neighbours, oriented by the file's normals
-// where it has them (each takes the side of the given one), else towards --viewpoint, else by a
-// minimum spanning tree (focal/normals/cloud_normals.h). The paper's future work: "use focal
-// surfaces to fix vertex normals of scanned surfaces".
+// Point clouds: the normals the cloud curvature default fits with (estimate_cloud_normals,
+// focal/curvature/cloud_curvature.h: jets over 16 neighbours, or 64 on noisy positions, the file's
+// where they agree); with --k, --radius or --adaptive-radius PCA + jet normals over those
+// neighbours, each on the side of the file's normal where it has one, else towards --viewpoint,
+// else by a minimum spanning tree (focal/normals/cloud_normals.h). The paper's future work: "use
+// focal surfaces to fix vertex normals of scanned surfaces".
 
 #include <memory>
+#include <string>
 
 #include "commands.h"
 #include "estimator_flags.h"
+#include "focal/curvature/cloud_curvature.h"
 #include "focal/io/mesh_io.h"
-#include "focal/normals/cloud_normals.h"
 #include "paths.h"
 
 namespace focal::cli {
@@ -24,26 +27,18 @@ struct NormalsFlags {
   EstimatorFlags estimator;
 };
 
-/// Estimated normals of a cloud; where the file has a normal, the estimate takes its side.
-RowMatrixX3d cloud_normals_of(const Mesh& cloud, const EstimatorFlags& flags) {
-  const CloudOptions o = flags.cloud_options();
-  CloudNormalOptions normals = o.normals;
-  normals.threads = o.threads;
-  RowMatrixX3d N = cloud_normals(cloud.V, cloud_neighbourhoods(cloud.V, o), normals);
-  if (cloud.has_normals() && !normals.viewpoint) {
-    for (Eigen::Index i = 0; i < N.rows(); ++i) {
-      if (N.row(i).dot(cloud.N.row(i)) < 0.0) N.row(i) *= -1.0;
-    }
-  }
-  return N;
-}
-
 void run_normals(NormalsFlags& f, const Log& log) {
   Input input(f.input, f.estimator, log);
   RowMatrixX3d N;
   if (input.cloud) {
     Stage stage(log, "cloud normals");
-    N = cloud_normals_of(input.mesh, f.estimator);
+    N = estimate_cloud_normals(input.mesh.V, input.mesh.normals(), f.estimator.cloud_options());
+    const Eigen::Index missing = (!N.array().isFinite()).rowwise().any().count();
+    if (missing > 0) {
+      log.warning(std::to_string(missing) + " of " + std::to_string(N.rows()) +
+                  " points have no normal (NaN): outliers left out (--outlier-ratio 0 "
+                  "--off-surface-ratio 0 keep every point) or points without neighbours");
+    }
   } else {
     Estimate e = run_estimate(input, f.input, f.estimator, log);
     N = e.N ? std::move(*e.N) : input.mesh.N;
@@ -69,10 +64,12 @@ void add_normals_command(CLI::App& app, const Log& log) {
   cmd->add_flag("--force", f->force, "replace a read-only output file");
   cmd->footer(
       "Examples:\n"
-      "  focal normals scan.xyz -o scan-normals.ply              # PCA + jet, MST-oriented\n"
+      "  focal normals scan.xyz -o scan-normals.ply              # those `curvature` uses\n"
       "  focal normals scan.xyz -o out.xyz --viewpoint 0,0,10 --k 24\n"
       "  focal normals bunny.off -o bunny-normals.ply            # what the estimator fits\n"
-      "Clouds with normals keep each normal's side; meshes get the recommended estimator's\n"
+      "Clouds get the normals of the curvature default (jets over 16 neighbours, 64 on noisy\n"
+      "positions; the file's where they agree with them); with --k/--radius PCA + jets over\n"
+      "those, on the side of the file's normals. Meshes get the recommended estimator's\n"
       "normals (docs/POINTS.md, docs/ESTIMATOR.md).");
   cmd->parse_complete_callback([f] {
     require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz"});

@@ -629,6 +629,7 @@ def render(
     directions: Any = None,
     glyph_count: int = 2500,
     focal_meshes: Optional[FocalMeshes] = None,
+    splat_radius: float = 0.0,
     azimuth: float = 0.0,
     elevation: float = 0.0,
     orthographic: bool = False,
@@ -652,6 +653,11 @@ def render(
     range : (lo, hi) of the diverging map; None: [-P, P], P the range_percentile of |field|.
     directions : (n, 3) d1 or d2, drawn as short segments through about glyph_count vertices.
     focal_meshes : a FocalMeshes of this mesh: two more panels show Gamma_1 and Gamma_2.
+    Point clouds (F with 0 rows, e.g. ``np.zeros((0, 3), np.int32)``) are drawn as splats, as
+    ``focal render`` on a cloud: a disc per point in the plane normal to its row of N (N None, or
+    a non-finite row: the disc faces the eye), shaded as faces are.
+    splat_radius : the discs' radius in world units (``--splat-radius``); 0: 0.7 x each point's
+    mean distance to its 8 nearest. Ignored on meshes; negative or not finite: InvalidInputError.
     Camera: fitted to the mesh's bounding sphere from (azimuth, elevation) in degrees (0, 0 looks
     along -z), perspective with field_of_view degrees or orthographic; or, with eye, a look-at
     camera from eye to target (default: the mean of V) with up.
@@ -662,7 +668,10 @@ def render(
     be had (the message says what was tried), FocalIOError when the PNG cannot be written.
     """
     Va, Fa, _ = _mesh_arrays(V, F)
-    Na = _normals_for_picture(Va, Fa, N)
+    if Fa.shape[0] == 0 and N is None:
+        Na = np.full(Va.shape, np.nan)  # a cloud without normals: splats facing the eye
+    else:
+        Na = _normals_for_picture(Va, Fa, N)
     values = _vector(field, "field", Va.shape[0], np.float64)
     dirs = None if directions is None else _as_rows(directions, "directions", np.float64)
     gammas = None
@@ -686,6 +695,7 @@ def render(
         range_percentile=float(range_percentile),
         title=str(title),
         glyph_count=int(glyph_count),
+        splat_radius=float(splat_radius),
         samples=int(samples),
         threads=_threads(threads),
     )

@@ -53,6 +53,7 @@ def cloud_curvature(
     viewpoint: Optional[Sequence[float]] = None,
     solver: str = "closed-form",
     outlier_ratio: float = 3.0,
+    off_surface_ratio: float = 10.0,
     threads: Optional[int] = None,
 ) -> Curvature:
     """Principal curvatures and directions, H and K of a point cloud, by the two-slit fit of the
@@ -72,6 +73,9 @@ def cloud_curvature(
     outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
         median of the same are left out (NaN, ``undefined``); 0 keeps every point (the library
         default 3; docs/POINTS.md, "Outliers").
+    off_surface_ratio : then points farther from the plane of their 16 nearest than this many
+        times those neighbours' RMS distance to it are left out too; 0 keeps them (the library
+        default 10; docs/POINTS.md, "Near-surface outliers").
     threads : worker threads; None: FOCAL_NUM_THREADS if set, else all. Results do not depend
         on it.
 
@@ -88,7 +92,8 @@ def cloud_curvature(
         if N.shape[0] != P.shape[0]:
             raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
     d = _ext.cloud_curvature(
-        P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio), t
+        P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio),
+        float(off_surface_ratio), t
     )
     return Curvature(**d)
 

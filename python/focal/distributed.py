@@ -171,6 +171,7 @@ def cloud_curvature(
     viewpoint: Any = None,
     solver: str = "closed-form",
     outlier_ratio: float = 3.0,
+    off_surface_ratio: float = 10.0,
     threads: Optional[int] = None,
 ) -> focal.Curvature:
     """``focal.cloud_curvature`` of a point cloud, the fit tile by tile on a Dask cluster: the
@@ -196,7 +197,8 @@ def cloud_curvature(
             raise focal._shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
     o = {"k": k, "radius": r, "normal_method": normal_method,
          "viewpoint": _clouds._viewpoint(viewpoint), "solver": solver,
-         "outlier_ratio": float(outlier_ratio), "threads": t}
+         "outlier_ratio": float(outlier_ratio), "off_surface_ratio": float(off_surface_ratio),
+         "threads": t}
     plan = _ext.cloud_tile_plan(P, N, o, int(tile_vertices))
     Np, outlier = plan["N"], plan["outlier"]
 

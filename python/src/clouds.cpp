@@ -62,10 +62,12 @@ focal::CloudOptions cloud_options(int k, double radius, double adaptive_radius,
 nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N, int k,
                          double radius, double adaptive_radius, const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint,
-                         const std::string& solver, double outlier_ratio, int threads) {
+                         const std::string& solver, double outlier_ratio, double off_surface_ratio,
+                         int threads) {
   focal::CloudOptions o =
       cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver, threads);
   o.outlier_ratio = outlier_ratio;
+  o.off_surface_ratio = off_surface_ratio;
   focal::CloudCurvature c;
   {
     nb::gil_scoped_release release;
@@ -105,6 +107,7 @@ focal::CloudOptions cloud_options_of(const nb::dict& d) {
                     nb::cast<std::string>(d["normal_method"]), viewpoint,
                     nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
+  o.off_surface_ratio = nb::cast<double>(d["off_surface_ratio"]);
   focal::require_tileable(o);
   return o;
 }
@@ -191,7 +194,7 @@ nb::dict estimate_cloud_tile(const DoubleRows& V, const DoubleRows& N,
 void bind_clouds(nb::module_& m) {
   m.def("cloud_curvature", &cloud_curvature, "V"_a.noconvert(), "N"_a.none().noconvert(), "k"_a,
         "radius"_a, "adaptive_radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a,
-        "outlier_ratio"_a, "threads"_a);
+        "outlier_ratio"_a, "off_surface_ratio"_a, "threads"_a);
   m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "adaptive_radius"_a,
         "normal_method"_a, "viewpoint"_a.none(), "threads"_a);
   m.def("cloud_tile_plan", &cloud_tile_plan, "V"_a.noconvert(), "N"_a.none().noconvert(),

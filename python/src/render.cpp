@@ -5,7 +5,9 @@
 #include "focal/render/render.h"
 
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 
 #include "bindings.h"
 #include "focal/core/fields.h"
@@ -73,6 +75,7 @@ nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& 
   p.range_percentile = nb::cast<double>(o["range_percentile"]);
   p.title = nb::cast<std::string>(o["title"]);
   p.glyph_count = nb::cast<int>(o["glyph_count"]);
+  p.splat_radius = nb::cast<double>(o["splat_radius"]);
   p.samples = nb::cast<int>(o["samples"]);
   p.threads = nb::cast<int>(o["threads"]);
   if (directions) p.directions = view(*directions);
@@ -85,10 +88,11 @@ nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& 
   }
   const Eigen::Map<const Eigen::VectorXd> values(field.data(),
                                                  static_cast<Eigen::Index>(field.shape(0)));
+  // The camera reads the keywords (Python objects): with the GIL held.
+  p.camera = camera(view(V), o);
   focal::Image image;
   {
     nb::gil_scoped_release release;
-    p.camera = camera(view(V), o);
     image = focal::render_field_picture(view(V), view(F), view(N), values, p);
     if (path) focal::write_png(*path, image);
   }
@@ -100,10 +104,9 @@ nb::dict rasterise_gbuffer(const DoubleRows& V, const IntRows& F, const DoubleRo
   const int width = nb::cast<int>(o["width"]);
   const int height = nb::cast<int>(o["height"]);
   focal::GBuffer g;
-  focal::Camera cam;
+  const focal::Camera cam = camera(view(V), o);  // reads the keywords: with the GIL held
   {
     nb::gil_scoped_release release;
-    cam = camera(view(V), o);
     g = focal::rasterise_gbuffer(view(V), view(F), view(N), cam, width, height);
   }
   nb::dict d;

@@ -68,10 +68,24 @@ def test_outliers_are_left_out():
     c = focal.cloud_curvature(np.vstack([P, far]), np.vstack([N, [[0, 0, 1], [1, 0, 0]]]))
     assert c.undefined[-2:].all() and np.isnan(c.H[-2:]).all()
     np.testing.assert_allclose(c.H[:-2], 0.5, atol=1e-12)  # exact normals: exact, as without
-    kept = focal.cloud_curvature(np.vstack([P, far]), outlier_ratio=0)
+    kept = focal.cloud_curvature(np.vstack([P, far]), outlier_ratio=0, off_surface_ratio=0)
     assert not np.isnan(kept.H[-2:]).any()
     with pytest.raises(focal.InvalidInputError, match="outlier_ratio"):
         focal.cloud_curvature(P, outlier_ratio=0.5)
+    with pytest.raises(focal.InvalidInputError, match="off_surface_ratio"):
+        focal.cloud_curvature(P, off_surface_ratio=0.5)
+
+
+def test_near_surface_outliers_are_left_out():
+    """Points 2 and 2.5 mean spacings (0.079) off a sphere, the statistical test off: the
+    off-surface test leaves them out and no point of the sphere (docs/POINTS.md, "Near-surface
+    outliers")."""
+    P, N = sphere_points(n=2000, seed=5)
+    near = np.array([[0.0, 0.0, 2.2], [0.0, 0.0, -1.8], [2.16, 0.0, 0.0]])
+    c = focal.cloud_curvature(np.vstack([P, near]), outlier_ratio=0)
+    assert np.isnan(c.H[-3:]).all() and not np.isnan(c.H[:-3]).any()
+    kept = focal.cloud_curvature(np.vstack([P, near]), outlier_ratio=0, off_surface_ratio=0)
+    assert not np.isnan(kept.H[-3:]).any()
 
 
 def test_read_mesh_of_a_cloud_has_no_faces(tmp_path):

@@ -171,6 +171,49 @@ def test_render_classes_and_focal_mesh_panels():
     assert wide.shape == (160, 480, 3)
 
 
+def fibonacci_sphere(n):
+    i = np.arange(n) + 0.5
+    phi = np.arccos(1 - 2 * i / n)
+    theta = np.pi * (1 + 5**0.5) * i
+    return np.stack([np.cos(theta) * np.sin(phi), np.sin(theta) * np.sin(phi), np.cos(phi)], 1)
+
+
+def test_render_cloud_splat_radius():
+    # A unit sphere of 2000 points (spacing about 0.08) as a cloud, splats facing the eye (N
+    # None), seen along -z by an orthographic camera of half extent 2 on 300 pixels: 75 pixels
+    # per unit. The discs at the rim widen the silhouette to 2 (1 + c r) units, c in [0.92, 1]
+    # (an octagon: cos 22.5 deg to 1), so radius 0.3 against 0.1 adds 2 x 0.2 x 75 c = 27.7 to 30
+    # pixels (measured 30; asserted 26 to 32 for the rasterisation's pixel at each end). Discs
+    # of 0.005 leave most of the disc white; the default (0.7 x the mean distance to the 8
+    # nearest) leaves no hole (measured 15090 of 15394 pixels and 0).
+    V = fibonacci_sphere(2000)
+    F = np.zeros((0, 3), np.int32)
+    yy, xx = np.mgrid[0:300, 0:400]
+
+    def picture(**kw):
+        img = focal.render(V, F, np.ones(len(V)), width=400, height=300, orthographic=True,
+                           eye=(0, 0, 5), target=(0, 0, 0), half_extent=2.0, range=(-2, 2),
+                           samples=1, **kw)
+        covered = (img != 255).any(2)
+        row = covered[150]
+        left = int(np.argmax(row))
+        right = left + int(np.argmin(row[left:])) - 1
+        inside = np.hypot(xx + 0.5 - (left + right + 1) / 2, yy + 0.5 - 150) < 70
+        return right - left + 1, int((~covered[inside]).sum()), int(inside.sum())
+
+    w1, holes1, _ = picture(splat_radius=0.1)
+    w3, holes3, _ = picture(splat_radius=0.3)
+    assert 26 <= w3 - w1 <= 32, (w1, w3)
+    assert holes1 == 0 and holes3 == 0
+    _, holes_default, _ = picture()
+    assert holes_default == 0
+    _, holes_tiny, area = picture(splat_radius=0.005)
+    assert holes_tiny > 0.5 * area
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(focal.InvalidInputError):
+            focal.render(V, F, np.ones(len(V)), width=64, height=64, splat_radius=bad)
+
+
 def test_render_bad_input(tmp_path):
     s = focal.generate_surface("sphere", 200)
     with pytest.raises(focal.InvalidInputError, match="field must have shape"):

@@ -47,6 +47,12 @@ void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o
     throw InvalidInput("cloud curvature: outlier_ratio must be 0 (off) or finite and > 1, got " +
                        std::to_string(o.outlier_ratio));
   }
+  if (!(o.off_surface_ratio == 0.0 ||
+        (o.off_surface_ratio > 1.0 && std::isfinite(o.off_surface_ratio)))) {
+    throw InvalidInput(
+        "cloud curvature: off_surface_ratio must be 0 (off) or finite and > 1, got " +
+        std::to_string(o.off_surface_ratio));
+  }
   if (N && N->rows() != V.rows()) {
     throw InvalidInput("cloud curvature: " + std::to_string(N->rows()) + " normals for " +
                        std::to_string(V.rows()) + " points");
@@ -70,6 +76,29 @@ Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& option
   return nearest_neighbours(V, k, excluded, options.threads);
 }
 
+bool any_flag(const std::vector<char>& flags) {
+  return std::find(flags.begin(), flags.end(), 1) != flags.end();
+}
+
+/// The outlier tests of the options over `nearest16`, the 16 nearest of every point: statistical
+/// outliers, then points off the surface of their 16 nearest among the rest. Empty when both
+/// tests are off.
+std::vector<char> outlier_flags(PositionsRef V, const Neighbourhoods& nearest16,
+                                const CloudOptions& o) {
+  std::vector<char> flags;
+  if (o.outlier_ratio > 0.0) flags = outlier_points(V, nearest16, o.outlier_ratio, o.threads);
+  if (o.off_surface_ratio == 0.0) return flags;
+  // The planes without the isolated outliers, which would tilt them.
+  const std::vector<char> off = off_surface_points(
+      V,
+      any_flag(flags) ? nearest_neighbours(V, default_cloud_neighbours, flags, o.threads)
+                      : nearest16,
+      o.off_surface_ratio, o.threads);
+  if (flags.empty()) return off;
+  for (std::size_t i = 0; i < flags.size(); ++i) flags[i] = flags[i] || off[i];
+  return flags;
+}
+
 CloudNormalOptions normal_options(const CloudOptions& o) {
   CloudNormalOptions normals = o.normals;
   normals.threads = o.threads;
@@ -81,18 +110,16 @@ CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
                                 const CloudOptions& options) {
   CloudCurvature out;
   out.neighbours = neighbourhoods_without(V, options, {});
-  if (options.outlier_ratio > 0.0) {
-    // The test is over the 16 nearest (where its ratio was measured): the lists at hand when
-    // they are those, else a query of their own.
+  if (options.outlier_ratio > 0.0 || options.off_surface_ratio > 0.0) {
+    // The tests are over the 16 nearest (where their ratios were measured): the lists at hand
+    // when they are those, else a query of their own.
     const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
                          options.k == default_cloud_neighbours;
-    out.outlier = outlier_points(
+    out.outlier = outlier_flags(
         V,
         sixteen ? out.neighbours : nearest_neighbours(V, default_cloud_neighbours, options.threads),
-        options.outlier_ratio, options.threads);
-    if (std::find(out.outlier.begin(), out.outlier.end(), 1) != out.outlier.end()) {
-      out.neighbours = neighbourhoods_without(V, options, out.outlier);
-    }
+        options);
+    if (any_flag(out.outlier)) out.neighbours = neighbourhoods_without(V, options, out.outlier);
   }
   out.spacing = mean_spacing(V, out.neighbours);
   out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
@@ -126,9 +153,9 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   CloudCurvature out;
   out.k = default_cloud_neighbours;
   out.neighbours = nearest_neighbours(V, out.k, options.threads);
-  if (options.outlier_ratio > 0.0) {
-    out.outlier = outlier_points(V, out.neighbours, options.outlier_ratio, options.threads);
-    if (std::find(out.outlier.begin(), out.outlier.end(), 1) != out.outlier.end()) {
+  if (options.outlier_ratio > 0.0 || options.off_surface_ratio > 0.0) {
+    out.outlier = outlier_flags(V, out.neighbours, options);
+    if (any_flag(out.outlier)) {
       out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
     }
   }
@@ -208,6 +235,30 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
                                         const CloudOptions& options) {
   CloudCurvature out = plan_cloud_curvature(V, N, options);
   fit_cloud_curvature(V, out, options);
+  return out;
+}
+
+RowMatrixX3d estimate_cloud_normals(PositionsRef V, std::optional<NormalsRef> N,
+                                    const CloudOptions& options) {
+  validate(V, N, options);
+  if (!uses_plan(options)) {
+    // Neighbourhoods as given: every point's estimate over them, on the side of its given normal.
+    CloudNormalOptions normals = normal_options(options);
+    RowMatrixX3d out = cloud_normals(V, cloud_neighbourhoods(V, options), normals);
+    if (N && !normals.viewpoint) {
+      for (Eigen::Index i = 0; i < out.rows(); ++i) {
+        if (out.row(i).dot(N->row(i)) < 0.0) out.row(i) *= -1.0;
+      }
+    }
+    return out;
+  }
+  CloudCurvature plan = adaptive_plan(V, N, options);
+  if (!plan.file_normals_used) return std::move(plan.N);  // jet normals: unit or NaN rows
+  std::vector<char> ok;
+  RowMatrixX3d out = detail::unit_rows(plan.N, ok, options.threads);
+  for (Eigen::Index i = 0; i < out.rows(); ++i) {
+    if (!ok[static_cast<std::size_t>(i)]) out.row(i).setConstant(NAN);
+  }
   return out;
 }
 

@@ -64,6 +64,24 @@ namespace focal {
 [[nodiscard]] std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
                                                double ratio, int threads = 0);
 
+/// Points off their neighbours' surface (#V flags): the distance of a point to the
+/// least-squares plane of its neighbours (the point itself not in the fit) is more than `ratio`
+/// times the RMS distance of those neighbours to that plane (the sampling noise plus the
+/// surface's bending over the neighbourhood). The point being in neither, an outlier does not
+/// raise its own yardstick; another outlier among its neighbours raises it (the test errs
+/// towards keeping points). A point so flagged is kept again when its distance is at most
+/// ratio / 2 times the median over its neighbours of their own distance to their neighbours'
+/// plane, the point left out of those: a regular sampling (the pole of a sphere sampled in
+/// rings has one ring as its nearest, spread ~0). It catches what outlier_points does not: a
+/// point a spacing or more off the surface, as close to its neighbours as they are to theirs;
+/// not a point off the surface's edge within its tangent plane. Points with fewer than 3
+/// neighbours are not flagged; an RMS below 1e-9 x the mean neighbour distance counts as that
+/// (exactly flat neighbourhoods).
+/// \throw InvalidInput when ratio is not finite and > 1, threads < 0, or the neighbourhoods
+/// are not V's.
+[[nodiscard]] std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
+                                                   double ratio, int threads = 0);
+
 /// The mean over finite points of the distance to their nearest other point (0 when no point
 /// has a neighbour): the sampling spacing of a cloud, the scale of its class tolerances as the
 /// mean edge length is a mesh's.
