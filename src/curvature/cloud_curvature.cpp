@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "curvature/corrected_step.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/robust_fit.h"
 #include "focal/core/error.h"
@@ -154,6 +155,11 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
     }
   }
   if (out.file_normals_used) out.N = *N;
+  // The corrected step (step 5) on clean positions, and only where no point was left out as an
+  // outlier: outliers too near the surface to be flagged (docs/POINTS.md, "Outliers") enter
+  // the local triangulations, and the corrected measures, unlike the robust fit, take them in.
+  out.corrected = out.k == default_cloud_neighbours &&
+                  std::find(out.outlier.begin(), out.outlier.end(), 1) == out.outlier.end();
   return out;
 }
 
@@ -201,6 +207,12 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
     std::iota(all.begin(), all.end(), 0);
     detail::robust_fit_vertices({input, {}, 0.0}, all, detail::class_tolerances(fit, scale),
                                 options.threads, true, out.curvature);
+    if (out.corrected) {
+      // Clean positions without outliers: the corrected step on each point's local
+      // triangulation where the fit is not exact (corrected_step.h; docs/POINTS.md, "The
+      // corrected step on clouds").
+      detail::cloud_corrected_measures(V, out.N, ok, out.neighbours, {}, fit, scale, out.curvature);
+    }
   }
 }
 

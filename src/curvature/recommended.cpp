@@ -337,9 +337,8 @@ bool file_normals_agree(double median_angle, double noise, double agreement) {
   return median_angle <= std::max(agreement * noise, 1e-12);
 }
 
-/// A 1-ring fit residual (RMS ray misfit, slope units) at or below this is rounding: the rays
-/// meet two slits exactly (spheres, cylinders, planes), and so does the fit.
-constexpr double kExactFitResidual = 1e-9;
+/// A 1-ring fit residual at or below this is rounding (corrected_step.h).
+using detail::kExactFitResidual;
 
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
