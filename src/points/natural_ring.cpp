@@ -4,6 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+
+#include "core/parallel.h"
+#include "kernels/local_shape.h"
 
 namespace focal::detail {
 namespace {
@@ -100,6 +104,61 @@ std::vector<std::array<int, 3>> planar_fans(const std::vector<Eigen::Vector2d>& 
   }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                         const Neighbourhoods& neighbours, int threads) {
+  const Eigen::Index n = V.rows();
+  std::vector<std::vector<std::array<int, 3>>> fans(static_cast<std::size_t>(n));
+  parallel_for_blocks(n, 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<Eigen::Vector2d> p;
+    std::vector<int> index;
+    for (std::int64_t i = begin; i < end; ++i) {
+      if (!ok[static_cast<std::size_t>(i)]) continue;
+      const Eigen::Vector3d normal = N.row(i).transpose();
+      const kernels::Frame<double> f =
+          kernels::frame_of(kernels::Vec3<double>{normal.x(), normal.y(), normal.z()});
+      const Eigen::Vector3d x{f.x.x, f.x.y, f.x.z}, y{f.y.x, f.y.y, f.y.z};
+      // Counter-clockwise in (x, y) is counter-clockwise about the normal when x cross y is it.
+      const bool flip = x.cross(y).dot(normal) < 0.0;
+      p.clear();
+      index.clear();
+      const int v = static_cast<int>(i);
+      for (const int* j = neighbours.begin(v); j != neighbours.end(v); ++j) {
+        if (!ok[static_cast<std::size_t>(*j)] || !(N.row(*j).dot(N.row(i)) > 0.0)) continue;
+        const Eigen::Vector3d e = (V.row(*j) - V.row(i)).transpose();
+        p.emplace_back(e.dot(x), e.dot(y));
+        index.push_back(*j);
+      }
+      const PlanarRing ring = natural_neighbours_of_origin(p);
+      auto& fan = fans[static_cast<std::size_t>(i)];
+      const std::size_t m = ring.ring.size();
+      for (std::size_t k = 0; k < m; ++k) {
+        if (!ring.adjacent_to_next[k]) continue;
+        const int a = index[static_cast<std::size_t>(ring.ring[k])];
+        const int b = index[static_cast<std::size_t>(ring.ring[(k + 1) % m])];
+        fan.push_back(flip ? std::array<int, 3>{v, b, a} : std::array<int, 3>{v, a, b});
+      }
+    }
+  });
+  NaturalFans out;
+  out.own.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto v = static_cast<std::size_t>(i);
+    out.own.offsets[v + 1] = out.own.offsets[v] + static_cast<int>(fans[v].size());
+  }
+  const int total = out.own.offsets.back();
+  out.F.resize(total, 3);
+  out.own.faces.resize(static_cast<std::size_t>(total));
+  parallel_for(n, threads, [&](std::int64_t i) {
+    int row = out.own.offsets[static_cast<std::size_t>(i)];
+    for (const auto& t : fans[static_cast<std::size_t>(i)]) {
+      out.F.row(row) << t[0], t[1], t[2];
+      out.own.faces[static_cast<std::size_t>(row)] = row;
+      ++row;
+    }
+  });
   return out;
 }
 

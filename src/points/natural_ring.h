@@ -7,6 +7,10 @@
 #include <array>
 #include <vector>
 
+#include "focal/core/mesh.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/topology.h"
+
 namespace focal::detail {
 
 /// The natural neighbours of the origin among the 2D points `p`: the points whose Voronoi cells
@@ -31,5 +35,16 @@ PlanarRing natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p);
 /// (starting at its smallest corner, in ascending order).
 std::vector<std::array<int, 3>> planar_fans(const std::vector<Eigen::Vector2d>& p,
                                             const std::vector<int>& centres);
+
+/// Every point's fan: the triangles (i, a, b) of its local triangulation (its neighbours j with
+/// ok[j] and a normal in the hemisphere of N.row(i), projected onto the plane of N.row(i)) at i,
+/// counter-clockwise about N.row(i); points without ok[i] get none. Listed under their centre
+/// only (`own`), in point order: the same for any thread count.
+struct NaturalFans {
+  RowMatrixX3i F;   ///< all fans' triangles, point i's at rows own.begin(i) .. own.end(i)
+  VertexFaces own;  ///< each point's fan (not the incidence of F)
+};
+NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                         const Neighbourhoods& neighbours, int threads);
 
 }  // namespace focal::detail
