@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include "focal/points/neighbours.h"
+
 namespace focal::detail {
 namespace {
 
@@ -150,5 +152,80 @@ TEST(NaturalRing, PlanarFansListEachTriangleOnce) {
   EXPECT_EQ(std::adjacent_find(two.begin(), two.end()), two.end());
 }
 
+/// A hexagonal lattice of unit spacing in the plane z = 0, within `radius` of the origin.
+RowMatrixX3d planar_hexagonal_lattice(double radius) {
+  std::vector<Eigen::Vector3d> rows;
+  for (int i = -20; i <= 20; ++i) {
+    for (int j = -20; j <= 20; ++j) {
+      const Eigen::Vector3d q(i + 0.5 * j, j * std::sqrt(3.0) / 2.0, 0.0);
+      if (q.norm() <= radius) rows.push_back(q);
+    }
+  }
+  RowMatrixX3d V(static_cast<Eigen::Index>(rows.size()), 3);
+  for (std::size_t r = 0; r < rows.size(); ++r) V.row(static_cast<Eigen::Index>(r)) = rows[r];
+  return V;
+}
+
+// natural_fans on a planar hexagonal lattice (a cloud of known Delaunay triangulation): each
+// point far enough inside that its 16 nearest surround it gets its 6 equilateral triangles,
+// starting at itself, counter-clockwise about its normal (+z: positive in (x, y); -z: negative).
+// Points without ok get no fan, and a neighbour without ok or with a normal in the other
+// hemisphere is in no one's fan.
+TEST(NaturalRing, NaturalFansOfAPlanarLatticeAreItsSixTriangles) {
+  const RowMatrixX3d V = planar_hexagonal_lattice(6.0);
+  const Eigen::Index n = V.rows();
+  const Neighbourhoods knn = nearest_neighbours(V, 16);
+  for (const double side : {1.0, -1.0}) {
+    RowMatrixX3d N = RowMatrixX3d::Zero(n, 3);
+    N.col(2).setConstant(side);
+    const std::vector<char> ok(static_cast<std::size_t>(n), 1);
+    const NaturalFans fans = natural_fans(V, N, ok, knn, 2);
+    ASSERT_EQ(fans.own.vertex_count(), n);
+    int interior = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (V.row(i).norm() > 3.5) continue;
+      ++interior;
+      ASSERT_EQ(fans.own.size(i), 6) << i;
+      for (int f = fans.own.begin(i); f < fans.own.end(i); ++f) {
+        const auto t = fans.F.row(fans.own.faces[static_cast<std::size_t>(f)]);
+        EXPECT_EQ(t[0], i);
+        for (const int c : {1, 2}) EXPECT_NEAR((V.row(t[c]) - V.row(i)).norm(), 1.0, 1e-12);
+        EXPECT_NEAR((V.row(t[1]) - V.row(t[2])).norm(), 1.0, 1e-12);
+        const Vector2d a = (V.row(t[1]) - V.row(i)).head<2>().transpose();
+        const Vector2d b = (V.row(t[2]) - V.row(i)).head<2>().transpose();
+        EXPECT_GT(side * orient(Vector2d::Zero(), a, b), 0.0) << i;
+      }
+    }
+    EXPECT_GT(interior, 30);
+  }
+  // The origin's point: drop one neighbour (ok 0) and turn another's normal over.
+  RowMatrixX3d N = RowMatrixX3d::Zero(n, 3);
+  N.col(2).setOnes();
+  std::vector<char> ok(static_cast<std::size_t>(n), 1);
+  Eigen::Index centre = 0;
+  V.rowwise().norm().minCoeff(&centre);
+  const int dropped = knn.begin(static_cast<int>(centre))[0];
+  const int flipped = knn.begin(static_cast<int>(centre))[1];
+  ok[static_cast<std::size_t>(dropped)] = 0;
+  N(flipped, 2) = -1.0;
+  const NaturalFans fans = natural_fans(V, N, ok, knn, 1);
+  EXPECT_EQ(fans.own.size(dropped), 0);
+  EXPECT_EQ(fans.own.size(flipped), 0);  // all its neighbours are in the other hemisphere
+  for (int r = 0; r < fans.F.rows(); ++r) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NE(fans.F(r, c), dropped) << r;
+      EXPECT_NE(fans.F(r, c), flipped) << r;
+    }
+  }
+  // The centre's fan closes over the gap, through the next ring: its angles sum to 2 pi.
+  double total = 0.0;
+  for (int f = fans.own.begin(centre); f < fans.own.end(centre); ++f) {
+    const auto t = fans.F.row(fans.own.faces[static_cast<std::size_t>(f)]);
+    const Vector2d a = (V.row(t[1]) - V.row(centre)).head<2>().transpose();
+    const Vector2d b = (V.row(t[2]) - V.row(centre)).head<2>().transpose();
+    total += std::atan2(orient(Vector2d::Zero(), a, b), a.dot(b));
+  }
+  EXPECT_NEAR(total, 2.0 * std::numbers::pi, 1e-9);
+}
 }  // namespace
 }  // namespace focal::detail
