@@ -53,7 +53,21 @@ struct LocalScratch {
   std::vector<int> index;              ///< their rows of V
   std::vector<int> reached;            ///< local indices within the ball, breadth first
   std::vector<char> seen;
+  /// Each local point's fan (planar_fans about it alone), computed once: the walk through the
+  /// ball and the ball's triangles both need it.
+  std::vector<std::vector<std::array<int, 3>>> fan;
+  std::vector<char> has_fan;
+  std::vector<std::array<int, 3>> local_faces;
   std::vector<std::array<int, 3>> faces;
+
+  const std::vector<std::array<int, 3>>& fan_of(int c) {
+    const auto v = static_cast<std::size_t>(c);
+    if (!has_fan[v]) {
+      fan[v] = planar_fans(plane, {c});
+      has_fan[v] = 1;
+    }
+    return fan[v];
+  }
 };
 
 /// cloud_corrected_measures at point i (see there).
@@ -81,6 +95,8 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
   s.reached.assign(1, 0);
   s.seen.assign(s.plane.size(), 0);
   s.seen[0] = 1;
+  s.fan.resize(s.plane.size());
+  s.has_fan.assign(s.plane.size(), 0);
   std::size_t ring_end = 1;
   int rings = 0;
   for (std::size_t k = 0; k < s.reached.size(); ++k) {
@@ -90,7 +106,7 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
     }
     if (rings >= kCorrectedBallRings) break;
     const int c = s.reached[k];
-    for (const auto& t : planar_fans(s.plane, {c})) {
+    for (const auto& t : s.fan_of(c)) {
       for (const int q : t) {
         if (s.seen[static_cast<std::size_t>(q)]) continue;
         s.seen[static_cast<std::size_t>(q)] = 1;
@@ -98,8 +114,16 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
       }
     }
   }
+  // The ball's triangles, each once, as planar_fans(s.plane, s.reached) lists them.
+  s.local_faces.clear();
+  for (const int c : s.reached) {
+    const auto& fan = s.fan_of(c);
+    s.local_faces.insert(s.local_faces.end(), fan.begin(), fan.end());
+  }
+  std::sort(s.local_faces.begin(), s.local_faces.end());
+  s.local_faces.erase(std::unique(s.local_faces.begin(), s.local_faces.end()), s.local_faces.end());
   s.faces.clear();
-  for (const auto& t : planar_fans(s.plane, s.reached)) {
+  for (const auto& t : s.local_faces) {
     s.faces.push_back({s.index[static_cast<std::size_t>(t[0])],
                        s.index[static_cast<std::size_t>(t[1])],
                        s.index[static_cast<std::size_t>(t[2])]});
