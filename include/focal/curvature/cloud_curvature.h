@@ -19,7 +19,9 @@
 ///  3. the cloud's own normals are used when their median angle to the jet normals is at most
 ///     2.5 times the noise (measured ratio: exact normals 0.49-0.62, exact normals on 10% noisy
 ///     positions 0.74-0.79, normal noise 0.05: 3.4 and more), else the jet normals turned to
-///     their side;
+///     their side; on clean positions (16 neighbours) each point's jet normal gives way to Max's
+///     normal over its fan in its local triangulation (step 5's) where the two-slit residual of
+///     Max's normals is below half the jets' (the mesh default's choice; exact on a sphere);
 ///  4. the two-slit fit, repeated without the rays far off it where there are such (the mesh
 ///     default's robust fit, curvature/robust_fit.h; clean fits keep every ray);
 ///  5. on clean positions (16 neighbours) where no point was flagged as an outlier, the mesh
