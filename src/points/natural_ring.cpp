@@ -110,10 +110,17 @@ std::vector<std::array<int, 3>> planar_fans(const std::vector<Eigen::Vector2d>& 
 NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
                          const Neighbourhoods& neighbours, int threads) {
   const Eigen::Index n = V.rows();
-  std::vector<std::vector<std::array<int, 3>>> fans(static_cast<std::size_t>(n));
-  parallel_for_blocks(n, 256, threads, [&](std::int64_t begin, std::int64_t end) {
+  // One list of triangles per block of points (their counts per point beside it): a list per
+  // point would cost more than its 6 or so triangles at 1M points (the default's peak memory).
+  constexpr std::int64_t kBlock = 256;
+  std::vector<std::vector<std::array<int, 3>>> lists(
+      static_cast<std::size_t>((n + kBlock - 1) / kBlock));
+  NaturalFans out;
+  out.own.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
     std::vector<Eigen::Vector2d> p;
     std::vector<int> index;
+    auto& list = lists[static_cast<std::size_t>(begin / kBlock)];
     for (std::int64_t i = begin; i < end; ++i) {
       if (!ok[static_cast<std::size_t>(i)]) continue;
       const Eigen::Vector3d normal = N.row(i).transpose();
@@ -132,32 +139,32 @@ NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vecto
         index.push_back(*j);
       }
       const PlanarRing ring = natural_neighbours_of_origin(p);
-      auto& fan = fans[static_cast<std::size_t>(i)];
-      const std::size_t m = ring.ring.size();
+      const std::size_t m = ring.ring.size(), before = list.size();
       for (std::size_t k = 0; k < m; ++k) {
         if (!ring.adjacent_to_next[k]) continue;
         const int a = index[static_cast<std::size_t>(ring.ring[k])];
         const int b = index[static_cast<std::size_t>(ring.ring[(k + 1) % m])];
-        fan.push_back(flip ? std::array<int, 3>{v, b, a} : std::array<int, 3>{v, a, b});
+        list.push_back(flip ? std::array<int, 3>{v, b, a} : std::array<int, 3>{v, a, b});
       }
+      out.own.offsets[static_cast<std::size_t>(i) + 1] = static_cast<int>(list.size() - before);
     }
   });
-  NaturalFans out;
-  out.own.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto v = static_cast<std::size_t>(i);
-    out.own.offsets[v + 1] = out.own.offsets[v] + static_cast<int>(fans[v].size());
+    out.own.offsets[v + 1] += out.own.offsets[v];
   }
   const int total = out.own.offsets.back();
   out.F.resize(total, 3);
   out.own.faces.resize(static_cast<std::size_t>(total));
-  parallel_for(n, threads, [&](std::int64_t i) {
-    int row = out.own.offsets[static_cast<std::size_t>(i)];
-    for (const auto& t : fans[static_cast<std::size_t>(i)]) {
+  parallel_for(static_cast<std::int64_t>(lists.size()), threads, [&](std::int64_t b) {
+    int row = out.own.offsets[static_cast<std::size_t>(b * kBlock)];
+    auto& list = lists[static_cast<std::size_t>(b)];
+    for (const auto& t : list) {
       out.F.row(row) << t[0], t[1], t[2];
       out.own.faces[static_cast<std::size_t>(row)] = row;
       ++row;
     }
+    std::vector<std::array<int, 3>>().swap(list);  // freed as F fills
   });
   return out;
 }
