@@ -26,6 +26,11 @@ struct Cell {
 void clip(Cell& cell, const Eigen::Vector2d& p, int j, Cell& scratch) {
   const double offset = 0.5 * p.squaredNorm();
   const auto side = [&](const Eigen::Vector2d& x) { return x.dot(p) - offset; };
+  // A point whose bisector misses the cell leaves it as it is: nothing to copy.
+  if (std::all_of(cell.vertex.begin(), cell.vertex.end(),
+                  [&](const Eigen::Vector2d& x) { return side(x) <= 0.0; })) {
+    return;
+  }
   scratch.vertex.clear();
   scratch.label.clear();
   const std::size_t m = cell.vertex.size();
