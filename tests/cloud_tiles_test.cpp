@@ -62,7 +62,7 @@ TEST(CloudTiles, TheTilesGiveTheWholeCloudsBits) {
                                           {.k = 8, .solver = Solver::levenberg_marquardt}};
   const std::vector<std::string> names{"default", "k 10", "radius 0.15", "no outlier test",
                                        "k 8 levenberg-marquardt"};
-  bool wide_plan = false, outliers = false, estimated = false;
+  bool wide_plan = false, outliers = false, estimated = false, corrected = false;
   for (const Case& c : clouds()) {
     for (std::size_t o = 0; o < options.size(); ++o) {
       for (const bool normals : {true, false}) {
@@ -83,11 +83,13 @@ TEST(CloudTiles, TheTilesGiveTheWholeCloudsBits) {
         wide_plan |= whole.k == 4 * default_cloud_neighbours;
         outliers |= std::count(whole.outlier.begin(), whole.outlier.end(), 1) > 0;
         estimated |= whole.normals_estimated;
+        corrected |= whole.corrected;
       }
     }
   }
-  // The cases reach every branch of the plan: 64 neighbours, outliers left out, normals estimated.
-  EXPECT_TRUE(wide_plan && outliers && estimated);
+  // The cases reach every branch of the plan: 64 neighbours, outliers left out, normals
+  // estimated, the corrected step on local triangulations.
+  EXPECT_TRUE(wide_plan && outliers && estimated && corrected);
 }
 
 TEST(CloudTiles, EveryPointIsOwnedOnceWithItsNeighboursInItsTile) {
@@ -139,7 +141,7 @@ TEST(CloudTiles, AHaloOneStepShortChangesTheResult) {
     const CloudCurvature plan = plan_cloud_curvature(s.mesh.V, N, options);
     CloudCurvature whole = plan;
     fit_cloud_curvature(s.mesh.V, whole, options);
-    const CloudWideChoices choices{plan.spacing, plan.k};
+    const CloudWideChoices choices{plan.spacing, plan.k, plan.corrected};
     for (const int depth : {0, 1}) {
       const Tiling tiling =
           partition_cloud(s.mesh.V, plan.neighbours, depth, {.tile_vertices = 300});

@@ -150,6 +150,7 @@ nb::dict cloud_tile_plan(const DoubleRows& V, const std::optional<DoubleRows>& N
   nb::dict choices;
   choices["spacing"] = plan.spacing;
   choices["k"] = plan.k;
+  choices["corrected"] = plan.corrected;
   nb::dict d;
   d["choices"] = choices;
   d["N"] = to_numpy(std::move(plan.N));
@@ -178,8 +179,8 @@ nb::dict estimate_cloud_tile(const DoubleRows& V, const DoubleRows& N,
                              const std::optional<Flags>& outlier, const nb::dict& options,
                              const nb::dict& choices) {
   const focal::CloudOptions o = cloud_options_of(options);
-  const focal::CloudWideChoices c{nb::cast<double>(choices["spacing"]),
-                                  nb::cast<int>(choices["k"])};
+  const focal::CloudWideChoices c{nb::cast<double>(choices["spacing"]), nb::cast<int>(choices["k"]),
+                                  nb::cast<bool>(choices["corrected"])};
   focal::TileEstimate r;
   {
     nb::gil_scoped_release release;

@@ -7,12 +7,18 @@
 #include <utility>
 #include <vector>
 
+#include "core/parallel.h"
+#include "curvature/corrected_step.h"
 #include "curvature/curvature_detail.h"
+#include "curvature/detail.h"
 #include "curvature/robust_fit.h"
 #include "focal/core/error.h"
+#include "focal/mesh/normals.h"
 #include "focal/points/neighbours.h"
+#include "mesh/normals_detail.h"
 #include "mesh/prepared_detail.h"
 #include "normals/cloud_normals_detail.h"
+#include "points/natural_ring.h"
 
 namespace focal {
 namespace {
@@ -147,6 +153,33 @@ double median_angle(NormalsRef N, const RowMatrixX3d& M) {
   return median_of(std::move(angles));
 }
 
+/// Clean positions, the file's normals not used (the plan's step 3): the jets' normals `jets`,
+/// or Max's normals over the point's fan in its local triangulation (points/natural_ring.h)
+/// where those are clearly smoother (select_normal: their two-slit residual over the point's
+/// neighbours below half the jets'), as the mesh default picks between the jets and Max's
+/// normals: Max's weights are exact on a sphere (Max 1999), cubic jets are not.
+RowMatrixX3d with_max_normals(PositionsRef V, RowMatrixX3d jets, const Neighbourhoods& neighbours,
+                              double spacing, int threads) {
+  std::vector<char> ok, max_ok;
+  const RowMatrixX3d J = detail::unit_rows(jets, ok, threads);
+  const detail::NaturalFans fans = detail::natural_fans(V, J, ok, neighbours, threads);
+  const RowMatrixX3d M = detail::unit_rows(
+      detail::vertex_normals_from(V, fans.F, fans.own, NormalWeighting::max, threads), max_ok,
+      threads);
+  CurvatureOptions fit;
+  fit.threads = threads;
+  const Eigen::VectorXd rj = detail::fit_roughness({V, J, ok, neighbours, spacing}, fit);
+  const Eigen::VectorXd rm = detail::fit_roughness({V, M, max_ok, neighbours, spacing}, fit);
+  detail::parallel_for(V.rows(), threads, [&](std::int64_t i) {
+    // Only where the jets gave a normal: a point without one has no fan either.
+    if (!ok[static_cast<std::size_t>(i)]) return;
+    jets.row(i) =
+        detail::select_normal(J.row(i).transpose(), rj[i], M.row(i).transpose(), rm[i], true)
+            .first.transpose();
+  });
+  return jets;
+}
+
 /// The default's plan (cloud_curvature.h, steps 1-3).
 CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
                              const CloudOptions& options) {
@@ -175,12 +208,20 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
                                 median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
   out.normals_estimated = !out.file_normals_used;
   out.N = std::move(jets.N);
+  if (out.k == default_cloud_neighbours && !out.file_normals_used) {
+    out.N = with_max_normals(V, std::move(out.N), out.neighbours, out.spacing, options.threads);
+  }
   if (N && !out.file_normals_used) {
     for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
       if (out.N.row(i).dot(N->row(i)) < 0.0) out.N.row(i) *= -1.0;  // the file's side
     }
   }
   if (out.file_normals_used) out.N = *N;
+  // The corrected step (step 5) on clean positions, and only where no point was left out as an
+  // outlier: outliers too near the surface to be flagged (docs/POINTS.md, "Outliers") enter
+  // the local triangulations, and the corrected measures, unlike the robust fit, take them in.
+  out.corrected = out.k == default_cloud_neighbours &&
+                  std::find(out.outlier.begin(), out.outlier.end(), 1) == out.outlier.end();
   return out;
 }
 
@@ -228,6 +269,12 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
     std::iota(all.begin(), all.end(), 0);
     detail::robust_fit_vertices({input, {}, 0.0}, all, detail::class_tolerances(fit, scale),
                                 options.threads, true, out.curvature);
+    if (out.corrected) {
+      // Clean positions without outliers: the corrected step on each point's local
+      // triangulation where the fit is not exact (corrected_step.h; docs/POINTS.md, "The
+      // corrected step on clouds").
+      detail::cloud_corrected_measures(V, out.N, ok, out.neighbours, {}, fit, scale, out.curvature);
+    }
   }
 }
 

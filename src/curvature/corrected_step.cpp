@@ -1,12 +1,17 @@
 #include "curvature/corrected_step.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 
 #include "core/fields_detail.h"
 #include "core/parallel.h"
 #include "curvature/baselines/lachaud_2020_detail.h"
+#include "curvature/normal_rays_detail.h"
 #include "mesh/prepared_detail.h"
+#include "points/natural_ring.h"
 
 namespace focal::detail {
 namespace {
@@ -42,7 +47,105 @@ double local_edge_length(PositionsRef V, const Neighbourhoods& ring, int i) {
   return sum / count;  // i has neighbours: its asymmetry was finite
 }
 
+/// What one thread of cloud_corrected_measures reuses from point to point.
+struct LocalScratch {
+  std::vector<Eigen::Vector2d> plane;  ///< the point (origin) and its neighbours, projected
+  std::vector<int> index;              ///< their rows of V
+  std::vector<int> reached;            ///< local indices within the ball, breadth first
+  std::vector<char> seen;
+  /// Each local point's fan (planar_fans about it alone), computed once: the walk through the
+  /// ball and the ball's triangles both need it.
+  std::vector<std::vector<std::array<int, 3>>> fan;
+  std::vector<char> has_fan;
+  std::vector<std::array<int, 3>> local_faces;
+  std::vector<std::array<int, 3>> faces;
+
+  const std::vector<std::array<int, 3>>& fan_of(int c) {
+    const auto v = static_cast<std::size_t>(c);
+    if (!has_fan[v]) {
+      fan[v] = planar_fans(plane, {c});
+      has_fan[v] = 1;
+    }
+    return fan[v];
+  }
+};
+
+/// cloud_corrected_measures at point i (see there).
+void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                           const Neighbourhoods& neighbours, const ClassTolerances& tol, int i,
+                           LocalScratch& s, CurvatureResult& fit) {
+  const TangentFrame frame = frame_of(N.row(i).transpose());
+  s.plane.assign(1, Eigen::Vector2d::Zero());
+  s.index.assign(1, i);
+  for (const int* j = neighbours.begin(i); j != neighbours.end(i); ++j) {
+    if (!ok[static_cast<std::size_t>(*j)] || !(N.row(*j).dot(N.row(i)) > 0.0)) continue;
+    const Eigen::Vector3d e = (V.row(*j) - V.row(i)).transpose();
+    s.plane.emplace_back(e.dot(frame.x), e.dot(frame.y));
+    s.index.push_back(*j);
+  }
+  const auto distance = [&](int local) {
+    return (V.row(s.index[static_cast<std::size_t>(local)]) - V.row(i)).norm();
+  };
+  const PlanarRing ring = natural_neighbours_of_origin(s.plane);
+  if (ring.ring.empty()) return;
+  double sum = 0.0;
+  for (const int q : ring.ring) sum += distance(q);
+  const double r = kCorrectedBall * sum / static_cast<double>(ring.ring.size());
+  // The points within the ball reached along the local triangulation's edges, as ball::gather.
+  s.reached.assign(1, 0);
+  s.seen.assign(s.plane.size(), 0);
+  s.seen[0] = 1;
+  s.fan.resize(s.plane.size());
+  s.has_fan.assign(s.plane.size(), 0);
+  std::size_t ring_end = 1;
+  int rings = 0;
+  for (std::size_t k = 0; k < s.reached.size(); ++k) {
+    if (k == ring_end) {
+      ring_end = s.reached.size();
+      ++rings;
+    }
+    if (rings >= kCorrectedBallRings) break;
+    const int c = s.reached[k];
+    for (const auto& t : s.fan_of(c)) {
+      for (const int q : t) {
+        if (s.seen[static_cast<std::size_t>(q)]) continue;
+        s.seen[static_cast<std::size_t>(q)] = 1;
+        if (distance(q) <= r) s.reached.push_back(q);
+      }
+    }
+  }
+  // The ball's triangles, each once, as planar_fans(s.plane, s.reached) lists them.
+  s.local_faces.clear();
+  for (const int c : s.reached) {
+    const auto& fan = s.fan_of(c);
+    s.local_faces.insert(s.local_faces.end(), fan.begin(), fan.end());
+  }
+  std::sort(s.local_faces.begin(), s.local_faces.end());
+  s.local_faces.erase(std::unique(s.local_faces.begin(), s.local_faces.end()), s.local_faces.end());
+  s.faces.clear();
+  for (const auto& t : s.local_faces) {
+    s.faces.push_back({s.index[static_cast<std::size_t>(t[0])],
+                       s.index[static_cast<std::size_t>(t[1])],
+                       s.index[static_cast<std::size_t>(t[2])]});
+  }
+  baselines::detail::corrected_curvature_of_faces(V, N, s.faces, i, r, tol, fit);
+}
+
 }  // namespace
+
+void cloud_corrected_measures(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                              const Neighbourhoods& neighbours, const std::vector<char>& skip,
+                              const CurvatureOptions& options, double scale, CurvatureResult& fit) {
+  const ClassTolerances tol = class_tolerances(options, scale);
+  parallel_for_blocks(V.rows(), 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
+    LocalScratch scratch;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const auto v = static_cast<std::size_t>(i);
+      if (!ok[v] || (!skip.empty() && skip[v]) || fit.residual[i] <= kExactFitResidual) continue;
+      cloud_corrected_point(V, N, ok, neighbours, tol, static_cast<int>(i), scratch, fit);
+    }
+  });
+}
 
 Eigen::VectorXd stencil_asymmetry(PositionsRef V, const RowMatrixX3d& N,
                                   const Neighbourhoods& one_ring, int threads) {

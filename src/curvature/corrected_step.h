@@ -75,4 +75,25 @@ CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& o
 /// Writes the rows of `rows` that replace into `fit`.
 void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResult& fit);
 
+/// A fit residual (RMS ray misfit, slope units) at or below this is rounding: the rays meet two
+/// slits exactly (spheres, cylinders, planes), and so does the fit, which the later steps keep.
+constexpr double kExactFitResidual = 1e-9;
+
+/// The corrected step of the cloud default (docs/POINTS.md, "The corrected step on clouds"): a
+/// cloud has no faces, so each point gets a local triangulation of its own, the Delaunay
+/// triangulation of it and its neighbours projected onto its tangent plane (points/
+/// natural_ring.h; its natural neighbours are its 1-ring). At each point i that is not skipped
+/// (`skip[i]`), whose normal is usable (`ok`) and whose fit is not exact (`fit` residual above
+/// kExactFitResidual), LRTC20's corrected measures of the unit normals N over the ball of
+/// kCorrectedBall local edge lengths (the mean distance to its natural neighbours) about it, on
+/// the triangles of that triangulation at the points within the ball reached from i along its
+/// edges (at most kCorrectedBallRings edges away), as the mesh's ball reaches its faces. Only
+/// neighbours j with ok[j] and a normal in the hemisphere of N.row(i) take part. Reads only i's
+/// and its neighbours' positions and normals (tiles with a halo of one link give the same
+/// rows); writes row i of `fit` where the measures are defined (a positive area in the ball),
+/// leaves it otherwise. `scale`: the cloud's spacing, the scale of the class tolerances.
+void cloud_corrected_measures(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                              const Neighbourhoods& neighbours, const std::vector<char>& skip,
+                              const CurvatureOptions& options, double scale, CurvatureResult& fit);
+
 }  // namespace focal::detail

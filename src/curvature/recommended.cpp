@@ -113,9 +113,6 @@ Eigen::VectorXd roughness_at(const Context& c, NormalsRef normals,
                                   static_cast<Eigen::Index>(vertices.size()));
 }
 
-/// select_normal: how much smoother (two-slit residual) the secondary normal must be.
-constexpr double kSmootherRatio = 0.5;
-
 /// Median of the finite entries; NaN when there are none.
 double finite_median(const Eigen::VectorXd& x) {
   std::vector<double> v;
@@ -226,22 +223,7 @@ RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions&
   return plan;
 }
 
-/// A vertex's normal: the primary `a` unless the secondary `b` is clearly smoother there: its
-/// 1-ring two-slit residual `rb` (RMS misfit of the rays, slope units) below kSmootherRatio
-/// times the primary's `ra`. On clean data the two residuals measure the same truncation error
-/// and the primary is kept; 10% vertex noise makes jets 5 to 10 times rougher than exact
-/// normals. Only where `may_replace` holds is the secondary considered. Returns the chosen unit
-/// normal and its residual.
-[[gnu::always_inline]] inline std::pair<Eigen::Vector3d, double> select_normal(
-    const Eigen::Vector3d& primary, double ra, const Eigen::Vector3d& secondary, double rb,
-    bool may_replace) {
-  const Eigen::Vector3d a = primary.normalized(), b = secondary.normalized();
-  // A field without a fit at i (too few rays, invalid normal) never wins over one with a fit.
-  const bool b_fits = std::isfinite(rb), a_fits = std::isfinite(ra);
-  const bool smoother = b_fits && (!a_fits || rb < kSmootherRatio * ra);
-  const bool take_b = b.allFinite() && (!a.allFinite() || (smoother && may_replace));
-  return take_b ? std::pair{b, rb} : std::pair{a, ra};
-}
+using detail::select_normal;
 
 /// select_normal at every vertex.
 RowMatrixX3d select_normals(NormalsRef primary, const Eigen::VectorXd& primary_roughness,
@@ -364,9 +346,8 @@ bool file_normals_agree(double median_angle, double noise, double agreement) {
   return median_angle <= std::max(agreement * noise, 1e-12);
 }
 
-/// A 1-ring fit residual (RMS ray misfit, slope units) at or below this is rounding: the rays
-/// meet two slits exactly (spheres, cylinders, planes), and so does the fit.
-constexpr double kExactFitResidual = 1e-9;
+/// A 1-ring fit residual at or below this is rounding (corrected_step.h).
+using detail::kExactFitResidual;
 
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to

@@ -406,6 +406,7 @@ TileEstimate estimate_cloud_tile(const TileCloud& tile, const CloudWideChoices& 
   plan.N = tile.N;
   plan.spacing = choices.spacing;
   plan.k = choices.k;
+  plan.corrected = choices.corrected;
   plan.neighbours = cloud_fit_neighbourhoods(tile.V, options, choices.k, tile.outlier);
   fit_cloud_curvature(tile.V, plan, options);
   return {std::move(plan.curvature), {}};
@@ -416,7 +417,7 @@ TileEstimate estimate_cloud_tiled(PositionsRef V, std::optional<NormalsRef> N,
   require_tileable(options);
   const CloudCurvature plan = plan_cloud_curvature(V, N, options);
   const Tiling tiling = partition_cloud(V, plan.neighbours, 1, tiles);
-  const CloudWideChoices choices{plan.spacing, plan.k};
+  const CloudWideChoices choices{plan.spacing, plan.k, plan.corrected};
   TileEstimate out{detail::unwritten_result(V.rows()), {}};
   for (const Tile& tile : tiling.tiles) {
     const TileEstimate part =

@@ -19,9 +19,17 @@
 ///  3. the cloud's own normals are used when their median angle to the jet normals is at most
 ///     2.5 times the noise (measured ratio: exact normals 0.49-0.62, exact normals on 10% noisy
 ///     positions 0.74-0.79, normal noise 0.05: 3.4 and more), else the jet normals turned to
-///     their side;
+///     their side; on clean positions (16 neighbours) each point's jet normal gives way to Max's
+///     normal over its fan in its local triangulation (step 5's) where the two-slit residual of
+///     Max's normals is below half the jets' (the mesh default's choice; exact on a sphere);
 ///  4. the two-slit fit, repeated without the rays far off it where there are such (the mesh
-///     default's robust fit, curvature/robust_fit.h; clean fits keep every ray).
+///     default's robust fit, curvature/robust_fit.h; clean fits keep every ray);
+///  5. on clean positions (16 neighbours) where no point was flagged as an outlier, the mesh
+///     default's corrected step on a local triangulation of each point (the Delaunay
+///     triangulation of it and its neighbours projected onto its tangent plane): LRTC20's
+///     corrected curvature measures of the normals over a ball of one local edge length,
+///     wherever the fit is not exact (measured in docs/POINTS.md: the H error of the analytic
+///     clean clouds 2-4x lower).
 /// Before all of it (also with k or radius given), statistical outliers (outlier_points over the
 /// 16 nearest, CloudOptions::outlier_ratio), then points off their neighbours' surface
 /// (off_surface_points over the 16 nearest of the rest, CloudOptions::off_surface_ratio) are left
@@ -103,6 +111,9 @@ struct CloudCurvature {
   double noise = NAN;
   int k = 0;
   bool file_normals_used = false;
+  /// The default's step 5: the corrected step on local triangulations (clean positions, no
+  /// outlier flagged).
+  bool corrected = false;
   /// #V flags of the points left out as outliers, statistical or off the surface (empty when
   /// CloudOptions::outlier_ratio and off_surface_ratio are 0).
   std::vector<char> outlier;

@@ -132,8 +132,9 @@ void scatter_rows(const TileEstimate& part, const std::vector<int>& rows,
 /// What a cloud's tiles take from the whole cloud besides their points' rows
 /// (plan_cloud_curvature).
 struct CloudWideChoices {
-  double spacing = 0.0;  ///< CloudCurvature::spacing: the scale of the class tolerances
-  int k = 0;             ///< CloudCurvature::k: neighbours of the fit (ignored with a radius)
+  double spacing = 0.0;    ///< CloudCurvature::spacing: the scale of the class tolerances
+  int k = 0;               ///< CloudCurvature::k: neighbours of the fit (ignored with a radius)
+  bool corrected = false;  ///< CloudCurvature::corrected: the corrected step on the fit
 };
 
 /// A cloud tile's rows, in the tile's (global) order.

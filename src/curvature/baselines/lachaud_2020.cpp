@@ -66,7 +66,15 @@ Measures triangle_measures(const std::array<Eigen::Vector3d, 3>& x,
   return m;
 }
 
-/// The fraction of face f's area inside the ball (docs in baselines.h): linear in the distance.
+/// The fraction of a face's area inside the ball of radius r (docs in baselines.h) from its
+/// nearest and farthest corners' distances to the centre: linear in the distance.
+double fraction_of(double near, double far, double r) {
+  if (far <= r) return 1.0;
+  if (near >= r) return 0.0;
+  return (r - near) / (far - near);
+}
+
+/// The fraction of face f's area inside the ball.
 double fraction_in_ball(PositionsRef V, FacesRef F, int f, const Eigen::Vector3d& centre,
                         double r) {
   double near = INFINITY, far = 0.0;
@@ -75,9 +83,7 @@ double fraction_in_ball(PositionsRef V, FacesRef F, int f, const Eigen::Vector3d
     near = std::min(near, d);
     far = std::max(far, d);
   }
-  if (far <= r) return 1.0;
-  if (near >= r) return 0.0;
-  return (r - near) / (far - near);
+  return fraction_of(near, far, r);
 }
 
 /// The measures of the ball: the faces reached, each weighted by its fraction inside.
@@ -111,9 +117,49 @@ RowMatrixX3d corrected_normals(const PreparedMesh& mesh, std::optional<NormalsRe
   return u;
 }
 
+/// Row i of `result` from the measures `sum` of its ball (faces reached: `faces`), as the
+/// baseline and the recommended estimator's corrected step write it; nothing where the ball's
+/// area is not positive.
+void store_measures(const Measures& sum, const Eigen::Vector3d& normal, std::int64_t i, int faces,
+                    const focal::detail::ClassTolerances& tol, CurvatureResult& result) {
+  if (!(sum.mu0 > 0.0)) return;
+  const TangentFrame frame = tangent_frame(normal);
+  const focal::detail::Principal2 p = principal_of(sum, frame);
+  const double H = 0.5 * sum.mu1 / sum.mu0;
+  // Residual: how far the anisotropic measure's mean curvature is from mu1's.
+  focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);
+  result.H[i] = H;  // the papers' H and K are mu1 / (2 mu0) and mu2 / mu0 themselves
+  result.K[i] = sum.mu2 / sum.mu0;
+  result.rays_used[i] = faces;  // faces reached
+}
+
 }  // namespace
 
 namespace detail {
+
+void corrected_curvature_of_faces(PositionsRef V, const RowMatrixX3d& u,
+                                  const std::vector<std::array<int, 3>>& faces, std::int64_t i,
+                                  double r, const focal::detail::ClassTolerances& tol,
+                                  CurvatureResult& result) {
+  const Eigen::Vector3d normal = u.row(i);
+  if (!(r > 0.0) || !normal.allFinite()) return;
+  const Eigen::Vector3d centre = V.row(i);
+  Measures sum;
+  for (const auto& t : faces) {
+    std::array<Eigen::Vector3d, 3> x, n;
+    double near = INFINITY, far = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      x[c] = V.row(t[static_cast<std::size_t>(c)]);
+      n[c] = u.row(t[static_cast<std::size_t>(c)]);
+      const double d = (x[c] - centre).norm();
+      near = std::min(near, d);
+      far = std::max(far, d);
+    }
+    const Measures m = triangle_measures(x, n);
+    if (std::isfinite(m.mu0)) sum.add(m, fraction_of(near, far, r));
+  }
+  store_measures(sum, normal, i, static_cast<int>(faces.size()), tol, result);
+}
 
 CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d& u,
                                     const Eigen::VectorXd& radius, int max_rings,
@@ -133,22 +179,13 @@ CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
   CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
   const auto radius_of = [&](std::int64_t i) { return radius[i]; };
-  ball::for_each_ball(
-      mesh, radius_of, max_rings, options.threads,
-      [&](std::int64_t i, const std::vector<int>& faces) {
-        const Eigen::Vector3d normal = u.row(i);
-        if (!(radius[i] > 0.0) || !normal.allFinite()) return;
-        const Measures sum = ball_measures(V, F, face, faces, V.row(i), radius[i]);
-        if (!(sum.mu0 > 0.0)) return;
-        const TangentFrame frame = tangent_frame(normal);
-        const focal::detail::Principal2 p = principal_of(sum, frame);
-        const double H = 0.5 * sum.mu1 / sum.mu0;
-        // Residual: how far the anisotropic measure's mean curvature is from mu1's.
-        focal::detail::store_vertex(result, i, frame, p, std::abs(0.5 * (p.k1 + p.k2) - H), tol);
-        result.H[i] = H;  // the papers' H and K are mu1 / (2 mu0) and mu2 / mu0 themselves
-        result.K[i] = sum.mu2 / sum.mu0;
-        result.rays_used[i] = static_cast<int>(faces.size());  // faces reached
-      });
+  ball::for_each_ball(mesh, radius_of, max_rings, options.threads,
+                      [&](std::int64_t i, const std::vector<int>& faces) {
+                        const Eigen::Vector3d normal = u.row(i);
+                        if (!(radius[i] > 0.0) || !normal.allFinite()) return;
+                        const Measures sum = ball_measures(V, F, face, faces, V.row(i), radius[i]);
+                        store_measures(sum, normal, i, static_cast<int>(faces.size()), tol, result);
+                      });
   return result;
 }
 

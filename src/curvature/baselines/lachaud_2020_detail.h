@@ -3,7 +3,11 @@
 // radius per vertex, for the baseline and the recommended estimator's corrected step.
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
 
+#include "curvature/detail.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/prepared.h"
@@ -16,5 +20,15 @@ namespace focal::baselines::detail {
 CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d& u,
                                     const Eigen::VectorXd& radius, int max_rings,
                                     const CurvatureOptions& options);
+
+/// The same at vertex i alone over the listed faces (corners into V and u; each weighted by its
+/// fraction inside the ball of radius r about V.row(i)) instead of the mesh's ball: a cloud
+/// point's local triangulation (curvature/cloud_curvature.cpp). Writes row i of `result`;
+/// leaves it as it is where u.row(i) is not finite, r is not positive or the faces' area inside
+/// the ball is not positive.
+void corrected_curvature_of_faces(PositionsRef V, const RowMatrixX3d& u,
+                                  const std::vector<std::array<int, 3>>& faces, std::int64_t i,
+                                  double r, const focal::detail::ClassTolerances& tol,
+                                  CurvatureResult& result);
 
 }  // namespace focal::baselines::detail

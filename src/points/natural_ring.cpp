@@ -1,0 +1,177 @@
+#include "points/natural_ring.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "core/parallel.h"
+#include "kernels/local_shape.h"
+
+namespace focal::detail {
+namespace {
+
+/// The box label: an edge of the starting square, not of any point's half-plane.
+constexpr int kBox = -1;
+
+/// A convex polygon about the origin: vertex k and the label of the edge from vertex k to k + 1.
+struct Cell {
+  std::vector<Eigen::Vector2d> vertex;
+  std::vector<int> label;
+};
+
+/// `cell` cut by the half-plane x . p <= |p|^2 / 2 (the side of the origin of the bisector of
+/// the origin and p); the new edge is labelled `j`. Sutherland-Hodgman on one plane.
+void clip(Cell& cell, const Eigen::Vector2d& p, int j, Cell& scratch) {
+  const double offset = 0.5 * p.squaredNorm();
+  const auto side = [&](const Eigen::Vector2d& x) { return x.dot(p) - offset; };
+  // A point whose bisector misses the cell leaves it as it is: nothing to copy.
+  if (std::all_of(cell.vertex.begin(), cell.vertex.end(),
+                  [&](const Eigen::Vector2d& x) { return side(x) <= 0.0; })) {
+    return;
+  }
+  scratch.vertex.clear();
+  scratch.label.clear();
+  const std::size_t m = cell.vertex.size();
+  for (std::size_t e = 0; e < m; ++e) {
+    const Eigen::Vector2d& a = cell.vertex[e];
+    const Eigen::Vector2d& b = cell.vertex[(e + 1) % m];
+    const double fa = side(a), fb = side(b);
+    if (fa <= 0.0) {
+      scratch.vertex.push_back(a);
+      scratch.label.push_back(cell.label[e]);
+    }
+    if ((fa <= 0.0) != (fb <= 0.0)) {
+      const Eigen::Vector2d c = a + (fa / (fa - fb)) * (b - a);
+      scratch.vertex.push_back(c);
+      // Leaving the half-plane, the edge from c runs along the bisector; entering it, along e.
+      scratch.label.push_back(fa <= 0.0 ? j : cell.label[e]);
+    }
+  }
+  std::swap(cell.vertex, scratch.vertex);
+  std::swap(cell.label, scratch.label);
+}
+
+}  // namespace
+
+PlanarRing natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p) {
+  double reach = 0.0;
+  for (const auto& q : p) reach = std::max(reach, q.norm());
+  PlanarRing out;
+  if (!(reach > 0.0) || !std::isfinite(reach)) return out;
+  // The cell of the origin lies within half the farthest point's distance in every direction
+  // that point closes; 4 times it leaves room for cells closed by nearer points at a slant.
+  const double r = 4.0 * reach;
+  Cell cell{{{-r, -r}, {r, -r}, {r, r}, {-r, r}}, {kBox, kBox, kBox, kBox}};
+  Cell scratch;
+  for (std::size_t j = 0; j < p.size(); ++j) {
+    if (p[j].norm() > 1e-12 * reach) clip(cell, p[j], static_cast<int>(j), scratch);
+  }
+  // Edges of length zero (a cell vertex where more than three cells meet, as on a lattice) are
+  // no contact: left out, so that their label's neighbours become consecutive.
+  const std::size_t m = cell.vertex.size();
+  std::vector<int> labels;
+  for (std::size_t e = 0; e < m; ++e) {
+    if ((cell.vertex[(e + 1) % m] - cell.vertex[e]).norm() > 1e-12 * reach) {
+      labels.push_back(cell.label[e]);
+    }
+  }
+  // Start after a box edge, if there is one, so that the open ring's ends are the list's ends.
+  std::size_t start = 0;
+  for (std::size_t e = 0; e < labels.size(); ++e) {
+    if (labels[e] == kBox) start = e + 1;
+  }
+  for (std::size_t k = 0; k < labels.size(); ++k) {
+    const int label = labels[(start + k) % labels.size()];
+    const int next = labels[(start + k + 1) % labels.size()];
+    if (label == kBox) continue;
+    out.ring.push_back(label);
+    out.adjacent_to_next.push_back(next != kBox && next != label ? 1 : 0);
+  }
+  return out;
+}
+
+std::vector<std::array<int, 3>> planar_fans(const std::vector<Eigen::Vector2d>& p,
+                                            const std::vector<int>& centres) {
+  std::vector<std::array<int, 3>> out;
+  std::vector<Eigen::Vector2d> about(p.size());
+  for (const int c : centres) {
+    for (std::size_t q = 0; q < p.size(); ++q) about[q] = p[q] - p[static_cast<std::size_t>(c)];
+    const PlanarRing ring = natural_neighbours_of_origin(about);
+    const std::size_t m = ring.ring.size();
+    for (std::size_t k = 0; k < m; ++k) {
+      if (!ring.adjacent_to_next[k]) continue;
+      std::array<int, 3> t{c, ring.ring[k], ring.ring[(k + 1) % m]};
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+      out.push_back(t);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+                         const Neighbourhoods& neighbours, int threads) {
+  const Eigen::Index n = V.rows();
+  // One list of triangles per block of points (their counts per point beside it): a list per
+  // point would cost more than its 6 or so triangles at 1M points (the default's peak memory).
+  constexpr std::int64_t kBlock = 256;
+  std::vector<std::vector<std::array<int, 3>>> lists(
+      static_cast<std::size_t>((n + kBlock - 1) / kBlock));
+  NaturalFans out;
+  out.own.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<Eigen::Vector2d> p;
+    std::vector<int> index;
+    auto& list = lists[static_cast<std::size_t>(begin / kBlock)];
+    for (std::int64_t i = begin; i < end; ++i) {
+      if (!ok[static_cast<std::size_t>(i)]) continue;
+      const Eigen::Vector3d normal = N.row(i).transpose();
+      const kernels::Frame<double> f =
+          kernels::frame_of(kernels::Vec3<double>{normal.x(), normal.y(), normal.z()});
+      const Eigen::Vector3d x{f.x.x, f.x.y, f.x.z}, y{f.y.x, f.y.y, f.y.z};
+      // Counter-clockwise in (x, y) is counter-clockwise about the normal when x cross y is it.
+      const bool flip = x.cross(y).dot(normal) < 0.0;
+      p.clear();
+      index.clear();
+      const int v = static_cast<int>(i);
+      for (const int* j = neighbours.begin(v); j != neighbours.end(v); ++j) {
+        if (!ok[static_cast<std::size_t>(*j)] || !(N.row(*j).dot(N.row(i)) > 0.0)) continue;
+        const Eigen::Vector3d e = (V.row(*j) - V.row(i)).transpose();
+        p.emplace_back(e.dot(x), e.dot(y));
+        index.push_back(*j);
+      }
+      const PlanarRing ring = natural_neighbours_of_origin(p);
+      const std::size_t m = ring.ring.size(), before = list.size();
+      for (std::size_t k = 0; k < m; ++k) {
+        if (!ring.adjacent_to_next[k]) continue;
+        const int a = index[static_cast<std::size_t>(ring.ring[k])];
+        const int b = index[static_cast<std::size_t>(ring.ring[(k + 1) % m])];
+        list.push_back(flip ? std::array<int, 3>{v, b, a} : std::array<int, 3>{v, a, b});
+      }
+      out.own.offsets[static_cast<std::size_t>(i) + 1] = static_cast<int>(list.size() - before);
+    }
+  });
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto v = static_cast<std::size_t>(i);
+    out.own.offsets[v + 1] += out.own.offsets[v];
+  }
+  const int total = out.own.offsets.back();
+  out.F.resize(total, 3);
+  out.own.faces.resize(static_cast<std::size_t>(total));
+  parallel_for(static_cast<std::int64_t>(lists.size()), threads, [&](std::int64_t b) {
+    int row = out.own.offsets[static_cast<std::size_t>(b * kBlock)];
+    auto& list = lists[static_cast<std::size_t>(b)];
+    for (const auto& t : list) {
+      out.F.row(row) << t[0], t[1], t[2];
+      out.own.faces[static_cast<std::size_t>(row)] = row;
+      ++row;
+    }
+    std::vector<std::array<int, 3>>().swap(list);  // freed as F fills
+  });
+  return out;
+}
+
+}  // namespace focal::detail
