@@ -109,6 +109,19 @@ bool LineCursor::next(std::string_view& line) {
   return true;
 }
 
+std::vector<std::size_t> line_aligned_cuts(std::string_view text, std::size_t chunk_bytes) {
+  std::vector<std::size_t> cuts{0};
+  std::size_t next = chunk_bytes;
+  while (next < text.size()) {
+    const std::size_t newline = text.find('\n', next);
+    if (newline == std::string_view::npos || newline + 1 >= text.size()) break;
+    cuts.push_back(newline + 1);
+    next = cuts.back() + chunk_bytes;
+  }
+  cuts.push_back(text.size());
+  return cuts;
+}
+
 namespace {
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -77,6 +78,17 @@ class LineCursor {
   std::size_t pos_ = 0;
   std::size_t next_line_;
 };
+
+/// Bytes per run of lines that the text readers parse in parallel: large enough that a run's
+/// setup is noise, small enough that 1M-vertex files give dozens of runs to share out.
+inline constexpr std::size_t kTextChunkBytes = std::size_t{1} << 20;
+
+/// Offsets that cut `text` into runs of whole lines of about `chunk_bytes` each: 0, then
+/// repeatedly the offset just past the first '\n' at least `chunk_bytes` past the previous cut,
+/// then text.size() (increasing, no empty run). The cuts depend on the text only, never on a thread
+/// count.
+[[nodiscard]] std::vector<std::size_t> line_aligned_cuts(std::string_view text,
+                                                         std::size_t chunk_bytes);
 
 /// Splits `line` at blanks (space, tab, CR, VT, FF) into `tokens` (cleared first).
 void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
@@ -149,7 +161,8 @@ inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index 
 void weld_corners(Mesh& mesh, double tolerance, bool weld);
 
 // The per-format readers, dispatched by read_mesh().
-[[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
+/// `threads` as ReadOptions::threads (the mesh does not depend on it).
+[[nodiscard]] Mesh read_obj(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
 /// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
@@ -160,6 +173,16 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 // parse_X(path, read_whole_file(path))); `path` only names the file in messages. The fuzz targets
 // in fuzz/ call these directly. \throw IoError as the readers.
 [[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data);
+/// parse_obj reading runs of `chunk_bytes` (line_aligned_cuts) on `threads` threads (0: the
+/// default); the Mesh, or the error, is the serial reader's for any thread count and run size.
+[[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// The parallel read of that parse_obj alone: nothing where parse_obj falls back to the serial
+/// read (one run or one thread; a run holding an error, a control byte or a relative index).
+/// Lets tests see that the parallel read ran.
+[[nodiscard]] std::optional<Mesh> parse_obj_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
 /// parse_ply with its parallel passes on `threads` threads (0: the default).
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
