@@ -174,14 +174,24 @@ void TriangleCollector::reserve(std::size_t polygons) {
   source_.reserve(polygons);
 }
 
+std::size_t fan_triangulate(const std::int32_t* corners, std::size_t count, std::int32_t polygon,
+                            std::int32_t* triangles, std::int32_t* source) {
+  for (std::size_t k = 1; k + 1 < count; ++k) {
+    *triangles++ = corners[0];
+    *triangles++ = corners[k];
+    *triangles++ = corners[k + 1];
+    *source++ = polygon;
+  }
+  return count < 3 ? 0 : count - 2;
+}
+
 void TriangleCollector::add_polygon(const std::int32_t* corners, std::size_t count,
                                     std::int32_t polygon) {
-  for (std::size_t k = 1; k + 1 < count; ++k) {
-    corners_.push_back(corners[0]);
-    corners_.push_back(corners[k]);
-    corners_.push_back(corners[k + 1]);
-    source_.push_back(polygon);
-  }
+  const std::size_t triangles = count < 3 ? 0 : count - 2;
+  corners_.resize(corners_.size() + 3 * triangles);
+  source_.resize(source_.size() + triangles);
+  (void)fan_triangulate(corners, count, polygon, corners_.data() + corners_.size() - 3 * triangles,
+                        source_.data() + source_.size() - triangles);
 }
 
 void TriangleCollector::add_strip(const std::int32_t* corners, std::size_t count,

@@ -104,6 +104,12 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 /// Parses a whole token as a decimal integer (a leading '+' accepted).
 [[nodiscard]] bool parse_int(std::string_view token, std::int64_t& value);
 
+/// The fan triangles (v0, vk, vk+1) of one polygon of `count` corners: writes count - 2 of them
+/// (none below 3 corners) to `triangles` (3 ints each) and `polygon` once per triangle to
+/// `source`; returns how many.
+std::size_t fan_triangulate(const std::int32_t* corners, std::size_t count, std::int32_t polygon,
+                            std::int32_t* triangles, std::int32_t* source);
+
 /// Triangles collected while reading: polygons are fan-triangulated (v0, vk, vk+1) and each
 /// triangle remembers the index of its input polygon.
 class TriangleCollector {

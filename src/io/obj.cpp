@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <span>
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
@@ -150,100 +151,148 @@ class ObjReader {
   ObjData d_;
 };
 
-/// The runs of lines read one after the other, as one reader of their whole text would have
-/// read them (no relative indices, so only the polygons' corner offsets and lines shift).
-ObjData concatenate(std::vector<ObjData>& parts) {
-  ObjData all;
-  std::size_t positions = 0, normals = 0, corners = 0, polygons = 0;
-  for (const ObjData& p : parts) {
-    positions += p.positions.size();
-    normals += p.normals.size();
-    corners += p.corners.size();
-    polygons += p.polygon_end.size();
-  }
-  all.positions.reserve(positions);
-  all.normals.reserve(normals);
-  all.corners.reserve(corners);
-  all.polygon_end.reserve(polygons);
-  all.polygon_line.reserve(polygons);
-  for (ObjData& p : parts) {
-    all.positions.insert(all.positions.end(), p.positions.begin(), p.positions.end());
-    all.normals.insert(all.normals.end(), p.normals.begin(), p.normals.end());
-    const std::size_t corner_offset = all.corners.size();
-    all.corners.insert(all.corners.end(), p.corners.begin(), p.corners.end());
-    for (const std::size_t end : p.polygon_end) all.polygon_end.push_back(corner_offset + end);
-    for (const std::size_t line : p.polygon_line) all.polygon_line.push_back(all.lines + line);
-    all.texture_count += p.texture_count;
-    all.lines += p.lines;
-    p = {};  // free each part once copied: the peak stays near one copy of the data
-  }
-  return all;
-}
+/// Where each run's elements start in the whole file's numbering.
+struct RunStart {
+  std::size_t vertex = 0;
+  std::size_t normal = 0;
+  std::size_t polygon = 0;
+  std::size_t triangle = 0;
+  std::size_t line = 0;  // lines before the run
+};
 
-/// Builds the mesh from the statements of a whole file.
+/// Builds the mesh from the statements of a whole file, read as one run or as consecutive runs
+/// of its lines: the runs' elements follow each other, the indices in their corners are the
+/// file's (runs hold no relative index), their lines and polygons count from the run's start.
 class ObjMeshBuilder {
  public:
-  ObjMeshBuilder(const std::filesystem::path& path, const ObjData& d) : path_(path), d_(d) {}
+  ObjMeshBuilder(const std::filesystem::path& path, std::span<const ObjData> runs, int threads)
+      : path_(path), runs_(runs), threads_(threads), start_(runs.size() + 1) {
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const ObjData& d = runs[r];
+      const RunStart& s = start_[r];
+      // Every polygon has at least 3 corners, so it fans into corners - 2 triangles.
+      start_[r + 1] = {s.vertex + d.positions.size() / 3, s.normal + d.normals.size() / 3,
+                       s.polygon + d.polygon_end.size(),
+                       s.triangle + d.corners.size() - 2 * d.polygon_end.size(), s.line + d.lines};
+    }
+  }
 
   Mesh build() const {
     check_ranges();
-    Mesh mesh;
-    const auto vertex_count = static_cast<Eigen::Index>(d_.positions.size() / 3);
-    if (vertex_count > std::numeric_limits<std::int32_t>::max()) {
+    const RunStart& total = start_.back();
+    if (total.vertex > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
       io_detail::fail(path_, "more vertices than 32-bit indices can address");
     }
-    mesh.V = Eigen::Map<const RowMatrixX3d>(d_.positions.data(), vertex_count, 3);
-    const bool any_normal = std::any_of(d_.corners.begin(), d_.corners.end(),
-                                        [](const Corner& c) { return c.normal >= 0; });
+    Mesh mesh;
+    const auto vertex_count = static_cast<Eigen::Index>(total.vertex);
+    mesh.V.resize(vertex_count, 3);
+    for_each_run([&](std::size_t r) {
+      std::copy(runs_[r].positions.begin(), runs_[r].positions.end(),
+                mesh.V.data() + 3 * start_[r].vertex);
+    });
+    const bool any_normal = std::any_of(runs_.begin(), runs_.end(), [](const ObjData& d) {
+      return std::any_of(d.corners.begin(), d.corners.end(),
+                         [](const Corner& c) { return c.normal >= 0; });
+    });
     if (any_normal) {
       mesh.N = vertex_normals(vertex_count);
-    } else if (d_.polygon_end.empty() && vertex_count > 0 &&
-               d_.normals.size() == d_.positions.size()) {
+    } else if (total.polygon == 0 && vertex_count > 0 && total.normal == total.vertex) {
       // A point cloud (no faces) with one `vn` per `v`, as write_obj writes one: paired in order.
-      mesh.N = Eigen::Map<const RowMatrixX3d>(d_.normals.data(), vertex_count, 3);
+      const std::vector<double> normals = joined_normals();
+      mesh.N = Eigen::Map<const RowMatrixX3d>(normals.data(), vertex_count, 3);
     }
-
-    io_detail::TriangleCollector triangles;
-    triangles.reserve(d_.polygon_end.size());
-    std::vector<std::int32_t> polygon;
-    std::size_t begin = 0;
-    for (std::size_t p = 0; p < d_.polygon_end.size(); ++p) {
-      polygon.clear();
-      for (std::size_t k = begin; k < d_.polygon_end[p]; ++k) {
-        polygon.push_back(static_cast<std::int32_t>(d_.corners[k].vertex));
-      }
-      triangles.add_polygon(polygon.data(), polygon.size(), static_cast<std::int32_t>(p));
-      begin = d_.polygon_end[p];
-    }
-    triangles.move_into(mesh);
+    triangulate(mesh);
     return mesh;
   }
 
  private:
-  /// Indices may refer forward, so the range check waits until every v and vn is known.
-  void check_ranges() const {
-    const auto vertices = static_cast<std::int64_t>(d_.positions.size() / 3);
-    const auto normals = static_cast<std::int64_t>(d_.normals.size() / 3);
-    std::size_t begin = 0;
-    for (std::size_t p = 0; p < d_.polygon_end.size(); ++p) {
-      for (std::size_t k = begin; k < d_.polygon_end[p]; ++k) {
-        const Corner& c = d_.corners[k];
-        if (c.vertex >= vertices) {
-          fail_at_line(path_, d_.polygon_line[p],
-                       "face " + std::to_string(p) + " refers to vertex " +
-                           std::to_string(c.vertex + 1) + " but there are " +
-                           std::to_string(vertices) + " vertices");
+  template <class Body>
+  void for_each_run(Body&& body) const {
+    detail::parallel_chunks(static_cast<std::int64_t>(runs_.size()), threads_,
+                            [&](std::int64_t r) { body(static_cast<std::size_t>(r)); });
+  }
+
+  /// Fans every polygon, each run into its own rows of F.
+  void triangulate(Mesh& mesh) const {
+    const auto triangles = static_cast<Eigen::Index>(start_.back().triangle);
+    mesh.F.resize(triangles, 3);
+    mesh.face_source.resize(triangles);
+    for_each_run([&](std::size_t r) {
+      const ObjData& d = runs_[r];
+      std::int32_t* corners_out = mesh.F.data() + 3 * start_[r].triangle;
+      std::int32_t* source_out = mesh.face_source.data() + start_[r].triangle;
+      std::vector<std::int32_t> polygon;
+      std::size_t begin = 0;
+      for (std::size_t p = 0; p < d.polygon_end.size(); ++p) {
+        polygon.clear();
+        for (std::size_t k = begin; k < d.polygon_end[p]; ++k) {
+          polygon.push_back(static_cast<std::int32_t>(d.corners[k].vertex));
         }
-        if (c.normal >= normals) {
-          fail_at_line(path_, d_.polygon_line[p],
-                       "face " + std::to_string(p) + " refers to normal " +
-                           std::to_string(c.normal + 1) + " but there are " +
-                           std::to_string(normals) + " normals");
-        }
+        const auto source = static_cast<std::int32_t>(start_[r].polygon + p);
+        const std::size_t written = io_detail::fan_triangulate(polygon.data(), polygon.size(),
+                                                               source, corners_out, source_out);
+        corners_out += 3 * written;
+        source_out += written;
+        begin = d.polygon_end[p];
       }
-      begin = d_.polygon_end[p];
+    });
+  }
+
+  /// Indices may refer forward, so the range check waits until every v and vn is known. The
+  /// runs are checked in parallel; the file's first polygon out of range is reported.
+  void check_ranges() const {
+    std::vector<std::size_t> first_bad(runs_.size(), kNone);
+    for_each_run([&](std::size_t r) {
+      const ObjData& d = runs_[r];
+      std::size_t begin = 0;
+      for (std::size_t p = 0; p < d.polygon_end.size() && first_bad[r] == kNone; ++p) {
+        for (std::size_t k = begin; k < d.polygon_end[p]; ++k) {
+          if (out_of_range(d.corners[k])) first_bad[r] = p;
+        }
+        begin = d.polygon_end[p];
+      }
+    });
+    for (std::size_t r = 0; r < runs_.size(); ++r) {
+      if (first_bad[r] != kNone) fail_out_of_range(r, first_bad[r]);
     }
   }
+
+  [[nodiscard]] bool out_of_range(const Corner& c) const {
+    return c.vertex >= static_cast<std::int64_t>(start_.back().vertex) ||
+           c.normal >= static_cast<std::int64_t>(start_.back().normal);
+  }
+
+  /// Throws for the first corner out of range of polygon p of run r.
+  [[noreturn]] void fail_out_of_range(std::size_t r, std::size_t p) const {
+    const ObjData& d = runs_[r];
+    const std::size_t line = start_[r].line + d.polygon_line[p];
+    const std::string face = "face " + std::to_string(start_[r].polygon + p);
+    const auto vertices = static_cast<std::int64_t>(start_.back().vertex);
+    const auto normals = static_cast<std::int64_t>(start_.back().normal);
+    for (std::size_t k = p == 0 ? 0 : d.polygon_end[p - 1]; k < d.polygon_end[p]; ++k) {
+      const Corner& c = d.corners[k];
+      if (c.vertex >= vertices) {
+        fail_at_line(path_, line,
+                     face + " refers to vertex " + std::to_string(c.vertex + 1) +
+                         " but there are " + std::to_string(vertices) + " vertices");
+      }
+      if (c.normal >= normals) {
+        fail_at_line(path_, line,
+                     face + " refers to normal " + std::to_string(c.normal + 1) +
+                         " but there are " + std::to_string(normals) + " normals");
+      }
+    }
+    io_detail::fail(path_, "internal error: polygon reported out of range is not");
+  }
+
+  /// Every run's `vn` components, in file order.
+  [[nodiscard]] std::vector<double> joined_normals() const {
+    std::vector<double> all;
+    all.reserve(3 * start_.back().normal);
+    for (const ObjData& d : runs_) all.insert(all.end(), d.normals.begin(), d.normals.end());
+    return all;
+  }
+
   /// Per vertex: the referenced normal, or the normalised average of the distinct normals
   /// (by vn index) referenced for it; NaN where a vertex is never referenced with a normal.
   RowMatrixX3d vertex_normals(Eigen::Index vertex_count) const {
@@ -251,15 +300,22 @@ class ObjMeshBuilder {
     RowMatrixX3d N = RowMatrixX3d::Constant(vertex_count, 3, kNaN);
     std::vector<std::int64_t> first(static_cast<std::size_t>(vertex_count), -1);
     std::vector<std::pair<std::int64_t, std::int64_t>> others;  // (vertex, normal) conflicts
-    for (const Corner& c : d_.corners) {
-      if (c.normal < 0) continue;
-      auto& f = first[static_cast<std::size_t>(c.vertex)];
-      if (f < 0) {
-        f = c.normal;
-      } else if (f != c.normal) {
-        others.emplace_back(c.vertex, c.normal);
+    for (const ObjData& d : runs_) {
+      for (const Corner& c : d.corners) {
+        if (c.normal < 0) continue;
+        auto& f = first[static_cast<std::size_t>(c.vertex)];
+        if (f < 0) {
+          f = c.normal;
+        } else if (f != c.normal) {
+          others.emplace_back(c.vertex, c.normal);
+        }
       }
     }
+    const std::vector<double> normals = joined_normals();
+    const auto normal = [&](std::int64_t n) {
+      const auto k = static_cast<std::size_t>(3 * n);
+      return Eigen::RowVector3d(normals[k], normals[k + 1], normals[k + 2]);
+    };
     for (Eigen::Index v = 0; v < vertex_count; ++v) {
       const auto f = first[static_cast<std::size_t>(v)];
       if (f >= 0) N.row(v) = normal(f);
@@ -278,13 +334,11 @@ class ObjMeshBuilder {
     return N;
   }
 
-  [[nodiscard]] Eigen::RowVector3d normal(std::int64_t n) const {
-    const auto k = static_cast<std::size_t>(3 * n);
-    return {d_.normals[k], d_.normals[k + 1], d_.normals[k + 2]};
-  }
-
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   const std::filesystem::path& path_;
-  const ObjData& d_;
+  std::span<const ObjData> runs_;
+  int threads_;
+  std::vector<RunStart> start_;  // per run, then the totals
 };
 
 /// The control-byte check and the statements of a whole file, read in file order: the
@@ -304,13 +358,14 @@ ObjData read_obj_serially(const std::filesystem::path& path, std::string_view da
 /// too small to split or a run meets anything a run cannot judge alone (an error, whose message
 /// needs the face count and line so far, or a relative index): the serial read then gives the
 /// exact result or error. Runs without either are read exactly as the serial reader reads them,
-/// so the concatenation is its result bit for bit, whatever the thread count.
-std::optional<ObjData> read_obj_chunks(const std::filesystem::path& path, std::string_view data,
-                                       int threads, std::size_t chunk_bytes) {
+/// so the runs one after the other are its statements, whatever the thread count.
+std::optional<std::vector<ObjData>> read_obj_chunks(const std::filesystem::path& path,
+                                                    std::string_view data, int threads,
+                                                    std::size_t chunk_bytes) {
   const std::vector<std::size_t> cuts = io_detail::line_aligned_cuts(data, chunk_bytes);
   const auto chunks = static_cast<std::int64_t>(cuts.size()) - 1;
   if (chunks < 2 || detail::thread_count(threads) < 2) return std::nullopt;
-  std::vector<ObjData> parts(static_cast<std::size_t>(chunks));
+  std::vector<ObjData> runs(static_cast<std::size_t>(chunks));
   std::atomic<bool> serial{false};
   detail::parallel_chunks(chunks, threads, [&](std::int64_t c) {
     if (serial.load(std::memory_order_relaxed)) return;
@@ -318,7 +373,7 @@ std::optional<ObjData> read_obj_chunks(const std::filesystem::path& path, std::s
     const std::string_view text = data.substr(cuts[k], cuts[k + 1] - cuts[k]);
     try {
       if (find_control_byte(text) != std::string_view::npos) throw NeedsWholeFile{};
-      parts[k] = ObjReader(path, ObjText::run_of_lines).read(text);
+      runs[k] = ObjReader(path, ObjText::run_of_lines).read(text);
     } catch (const IoError&) {
       serial.store(true, std::memory_order_relaxed);
     } catch (const NeedsWholeFile&) {
@@ -326,7 +381,7 @@ std::optional<ObjData> read_obj_chunks(const std::filesystem::path& path, std::s
     }
   });
   if (serial.load()) return std::nullopt;
-  return concatenate(parts);
+  return runs;
 }
 
 /// `data` less a UTF-8 byte order mark, after the checks of its start.
@@ -348,8 +403,8 @@ std::string_view obj_text(const std::filesystem::path& path, std::string_view da
   return data;
 }
 
-Mesh obj_mesh(const std::filesystem::path& path, const ObjData& statements) {
-  Mesh mesh = ObjMeshBuilder(path, statements).build();
+Mesh obj_mesh(const std::filesystem::path& path, std::span<const ObjData> runs, int threads) {
+  Mesh mesh = ObjMeshBuilder(path, runs, threads).build();
   if (mesh.V.rows() == 0) io_detail::fail(path, "no vertices ('v' lines): not an OBJ mesh");
   return mesh;
 }
@@ -365,9 +420,10 @@ Mesh parse_obj(const std::filesystem::path& path, std::string_view data) {
 std::optional<Mesh> parse_obj_in_chunks(const std::filesystem::path& path, std::string_view data,
                                         int threads, std::size_t chunk_bytes) {
   const std::string_view text = obj_text(path, data);
-  std::optional<ObjData> statements = read_obj_chunks(path, text, threads, chunk_bytes);
-  if (!statements) return std::nullopt;
-  return obj_mesh(path, *statements);
+  const std::optional<std::vector<ObjData>> runs =
+      read_obj_chunks(path, text, threads, chunk_bytes);
+  if (!runs) return std::nullopt;
+  return obj_mesh(path, *runs, threads);
 }
 
 Mesh parse_obj(const std::filesystem::path& path, std::string_view data, int threads,
@@ -375,7 +431,8 @@ Mesh parse_obj(const std::filesystem::path& path, std::string_view data, int thr
   if (std::optional<Mesh> mesh = parse_obj_in_chunks(path, data, threads, chunk_bytes)) {
     return std::move(*mesh);
   }
-  return obj_mesh(path, read_obj_serially(path, obj_text(path, data)));
+  const ObjData whole = read_obj_serially(path, obj_text(path, data));
+  return obj_mesh(path, {&whole, 1}, threads);
 }
 
 Mesh read_obj(const std::filesystem::path& path, int threads) {
