@@ -124,25 +124,30 @@ std::vector<std::size_t> line_aligned_cuts(std::string_view text, std::size_t ch
 
 namespace {
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-}  // namespace
 
-void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+/// split_tokens, stopping at a token that starts with '#' where `Comments`.
+template <bool Comments>
+void split(std::string_view line, std::vector<std::string_view>& tokens) {
   tokens.clear();
   std::size_t i = 0;
   const std::size_t n = line.size();
   while (i < n) {
     while (i < n && is_blank(line[i])) ++i;
+    if (Comments && i < n && line[i] == '#') return;
     const std::size_t start = i;
     while (i < n && !is_blank(line[i])) ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
 }
+}  // namespace
 
-std::string_view strip_comment(std::string_view line) {
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    if (line[i] == '#' && (i == 0 || is_blank(line[i - 1]))) return line.substr(0, i);
-  }
-  return line;
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+  split<false>(line, tokens);
+}
+
+void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens) {
+  // A '#' at the start of the line or after a blank is exactly a '#' that starts a token.
+  split<true>(line, tokens);
 }
 
 bool parse_double(std::string_view token, double& value) {

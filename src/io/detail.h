@@ -93,9 +93,10 @@ inline constexpr std::size_t kTextChunkBytes = std::size_t{1} << 20;
 /// Splits `line` at blanks (space, tab, CR, VT, FF) into `tokens` (cleared first).
 void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 
-/// `line` up to its comment: a '#' at the start of the line or after a blank. A '#' inside a
-/// token is not a comment, so that old MSVC's "1.#QNAN" or "1.#INF" is an error, not "1.".
-[[nodiscard]] std::string_view strip_comment(std::string_view line);
+/// split_tokens of `line` up to its comment: a '#' at the start of the line or after a blank. A
+/// '#' inside a token is not a comment, so that old MSVC's "1.#QNAN" or "1.#INF" is an error,
+/// not "1.".
+void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens);
 
 /// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
 /// A value below the smallest double (1e-400) underflows to a subnormal or zero, as in C; one

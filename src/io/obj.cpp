@@ -68,7 +68,7 @@ class ObjReader {
     std::vector<std::string_view> tokens;
     while (cursor.next(line)) {
       line_ = cursor.line_number();
-      io_detail::split_tokens(io_detail::strip_comment(line), tokens);
+      io_detail::split_tokens_before_comment(line, tokens);
       if (tokens.empty()) continue;
       if (tokens[0] == "v") {
         read_triple(tokens, "coordinates", d_.positions);

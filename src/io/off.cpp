@@ -52,7 +52,7 @@ class OffReader {
   bool next_line() {
     std::string_view line;
     while (cursor_.next(line)) {
-      io_detail::split_tokens(io_detail::strip_comment(line), tokens_);
+      io_detail::split_tokens_before_comment(line, tokens_);
       if (!tokens_.empty()) return true;
     }
     return false;
