@@ -150,6 +150,12 @@ void split_tokens_before_comment(std::string_view line, std::vector<std::string_
   split<true>(line, tokens);
 }
 
+bool has_token_before_comment(std::string_view line) {
+  std::size_t i = 0;
+  while (i < line.size() && is_blank(line[i])) ++i;
+  return i < line.size() && line[i] != '#';
+}
+
 bool parse_double(std::string_view token, double& value) {
   // from_chars rejects '+' but writers emit it ("+1.5e+00").
   if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);

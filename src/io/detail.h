@@ -98,6 +98,9 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 /// not "1.".
 void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens);
 
+/// Whether split_tokens_before_comment(line) gives any token: a cheap test for element lines.
+[[nodiscard]] bool has_token_before_comment(std::string_view line);
+
 /// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
 /// A value below the smallest double (1e-400) underflows to a subnormal or zero, as in C; one
 /// above the largest (1e400) is not a number.
@@ -171,7 +174,7 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 /// `threads` as ReadOptions::threads (the mesh does not depend on it).
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
-[[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_off(const std::filesystem::path& path, int threads);
 /// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
 [[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
@@ -194,6 +197,14 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 /// parse_ply with its parallel passes on `threads` threads (0: the default).
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
 [[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
+/// parse_off reading the body (the vertex and face lines) as parse_obj reads a file: runs of
+/// `chunk_bytes` on `threads` threads, the serial reader's Mesh or error whatever the count.
+[[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// Its parallel read alone: nothing where it falls back to the serial read. For tests.
+[[nodiscard]] std::optional<Mesh> parse_off_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
 
 }  // namespace focal::io_detail

@@ -30,7 +30,7 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
     case MeshFormat::ply:
       return io_detail::read_ply(path, options.threads);
     case MeshFormat::off:
-      return io_detail::read_off(path);
+      return io_detail::read_off(path, options.threads);
     case MeshFormat::stl: {
       if (!(options.weld_tolerance >= 0.0) || !std::isfinite(options.weld_tolerance)) {
         throw InvalidInput("read_mesh: weld_tolerance must be finite and >= 0");
