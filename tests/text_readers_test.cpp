@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cstring>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -366,6 +367,70 @@ TEST(OffParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
       }
     }
   }
+}
+
+// Differential: random edits anywhere in the files (bytes replaced, erased, inserted; the file
+// cut) must give the serial reader's mesh or its error, with 3 threads on 97-byte runs.
+
+using Parser = Mesh (*)(const std::filesystem::path&, std::string_view, int, std::size_t);
+
+/// The mesh, or the IoError's message.
+struct Outcome {
+  std::optional<Mesh> mesh;
+  std::string error;
+};
+
+Outcome outcome(Parser parse, std::string_view text, int threads, std::size_t run_bytes) {
+  try {
+    return {parse("edited", text, threads, run_bytes), {}};
+  } catch (const IoError& e) {
+    return {std::nullopt, e.what()};
+  }
+}
+
+void expect_same_outcomes(Parser parse, const std::string& seed, std::uint32_t rng_seed) {
+  std::mt19937 rng(rng_seed);
+  const char alphabet[] = "0123456789 -+./#\n\r\txef\x01";
+  int errors = 0;
+  for (int iteration = 0; iteration < 150; ++iteration) {
+    std::string text = seed;
+    const int edits = 1 + static_cast<int>(rng() % 3);
+    for (int e = 0; e < edits && !text.empty(); ++e) {
+      const std::size_t at = rng() % text.size();
+      const char byte = alphabet[rng() % (sizeof alphabet - 1)];
+      switch (rng() % 4) {
+        case 0:
+          text[at] = byte;
+          break;
+        case 1:
+          text.erase(at, 1 + rng() % 8);
+          break;
+        case 2:
+          text.insert(at, 1, byte);
+          break;
+        default:
+          if (rng() % 4 == 0) text.resize(at);  // rarely: most cuts end inside a face anyway
+      }
+    }
+    const Outcome serial = outcome(parse, text, 1, io_detail::kTextChunkBytes);
+    const Outcome parallel = outcome(parse, text, 3, 97);
+    SCOPED_TRACE("iteration " + std::to_string(iteration));
+    ASSERT_EQ(parallel.error, serial.error);
+    ASSERT_EQ(parallel.mesh.has_value(), serial.mesh.has_value());
+    if (serial.mesh) expect_same_mesh(*parallel.mesh, *serial.mesh);
+    errors += !serial.error.empty();
+  }
+  // Both kinds of outcome were met, so both paths were compared.
+  EXPECT_GT(errors, 10);
+  EXPECT_LT(errors, 140);
+}
+
+TEST(ObjParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
+  expect_same_outcomes(static_cast<Parser>(&io_detail::parse_obj), obj_text(), 2024);
+}
+
+TEST(OffParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
+  expect_same_outcomes(static_cast<Parser>(&io_detail::parse_off), off_text(true), 2025);
 }
 
 }  // namespace
