@@ -1,5 +1,5 @@
-// The parallel text readers (issue 19, OBJ and OFF): a file read in runs of lines on any number
-// of threads gives the serial reader's Mesh bit for bit, and its errors word for word.
+// The parallel text readers (issue 19: OBJ, OFF, ascii PLY): a file read in runs of lines on any
+// number of threads gives the serial reader's Mesh bit for bit, and its errors word for word.
 
 #include <gtest/gtest.h>
 
@@ -143,9 +143,12 @@ std::string with_line(const std::string& text, std::size_t line, const std::stri
   return text.substr(0, begin) + replacement + text.substr(end);
 }
 
-/// The 1-based line of the first line starting with `prefix` after half the text.
-std::size_t line_in_the_middle(const std::string& text, std::string_view prefix) {
-  std::size_t pos = text.find(std::string("\n") + std::string(prefix), text.size() / 2) + 1;
+/// The 1-based line of the first line starting with `prefix` after half the text (after `from`,
+/// if given).
+std::size_t line_in_the_middle(const std::string& text, std::string_view prefix,
+                               std::size_t from = std::string::npos) {
+  if (from == std::string::npos) from = text.size() / 2;
+  std::size_t pos = text.find(std::string("\n") + std::string(prefix), from) + 1;
   return static_cast<std::size_t>(
              std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n')) +
          1;
@@ -431,6 +434,128 @@ TEST(ObjParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
 
 TEST(OffParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
   expect_same_outcomes(static_cast<Parser>(&io_detail::parse_off), off_text(true), 2025);
+}
+
+// ASCII PLY: the header is read serially, the body's lines in runs.
+
+const std::filesystem::path kPlyPath = "grid.ply";
+
+/// An ascii PLY of the grid: an element before the vertices, vertex lists and normals, faces with
+/// a flag after the list, triangle strips, an element after them; blank lines, CRLF and tabs.
+std::string ply_text() {
+  std::string vertices, faces;
+  int face_count = 0;
+  for (int r = 0; r < kRows; ++r) {
+    for (int c = 0; c < kCols; ++c) {
+      const int i = r * kCols + c;
+      const double x = 0.1 * c + 1e-7 * i, y = -0.03 * r / 7.0, z = 1.0 / (1.0 + i);
+      if (i % 5 == 0) vertices += '\t';
+      vertices += number(x);
+      vertices += i % 3 ? " " : " \t ";
+      vertices += number(y);
+      vertices += ' ';
+      vertices += number(z);
+      vertices += i % 4 ? " 0 " : " 2 7 8 ";  // a list property between position and normal
+      vertices += number(z);
+      vertices += ' ';
+      vertices += number(-x);
+      vertices += ' ';
+      vertices += number(y);
+      vertices += i % 7 == 0 ? "\r\n" : "\n";
+      if (i % 97 == 0) vertices += "\n  \n";
+    }
+  }
+  const auto v = [](int r, int c) { return std::to_string(r * kCols + c); };
+  for (int r = 0; r + 1 < kRows; ++r) {
+    for (int c = 0; c + 1 < kCols; ++c) {
+      if (c % 10 == 3 && c + 2 < kCols) {
+        faces += "6 " + v(r, c) + " " + v(r, c + 1) + " " + v(r, c + 2) + " " + v(r + 1, c + 2) +
+                 " " + v(r + 1, c + 1) + " " + v(r + 1, c) + " 1\n";
+        ++c;
+      } else {
+        faces += "4\t" + v(r, c) + " " + v(r, c + 1) + " " + v(r + 1, c + 1) + " " + v(r + 1, c) +
+                 (c % 5 == 0 ? " 0\r\n" : " 0\n");
+      }
+      ++face_count;
+    }
+    if (r % 13 == 0) faces += "\n";
+  }
+  return "ply\nformat ascii 1.0\ncomment made by text_readers_test\nelement material 2\n"
+         "property float shine\nelement vertex " +
+         std::to_string(kRows * kCols) +
+         "\nproperty double x\nproperty double y\nproperty double z\n"
+         "property list uchar int extra\nproperty float nx\nproperty float ny\nproperty float nz\n"
+         "element face " +
+         std::to_string(face_count) +
+         "\nproperty list uchar int vertex_indices\nproperty uchar flag\n"
+         "element tristrips 2\nproperty list int int vertex_indices\n"
+         "element edge 2\nproperty int v1\nproperty int v2\nend_header\n0.5\n0.25\n" +
+         vertices + faces + "5 0 1 60 61 -1\n4 2 3 62 63\n0 1\n1 2\n";
+}
+
+TEST(PlyParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
+  const std::string text = ply_text();
+  const Mesh serial = io_detail::parse_ply(kPlyPath, text, 1, io_detail::kTextChunkBytes);
+  ASSERT_EQ(serial.V.rows(), kRows * kCols);
+  // Per row of cells: 6 hexagons (4 triangles each) and 47 quads (2 each); then the two strips,
+  // 0 1 60 61 (ended by a -1) and 2 3 62 63, of two triangles each.
+  EXPECT_EQ(serial.F.rows(), (kRows - 1) * (6 * 4 + 47 * 2) + 2 + 2);
+  EXPECT_EQ(serial.V(1, 0), 0.1 + 1e-7);
+  EXPECT_EQ(serial.N.rows(), serial.V.rows());
+  for (const std::size_t run : kRunBytes) {
+    for (const int threads : kThreads) {
+      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
+      expect_same_mesh(io_detail::parse_ply(kPlyPath, text, threads, run), serial);
+      const std::optional<Mesh> parallel =
+          io_detail::parse_ply_in_chunks(kPlyPath, text, threads, run);
+      ASSERT_EQ(parallel.has_value(), threads > 1);
+      if (parallel) expect_same_mesh(*parallel, serial);
+    }
+  }
+}
+
+std::string ply_error(std::string_view text, int threads, std::size_t run_bytes) {
+  try {
+    (void)io_detail::parse_ply(kPlyPath, text, threads, run_bytes);
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(PlyParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
+  const std::string text = ply_text();
+  const std::size_t v_line = line_in_the_middle(text.substr(0, text.find("\n4\t")), "0.");
+  // The faces are the last fifth of the file.
+  const std::size_t f_line = line_in_the_middle(text, "4\t", text.size() / 10 * 9);
+  const std::string cut = text.substr(0, line_start(text, f_line));
+  const std::vector<std::string> broken = {
+      with_line(text, v_line, "1.0 2.0x 3.0 0 0 0 1"),
+      with_line(text, v_line, "1.0 2.0 3.0 0 0 0"),
+      with_line(text, v_line, "1.0 2.0 3.0 2 7 0 0 1"),
+      with_line(text, f_line, "2 1 2 0"),
+      with_line(text, f_line, "4 1 2 3 99999 0"),
+      with_line(text, f_line, "4 1 2 3 4"),
+      cut,
+  };
+  for (std::size_t b = 0; b < broken.size(); ++b) {
+    const std::string serial = ply_error(broken[b], 1, io_detail::kTextChunkBytes);
+    const std::size_t line = b < 3 ? v_line : f_line;
+    EXPECT_NE(serial.find(b < 6 ? "line " + std::to_string(line) + ": " : "file ends inside face"),
+              std::string::npos)
+        << serial;
+    for (const std::size_t run : kRunBytes) {
+      for (const int threads : kThreads) {
+        EXPECT_EQ(ply_error(broken[b], threads, run), serial)
+            << "run bytes " << run << ", threads " << threads;
+      }
+    }
+  }
+}
+
+TEST(PlyParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
+  // Edits in the header give header errors, which both reads report before reading any run.
+  expect_same_outcomes(static_cast<Parser>(&io_detail::parse_ply), ply_text(), 2026);
 }
 
 }  // namespace

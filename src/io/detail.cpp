@@ -10,6 +10,7 @@
 #include <memory>
 #include <system_error>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 
 namespace focal::io_detail {
@@ -150,9 +151,19 @@ void split_tokens_before_comment(std::string_view line, std::vector<std::string_
   split<true>(line, tokens);
 }
 
-bool has_token_before_comment(std::string_view line) {
+namespace {
+/// Offset of the first non-blank byte of `line`, or its size.
+std::size_t first_non_blank(std::string_view line) {
   std::size_t i = 0;
   while (i < line.size() && is_blank(line[i])) ++i;
+  return i;
+}
+}  // namespace
+
+bool has_token(std::string_view line) { return first_non_blank(line) < line.size(); }
+
+bool has_token_before_comment(std::string_view line) {
+  const std::size_t i = first_non_blank(line);
   return i < line.size() && line[i] != '#';
 }
 
@@ -231,6 +242,18 @@ void TriangleCollector::move_into(Mesh& mesh) {
   mesh.face_source = Eigen::Map<const Eigen::VectorXi>(source_.data(), triangles);
   corners_ = {};
   source_ = {};
+}
+
+void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh) {
+  std::vector<Eigen::Index> start(runs.size() + 1, 0);
+  for (std::size_t r = 0; r < runs.size(); ++r) start[r + 1] = start[r] + runs[r].F.rows();
+  mesh.F.resize(start.back(), 3);
+  mesh.face_source.resize(start.back());
+  detail::parallel_chunks(static_cast<std::int64_t>(runs.size()), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    mesh.F.middleRows(start[r], runs[r].F.rows()) = runs[r].F;
+    mesh.face_source.segment(start[r], runs[r].F.rows()) = runs[r].face_source;
+  });
 }
 
 namespace {

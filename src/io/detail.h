@@ -98,7 +98,9 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 /// not "1.".
 void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens);
 
-/// Whether split_tokens_before_comment(line) gives any token: a cheap test for element lines.
+/// Whether split_tokens(line) gives any token, without splitting: a cheap test for element lines.
+[[nodiscard]] bool has_token(std::string_view line);
+/// Whether split_tokens_before_comment(line) gives any token, without splitting.
 [[nodiscard]] bool has_token_before_comment(std::string_view line);
 
 /// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
@@ -132,6 +134,10 @@ class TriangleCollector {
   std::vector<std::int32_t> corners_;
   std::vector<std::int32_t> source_;
 };
+
+/// The triangles (F, face_source) of runs read in parallel, one run after the other, into
+/// mesh.F and mesh.face_source (copied on `threads` threads).
+void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh);
 
 /// Appends the shortest text that reads back to exactly `value`; NaN as `nan`, infinities as
 /// `inf` / `-inf`.
@@ -196,6 +202,15 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
 /// parse_ply with its parallel passes on `threads` threads (0: the default).
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
+/// That parse_ply with an ascii body read as parse_obj reads a file: runs of `chunk_bytes`, the
+/// serial reader's Mesh or error whatever the thread count.
+[[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// Its parallel ascii read alone: nothing where it falls back to the serial read (and for binary
+/// files). For tests.
+[[nodiscard]] std::optional<Mesh> parse_ply_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
 /// parse_off reading the body (the vertex and face lines) as parse_obj reads a file: runs of
 /// `chunk_bytes` on `threads` threads, the serial reader's Mesh or error whatever the count.

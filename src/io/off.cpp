@@ -10,7 +10,6 @@
 #include <cmath>
 #include <numeric>
 #include <optional>
-#include <span>
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
@@ -272,19 +271,6 @@ class OffReader {
   std::vector<std::string_view> tokens_;
 };
 
-/// The triangles of each run, one after the other, into mesh.F and mesh.face_source.
-void join_faces(std::span<const Mesh> runs, int threads, Mesh& mesh) {
-  std::vector<Eigen::Index> start(runs.size() + 1, 0);
-  for (std::size_t r = 0; r < runs.size(); ++r) start[r + 1] = start[r] + runs[r].F.rows();
-  mesh.F.resize(start.back(), 3);
-  mesh.face_source.resize(start.back());
-  detail::parallel_chunks(static_cast<std::int64_t>(runs.size()), threads, [&](std::int64_t c) {
-    const auto r = static_cast<std::size_t>(c);
-    mesh.F.middleRows(start[r], runs[r].F.rows()) = runs[r].F;
-    mesh.face_source.segment(start[r], runs[r].F.rows()) = runs[r].face_source;
-  });
-}
-
 /// The body read as runs of lines in parallel (each run by the serial reader's code, its first
 /// element's index known from the element lines before it), or nothing when the body is too
 /// small to split, ends before its last face, or a run meets an error: the serial read then
@@ -323,7 +309,7 @@ std::optional<Mesh> read_off_runs(const std::filesystem::path& path, std::string
     }
   });
   if (serial.load()) return std::nullopt;
-  join_faces(faces, threads, mesh);
+  io_detail::join_triangles(faces, threads, mesh);
   return mesh;
 }
 
