@@ -101,9 +101,11 @@ std::string obj_text() {
 
 template <class Matrix>
 bool same_bits(const Matrix& a, const Matrix& b) {
+  // An empty matrix has no data pointer, and memcmp must not be given a null one.
   return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(*a.data()) * static_cast<std::size_t>(a.size())) ==
-             0;
+         (a.size() == 0 ||
+          std::memcmp(a.data(), b.data(), sizeof(*a.data()) * static_cast<std::size_t>(a.size())) ==
+              0);
 }
 
 void expect_same_mesh(const Mesh& a, const Mesh& b) {
