@@ -10,6 +10,7 @@
 #include <memory>
 #include <system_error>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 
 namespace focal::io_detail {
@@ -109,27 +110,61 @@ bool LineCursor::next(std::string_view& line) {
   return true;
 }
 
+std::vector<std::size_t> line_aligned_cuts(std::string_view text, std::size_t chunk_bytes) {
+  std::vector<std::size_t> cuts{0};
+  std::size_t next = chunk_bytes;
+  while (next < text.size()) {
+    const std::size_t newline = text.find('\n', next);
+    if (newline == std::string_view::npos || newline + 1 >= text.size()) break;
+    cuts.push_back(newline + 1);
+    next = cuts.back() + chunk_bytes;
+  }
+  cuts.push_back(text.size());
+  return cuts;
+}
+
 namespace {
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-}  // namespace
 
-void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+/// split_tokens, stopping at a token that starts with '#' where `Comments`.
+template <bool Comments>
+void split(std::string_view line, std::vector<std::string_view>& tokens) {
   tokens.clear();
   std::size_t i = 0;
   const std::size_t n = line.size();
   while (i < n) {
     while (i < n && is_blank(line[i])) ++i;
+    if (Comments && i < n && line[i] == '#') return;
     const std::size_t start = i;
     while (i < n && !is_blank(line[i])) ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
 }
+}  // namespace
 
-std::string_view strip_comment(std::string_view line) {
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    if (line[i] == '#' && (i == 0 || is_blank(line[i - 1]))) return line.substr(0, i);
-  }
-  return line;
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+  split<false>(line, tokens);
+}
+
+void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens) {
+  // A '#' at the start of the line or after a blank is exactly a '#' that starts a token.
+  split<true>(line, tokens);
+}
+
+namespace {
+/// Offset of the first non-blank byte of `line`, or its size.
+std::size_t first_non_blank(std::string_view line) {
+  std::size_t i = 0;
+  while (i < line.size() && is_blank(line[i])) ++i;
+  return i;
+}
+}  // namespace
+
+bool has_token(std::string_view line) { return first_non_blank(line) < line.size(); }
+
+bool has_token_before_comment(std::string_view line) {
+  const std::size_t i = first_non_blank(line);
+  return i < line.size() && line[i] != '#';
 }
 
 bool parse_double(std::string_view token, double& value) {
@@ -161,14 +196,24 @@ void TriangleCollector::reserve(std::size_t polygons) {
   source_.reserve(polygons);
 }
 
+std::size_t fan_triangulate(const std::int32_t* corners, std::size_t count, std::int32_t polygon,
+                            std::int32_t* triangles, std::int32_t* source) {
+  for (std::size_t k = 1; k + 1 < count; ++k) {
+    *triangles++ = corners[0];
+    *triangles++ = corners[k];
+    *triangles++ = corners[k + 1];
+    *source++ = polygon;
+  }
+  return count < 3 ? 0 : count - 2;
+}
+
 void TriangleCollector::add_polygon(const std::int32_t* corners, std::size_t count,
                                     std::int32_t polygon) {
-  for (std::size_t k = 1; k + 1 < count; ++k) {
-    corners_.push_back(corners[0]);
-    corners_.push_back(corners[k]);
-    corners_.push_back(corners[k + 1]);
-    source_.push_back(polygon);
-  }
+  const std::size_t triangles = count < 3 ? 0 : count - 2;
+  corners_.resize(corners_.size() + 3 * triangles);
+  source_.resize(source_.size() + triangles);
+  (void)fan_triangulate(corners, count, polygon, corners_.data() + corners_.size() - 3 * triangles,
+                        source_.data() + source_.size() - triangles);
 }
 
 void TriangleCollector::add_strip(const std::int32_t* corners, std::size_t count,
@@ -197,6 +242,18 @@ void TriangleCollector::move_into(Mesh& mesh) {
   mesh.face_source = Eigen::Map<const Eigen::VectorXi>(source_.data(), triangles);
   corners_ = {};
   source_ = {};
+}
+
+void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh) {
+  std::vector<Eigen::Index> start(runs.size() + 1, 0);
+  for (std::size_t r = 0; r < runs.size(); ++r) start[r + 1] = start[r] + runs[r].F.rows();
+  mesh.F.resize(start.back(), 3);
+  mesh.face_source.resize(start.back());
+  detail::parallel_chunks(static_cast<std::int64_t>(runs.size()), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    mesh.F.middleRows(start[r], runs[r].F.rows()) = runs[r].F;
+    mesh.face_source.segment(start[r], runs[r].F.rows()) = runs[r].face_source;
+  });
 }
 
 namespace {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -78,12 +79,29 @@ class LineCursor {
   std::size_t next_line_;
 };
 
+/// Bytes per run of lines that the text readers parse in parallel: large enough that a run's
+/// setup is noise, small enough that 1M-vertex files give dozens of runs to share out.
+inline constexpr std::size_t kTextChunkBytes = std::size_t{1} << 20;
+
+/// Offsets that cut `text` into runs of whole lines of about `chunk_bytes` each: 0, then
+/// repeatedly the offset just past the first '\n' at least `chunk_bytes` past the previous cut,
+/// then text.size() (increasing, no empty run). The cuts depend on the text only, never on a thread
+/// count.
+[[nodiscard]] std::vector<std::size_t> line_aligned_cuts(std::string_view text,
+                                                         std::size_t chunk_bytes);
+
 /// Splits `line` at blanks (space, tab, CR, VT, FF) into `tokens` (cleared first).
 void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 
-/// `line` up to its comment: a '#' at the start of the line or after a blank. A '#' inside a
-/// token is not a comment, so that old MSVC's "1.#QNAN" or "1.#INF" is an error, not "1.".
-[[nodiscard]] std::string_view strip_comment(std::string_view line);
+/// split_tokens of `line` up to its comment: a '#' at the start of the line or after a blank. A
+/// '#' inside a token is not a comment, so that old MSVC's "1.#QNAN" or "1.#INF" is an error,
+/// not "1.".
+void split_tokens_before_comment(std::string_view line, std::vector<std::string_view>& tokens);
+
+/// Whether split_tokens(line) gives any token, without splitting: a cheap test for element lines.
+[[nodiscard]] bool has_token(std::string_view line);
+/// Whether split_tokens_before_comment(line) gives any token, without splitting.
+[[nodiscard]] bool has_token_before_comment(std::string_view line);
 
 /// Parses a whole token as a double (std::from_chars; a leading '+', "nan" and "inf" accepted).
 /// A value below the smallest double (1e-400) underflows to a subnormal or zero, as in C; one
@@ -91,6 +109,12 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 [[nodiscard]] bool parse_double(std::string_view token, double& value);
 /// Parses a whole token as a decimal integer (a leading '+' accepted).
 [[nodiscard]] bool parse_int(std::string_view token, std::int64_t& value);
+
+/// The fan triangles (v0, vk, vk+1) of one polygon of `count` corners: writes count - 2 of them
+/// (none below 3 corners) to `triangles` (3 ints each) and `polygon` once per triangle to
+/// `source`; returns how many.
+std::size_t fan_triangulate(const std::int32_t* corners, std::size_t count, std::int32_t polygon,
+                            std::int32_t* triangles, std::int32_t* source);
 
 /// Triangles collected while reading: polygons are fan-triangulated (v0, vk, vk+1) and each
 /// triangle remembers the index of its input polygon.
@@ -110,6 +134,10 @@ class TriangleCollector {
   std::vector<std::int32_t> corners_;
   std::vector<std::int32_t> source_;
 };
+
+/// The triangles (F, face_source) of runs read in parallel, one run after the other, into
+/// mesh.F and mesh.face_source (copied on `threads` threads).
+void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh);
 
 /// Appends the shortest text that reads back to exactly `value`; NaN as `nan`, infinities as
 /// `inf` / `-inf`.
@@ -149,9 +177,10 @@ inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index 
 void weld_corners(Mesh& mesh, double tolerance, bool weld);
 
 // The per-format readers, dispatched by read_mesh().
-[[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
+/// `threads` as ReadOptions::threads (the mesh does not depend on it).
+[[nodiscard]] Mesh read_obj(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
-[[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_off(const std::filesystem::path& path, int threads);
 /// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
 [[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
@@ -160,10 +189,37 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 // parse_X(path, read_whole_file(path))); `path` only names the file in messages. The fuzz targets
 // in fuzz/ call these directly. \throw IoError as the readers.
 [[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data);
+/// parse_obj reading runs of `chunk_bytes` (line_aligned_cuts) on `threads` threads (0: the
+/// default); the Mesh, or the error, is the serial reader's for any thread count and run size.
+[[nodiscard]] Mesh parse_obj(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// The parallel read of that parse_obj alone: nothing where parse_obj falls back to the serial
+/// read (one run or one thread; a run holding an error, a control byte or a relative index).
+/// Lets tests see that the parallel read ran.
+[[nodiscard]] std::optional<Mesh> parse_obj_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
 /// parse_ply with its parallel passes on `threads` threads (0: the default).
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
+/// That parse_ply with an ascii body read as parse_obj reads a file: runs of `chunk_bytes`, the
+/// serial reader's Mesh or error whatever the thread count.
+[[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// Its parallel ascii read alone: nothing where it falls back to the serial read (and for binary
+/// files). For tests.
+[[nodiscard]] std::optional<Mesh> parse_ply_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data);
+/// parse_off reading the body (the vertex and face lines) as parse_obj reads a file: runs of
+/// `chunk_bytes` on `threads` threads, the serial reader's Mesh or error whatever the count.
+[[nodiscard]] Mesh parse_off(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// Its parallel read alone: nothing where it falls back to the serial read. For tests.
+[[nodiscard]] std::optional<Mesh> parse_off_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
 
 }  // namespace focal::io_detail

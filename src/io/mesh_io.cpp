@@ -15,7 +15,8 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::ply;
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".stl") return MeshFormat::stl;
-  if (ext == ".xyz" || ext == ".pwn" || ext == ".pts" || ext == ".txt" || ext == ".csv") return MeshFormat::xyz;
+  if (ext == ".xyz" || ext == ".pwn" || ext == ".pts" || ext == ".txt" || ext == ".csv")
+    return MeshFormat::xyz;
   io_detail::fail(path, "unknown mesh format '" + path.extension().string() +
                             "' (expected .obj, .ply, .off, .stl, or .xyz .pwn .pts .txt .csv for "
                             "point clouds)");
@@ -25,11 +26,11 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
   if (options.threads < 0) throw InvalidInput("read_mesh: threads must be >= 0");
   switch (mesh_format_from_path(path)) {
     case MeshFormat::obj:
-      return io_detail::read_obj(path);
+      return io_detail::read_obj(path, options.threads);
     case MeshFormat::ply:
       return io_detail::read_ply(path, options.threads);
     case MeshFormat::off:
-      return io_detail::read_off(path);
+      return io_detail::read_off(path, options.threads);
     case MeshFormat::stl: {
       if (!(options.weld_tolerance >= 0.0) || !std::isfinite(options.weld_tolerance)) {
         throw InvalidInput("read_mesh: weld_tolerance must be finite and >= 0");

@@ -6,8 +6,12 @@
 // The keyword's order tells the two apart; the colour (0 to 4 numbers) and texture coordinates
 // are skipped. Face lines are `n i0 .. in-1 [colour]`. `#` starts a comment.
 
+#include <atomic>
 #include <cmath>
+#include <numeric>
+#include <optional>
 
+#include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
 #include "io/atomic_file.h"
@@ -19,12 +23,27 @@ namespace {
 using io_detail::fail;
 using io_detail::fail_at_line;
 
+/// What a vertex line holds after its coordinates, from the keyword's prefixes.
+struct VertexLayout {
+  bool normals = false;
+  bool colour_before_normal = false;  ///< MeshLab's NCOFF
+  bool texture = false;
+};
+
+/// The keyword's layout and the element counts.
+struct OffHeader {
+  VertexLayout layout;
+  std::int64_t vertices = 0;
+  std::int64_t faces = 0;
+};
+
 class OffReader {
  public:
   OffReader(const std::filesystem::path& path, std::string_view text)
       : path_(path), text_(text), cursor_(text) {}
 
-  Mesh read() {
+  /// The keyword and counts; the body starts at offset().
+  OffHeader read_header() {
     if (!next_line()) fail(path_, "empty file, expected an OFF header");
     const VertexLayout layout = parse_keyword(tokens_[0]);
     tokens_.erase(tokens_.begin());
@@ -39,12 +58,33 @@ class OffReader {
     const std::string where = "line " + std::to_string(cursor_.line_number() + 1);
     io_detail::check_count_fits(path_, where, vertex_count, 2, rest, "vertices");
     io_detail::check_count_fits(path_, where, face_count, 2, rest, "faces");
+    return {layout, static_cast<std::int64_t>(vertex_count), static_cast<std::int64_t>(face_count)};
+  }
 
+  /// Offset just past the lines read so far.
+  [[nodiscard]] std::size_t offset() const { return cursor_.offset(); }
+
+  /// The vertices and faces that follow the header, in order.
+  Mesh read_body(const OffHeader& h) {
     Mesh mesh;
-    read_vertices(static_cast<Eigen::Index>(vertex_count), layout, mesh);
-    read_faces(static_cast<std::int64_t>(face_count), static_cast<std::int64_t>(vertex_count),
-               mesh);
+    read_vertices(h, mesh);
+    read_faces(h, mesh);
     return mesh;
+  }
+
+  /// The elements of a run of body lines (read_off_runs) whose first element line is element
+  /// `first` of the body (vertices, then faces; lines past the last face are not read): vertices
+  /// into their rows of `mesh`, faces into `triangles`.
+  void read_run(const OffHeader& h, std::int64_t first, Mesh& mesh,
+                io_detail::TriangleCollector& triangles) {
+    std::vector<std::int32_t> corners;
+    for (std::int64_t e = first; e < h.vertices + h.faces && next_line(); ++e) {
+      if (e < h.vertices) {
+        read_vertex(static_cast<Eigen::Index>(e), h, mesh);
+      } else {
+        read_face(e - h.vertices, h, triangles, corners);
+      }
+    }
   }
 
  private:
@@ -52,18 +92,11 @@ class OffReader {
   bool next_line() {
     std::string_view line;
     while (cursor_.next(line)) {
-      io_detail::split_tokens(io_detail::strip_comment(line), tokens_);
+      io_detail::split_tokens_before_comment(line, tokens_);
       if (!tokens_.empty()) return true;
     }
     return false;
   }
-
-  /// What a vertex line holds after its coordinates, from the keyword's prefixes.
-  struct VertexLayout {
-    bool normals = false;
-    bool colour_before_normal = false;  ///< MeshLab's NCOFF
-    bool texture = false;
-  };
 
   /// Removes `prefix` from the front of k if it is there.
   static bool take(std::string_view& k, std::string_view prefix) {
@@ -131,28 +164,34 @@ class OffReader {
     return value;
   }
 
-  void read_vertices(Eigen::Index count, VertexLayout layout, Mesh& mesh) {
-    const bool normals = layout.normals;
-    const std::size_t needed = normals ? 6 : 3;
-    mesh.V.resize(count, 3);
-    if (normals) mesh.N.resize(count, 3);
-    for (Eigen::Index i = 0; i < count; ++i) {
+  void read_vertices(const OffHeader& h, Mesh& mesh) {
+    mesh.V.resize(h.vertices, 3);
+    if (h.layout.normals) mesh.N.resize(h.vertices, 3);
+    for (Eigen::Index i = 0; i < h.vertices; ++i) {
       if (!next_line()) {
         fail_at_line(
             path_, cursor_.line_number(),
-            "file ends inside vertex " + std::to_string(i) + " of " + std::to_string(count));
+            "file ends inside vertex " + std::to_string(i) + " of " + std::to_string(h.vertices));
       }
-      if (tokens_.size() < needed) {
-        fail_at_line(path_, cursor_.line_number(),
-                     "vertex " + std::to_string(i) + ": expected " + std::to_string(needed) +
-                         (normals ? " coordinates and normal components" : " coordinates") +
-                         ", got " + std::to_string(tokens_.size()));
-      }
-      for (int c = 0; c < 3; ++c) mesh.V(i, c) = number(static_cast<std::size_t>(c));
-      if (!normals) continue;
-      const std::size_t first = layout.colour_before_normal ? normal_after_colour(i, layout) : 3;
-      for (int c = 0; c < 3; ++c) mesh.N(i, c) = number(first + static_cast<std::size_t>(c));
+      read_vertex(i, h, mesh);
     }
+  }
+
+  /// Vertex i from the current line, into row i of mesh.V (and mesh.N).
+  void read_vertex(Eigen::Index i, const OffHeader& h, Mesh& mesh) const {
+    const VertexLayout layout = h.layout;
+    const bool normals = layout.normals;
+    const std::size_t needed = normals ? 6 : 3;
+    if (tokens_.size() < needed) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "vertex " + std::to_string(i) + ": expected " + std::to_string(needed) +
+                       (normals ? " coordinates and normal components" : " coordinates") +
+                       ", got " + std::to_string(tokens_.size()));
+    }
+    for (int c = 0; c < 3; ++c) mesh.V(i, c) = number(static_cast<std::size_t>(c));
+    if (!normals) return;
+    const std::size_t first = layout.colour_before_normal ? normal_after_colour(i, layout) : 3;
+    for (int c = 0; c < 3; ++c) mesh.N(i, c) = number(first + static_cast<std::size_t>(c));
   }
 
   /// Token of the normal's first component on a MeshLab NCOFF vertex line: after the colour,
@@ -170,38 +209,45 @@ class OffReader {
     return tokens_.size() - 3 - (layout.texture ? 2 : 0);
   }
 
-  void read_faces(std::int64_t count, std::int64_t vertex_count, Mesh& mesh) {
+  void read_faces(const OffHeader& h, Mesh& mesh) {
     io_detail::TriangleCollector triangles;
-    triangles.reserve(static_cast<std::size_t>(count));
+    triangles.reserve(static_cast<std::size_t>(h.faces));
     std::vector<std::int32_t> corners;
-    for (std::int64_t f = 0; f < count; ++f) {
-      const std::string face = "face " + std::to_string(f);
+    for (std::int64_t f = 0; f < h.faces; ++f) {
       if (!next_line()) {
-        fail_at_line(path_, cursor_.line_number(),
-                     "file ends inside " + face + " of " + std::to_string(count));
+        fail_at_line(
+            path_, cursor_.line_number(),
+            "file ends inside face " + std::to_string(f) + " of " + std::to_string(h.faces));
       }
-      std::int64_t n = 0;
-      if (!io_detail::parse_int(tokens_[0], n) || n < 0) {
-        fail_at_line(path_, cursor_.line_number(),
-                     face + ": '" + std::string(tokens_[0]) + "' is not a vertex count");
-      }
-      if (n < 3) {
-        fail_at_line(path_, cursor_.line_number(),
-                     face + " has " + std::to_string(n) + " vertices; a face needs at least 3");
-      }
-      // Tokens after the indices are a colour.
-      if (tokens_.size() < static_cast<std::size_t>(n) + 1) {
-        fail_at_line(path_, cursor_.line_number(),
-                     face + ": expected " + std::to_string(n) + " vertex indices, got " +
-                         std::to_string(tokens_.size() - 1));
-      }
-      corners.resize(static_cast<std::size_t>(n));
-      for (std::size_t c = 0; c < corners.size(); ++c) {
-        corners[c] = vertex_index(tokens_[c + 1], face, vertex_count);
-      }
-      triangles.add_polygon(corners.data(), corners.size(), static_cast<std::int32_t>(f));
+      read_face(f, h, triangles, corners);
     }
     triangles.move_into(mesh);
+  }
+
+  /// Face f from the current line, fanned into `triangles` (`corners`: scratch).
+  void read_face(std::int64_t f, const OffHeader& h, io_detail::TriangleCollector& triangles,
+                 std::vector<std::int32_t>& corners) const {
+    const std::string face = "face " + std::to_string(f);
+    std::int64_t n = 0;
+    if (!io_detail::parse_int(tokens_[0], n) || n < 0) {
+      fail_at_line(path_, cursor_.line_number(),
+                   face + ": '" + std::string(tokens_[0]) + "' is not a vertex count");
+    }
+    if (n < 3) {
+      fail_at_line(path_, cursor_.line_number(),
+                   face + " has " + std::to_string(n) + " vertices; a face needs at least 3");
+    }
+    // Tokens after the indices are a colour.
+    if (tokens_.size() < static_cast<std::size_t>(n) + 1) {
+      fail_at_line(path_, cursor_.line_number(),
+                   face + ": expected " + std::to_string(n) + " vertex indices, got " +
+                       std::to_string(tokens_.size() - 1));
+    }
+    corners.resize(static_cast<std::size_t>(n));
+    for (std::size_t c = 0; c < corners.size(); ++c) {
+      corners[c] = vertex_index(tokens_[c + 1], face, h.vertices);
+    }
+    triangles.add_polygon(corners.data(), corners.size(), static_cast<std::int32_t>(f));
   }
 
   std::int32_t vertex_index(std::string_view token, const std::string& face,
@@ -225,15 +271,75 @@ class OffReader {
   std::vector<std::string_view> tokens_;
 };
 
+/// The body read as runs of lines in parallel (each run by the serial reader's code, its first
+/// element's index known from the element lines before it), or nothing when the body is too
+/// small to split, ends before its last face, or a run meets an error: the serial read then
+/// gives the exact error (whose message needs its line number) or result.
+std::optional<Mesh> read_off_runs(const std::filesystem::path& path, std::string_view body,
+                                  const OffHeader& header, int threads, std::size_t run_bytes) {
+  const std::vector<std::size_t> cuts = io_detail::line_aligned_cuts(body, run_bytes);
+  const std::size_t runs = cuts.size() - 1;
+  if (runs < 2 || detail::thread_count(threads) < 2) return std::nullopt;
+  const auto run = [&](std::size_t r) { return body.substr(cuts[r], cuts[r + 1] - cuts[r]); };
+  std::vector<std::int64_t> first(runs + 1, 0);  // element lines before each run
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    io_detail::LineCursor cursor(run(r));
+    std::string_view line;
+    while (cursor.next(line)) first[r + 1] += io_detail::has_token_before_comment(line);
+  });
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  const std::int64_t elements = header.vertices + header.faces;
+  if (first.back() < elements) return std::nullopt;
+
+  Mesh mesh;
+  mesh.V.resize(header.vertices, 3);
+  if (header.layout.normals) mesh.N.resize(header.vertices, 3);
+  std::vector<Mesh> faces(runs);  // each run's triangles
+  std::atomic<bool> serial{false};
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    if (first[r] >= elements || serial.load(std::memory_order_relaxed)) return;
+    try {
+      io_detail::TriangleCollector triangles;
+      OffReader(path, run(r)).read_run(header, first[r], mesh, triangles);
+      triangles.move_into(faces[r]);
+    } catch (const IoError&) {
+      serial.store(true, std::memory_order_relaxed);
+    }
+  });
+  if (serial.load()) return std::nullopt;
+  io_detail::join_triangles(faces, threads, mesh);
+  return mesh;
+}
+
 }  // namespace
 
 namespace io_detail {
 
 Mesh parse_off(const std::filesystem::path& path, std::string_view data) {
-  return OffReader(path, data).read();
+  return parse_off(path, data, 0, kTextChunkBytes);
 }
 
-Mesh read_off(const std::filesystem::path& path) { return parse_off(path, read_whole_file(path)); }
+std::optional<Mesh> parse_off_in_chunks(const std::filesystem::path& path, std::string_view data,
+                                        int threads, std::size_t chunk_bytes) {
+  OffReader reader(path, data);
+  const OffHeader header = reader.read_header();
+  return read_off_runs(path, data.substr(reader.offset()), header, threads, chunk_bytes);
+}
+
+Mesh parse_off(const std::filesystem::path& path, std::string_view data, int threads,
+               std::size_t chunk_bytes) {
+  OffReader reader(path, data);
+  const OffHeader header = reader.read_header();
+  std::optional<Mesh> mesh =
+      read_off_runs(path, data.substr(reader.offset()), header, threads, chunk_bytes);
+  return mesh ? std::move(*mesh) : reader.read_body(header);
+}
+
+Mesh read_off(const std::filesystem::path& path, int threads) {
+  return parse_off(path, read_whole_file(path), threads, kTextChunkBytes);
+}
 
 }  // namespace io_detail
 

@@ -2,9 +2,13 @@
 // the writer are in io/ply.h.
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <limits>
+#include <numeric>
+#include <optional>
 #include <type_traits>
+#include <utility>
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
@@ -578,27 +582,7 @@ class AsciiBody {
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
     for (std::uint64_t i = 0; i < e.count; ++i) {
       next_element(e, i);
-      std::size_t t = 0;
-      for (std::size_t k = 0; k < e.properties.size(); ++k) {
-        const auto& prop = e.properties[k];
-        if (prop.is_list) {
-          t += 1 + list_length(prop, e, i, t);
-          continue;
-        }
-        need(t + 1, e, i);
-        const int role = roles[k];
-        if (role >= 0) {
-          double value = 0.0;
-          if (!io_detail::parse_double(tokens_[t], value)) not_a_number(e, i, tokens_[t]);
-          if (role < 3) {
-            V[3 * i + role] = value;
-          } else {
-            N[3 * i + role - 3] = value;
-          }
-        }
-        ++t;
-      }
-      finish_element(t, e, i);
+      read_vertex(e, roles, i, V, N);
     }
   }
 
@@ -607,18 +591,7 @@ class AsciiBody {
     std::vector<std::int32_t> corners;
     for (std::uint64_t f = 0; f < e.count; ++f) {
       next_element(e, f);
-      std::size_t t = 0;
-      for (std::size_t k = 0; k < e.properties.size(); ++k) {
-        const auto& prop = e.properties[k];
-        if (!prop.is_list) {
-          need(++t, e, f);
-          continue;
-        }
-        const std::size_t n = list_length(prop, e, f, t);
-        if (k == list_prop) read_polygon(e, t + 1, n, f, vertex_count, kind, corners, triangles);
-        t += 1 + n;
-      }
-      finish_element(t, e, f);
+      read_face(e, list_prop, vertex_count, kind, f, corners, triangles);
     }
   }
 
@@ -626,26 +599,81 @@ class AsciiBody {
     if (e.properties.empty()) return;  // such elements occupy no text at all
     for (std::uint64_t i = 0; i < e.count; ++i) {
       next_element(e, i);
-      std::size_t t = 0;
-      for (const auto& prop : e.properties) {
-        t += prop.is_list ? 1 + list_length(prop, e, i, t) : 1;
-        need(t, e, i);
-      }
-      finish_element(t, e, i);
+      check_element(e, i);
     }
+  }
+
+  /// Next line with tokens; false at the end of the text.
+  bool next_line() {
+    std::string_view line;
+    while (cursor_.next(line)) {
+      io_detail::split_tokens(line, tokens_);
+      if (!tokens_.empty()) return true;
+    }
+    return false;
+  }
+
+  /// Vertex i from the current line into V (and N) by the properties' roles.
+  void read_vertex(const PlyElement& e, const std::vector<int>& roles, std::uint64_t i, double* V,
+                   double* N) const {
+    std::size_t t = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const auto& prop = e.properties[k];
+      if (prop.is_list) {
+        t += 1 + list_length(prop, e, i, t);
+        continue;
+      }
+      need(t + 1, e, i);
+      const int role = roles[k];
+      if (role >= 0) {
+        double value = 0.0;
+        if (!io_detail::parse_double(tokens_[t], value)) not_a_number(e, i, tokens_[t]);
+        if (role < 3) {
+          V[3 * i + role] = value;
+        } else {
+          N[3 * i + role - 3] = value;
+        }
+      }
+      ++t;
+    }
+    finish_element(t, e, i);
+  }
+
+  /// Face list f from the current line into `triangles` (`corners`: scratch).
+  void read_face(const PlyElement& e, std::size_t list_prop, std::int64_t vertex_count,
+                 FaceLists kind, std::uint64_t f, std::vector<std::int32_t>& corners,
+                 io_detail::TriangleCollector& triangles) const {
+    std::size_t t = 0;
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const auto& prop = e.properties[k];
+      if (!prop.is_list) {
+        need(++t, e, f);
+        continue;
+      }
+      const std::size_t n = list_length(prop, e, f, t);
+      if (k == list_prop) read_polygon(e, t + 1, n, f, vertex_count, kind, corners, triangles);
+      t += 1 + n;
+    }
+    finish_element(t, e, f);
+  }
+
+  /// Element i of a skipped element from the current line: only its token count is checked.
+  void check_element(const PlyElement& e, std::uint64_t i) const {
+    std::size_t t = 0;
+    for (const auto& prop : e.properties) {
+      t += prop.is_list ? 1 + list_length(prop, e, i, t) : 1;
+      need(t, e, i);
+    }
+    finish_element(t, e, i);
   }
 
  private:
   void next_element(const PlyElement& e, std::uint64_t index) {
-    std::string_view line;
-    do {
-      if (!cursor_.next(line)) {
-        fail_at_line(path_, cursor_.line_number(),
-                     "file ends inside " + e.name + " " + std::to_string(index) + " of " +
-                         std::to_string(e.count));
-      }
-      io_detail::split_tokens(line, tokens_);
-    } while (tokens_.empty());
+    if (!next_line()) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "file ends inside " + e.name + " " + std::to_string(index) + " of " +
+                       std::to_string(e.count));
+    }
   }
 
   [[noreturn]] void wrong_count(const PlyElement& e, std::uint64_t index,
@@ -696,7 +724,7 @@ class AsciiBody {
 
   void read_polygon(const PlyElement& e, std::size_t first, std::size_t n, std::uint64_t f,
                     std::int64_t vertex_count, FaceLists kind, std::vector<std::int32_t>& corners,
-                    io_detail::TriangleCollector& triangles) {
+                    io_detail::TriangleCollector& triangles) const {
     const std::size_t line = cursor_.line_number();
     check_list_length(path_, "line " + std::to_string(line), static_cast<std::int64_t>(n), f, kind);
     corners.resize(n);
@@ -721,62 +749,188 @@ class AsciiBody {
   std::vector<std::string_view> tokens_;
 };
 
-/// Reads every element in file order with `Body` (BinaryBody or AsciiBody).
-template <class Body>
-Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, Body& body) {
-  const auto vertex_it = std::find_if(header.elements.begin(), header.elements.end(),
-                                      [](const PlyElement& e) { return e.name == "vertex"; });
-  if (vertex_it == header.elements.end()) fail(path, "the header has no vertex element");
-  bool has_normals = false;
-  const std::vector<int> roles = vertex_roles(path, *vertex_it, has_normals);
-  const auto vertex_count = static_cast<std::int64_t>(vertex_it->count);
+/// What read_body does with an element: the first `vertex`, `face` and `tristrips` elements are
+/// read, any other element (and any repeat of those) is skipped.
+enum class ElementRole { vertices, faces, strips, skip };
 
+/// What the header says about the body, before any of it is read.
+struct BodyPlan {
+  std::vector<int> roles;  // vertex_roles
+  bool has_normals = false;
+  std::int64_t vertex_count = 0;
+  std::int32_t faces_before_strips = 0;  // strip triangles are numbered after the faces
+  bool has_strips = false;
+  std::vector<ElementRole> element_roles;  // per header element
+};
+
+BodyPlan plan_body(const std::filesystem::path& path, const PlyHeader& header) {
   const auto element_named = [&](std::string_view name) {
     return std::find_if(header.elements.begin(), header.elements.end(),
                         [name](const PlyElement& e) { return e.name == name; });
   };
+  const auto vertex_it = element_named("vertex");
+  if (vertex_it == header.elements.end()) fail(path, "the header has no vertex element");
+  BodyPlan plan;
+  plan.roles = vertex_roles(path, *vertex_it, plan.has_normals);
+  plan.vertex_count = static_cast<std::int64_t>(vertex_it->count);
   const auto face_it = element_named("face");
-  const bool has_strips = element_named("tristrips") != header.elements.end();
-  // Strip triangles are numbered after the faces in Mesh::face_source.
-  const auto faces_before_strips =
+  plan.has_strips = element_named("tristrips") != header.elements.end();
+  plan.faces_before_strips =
       static_cast<std::int32_t>(face_it == header.elements.end() ? 0 : face_it->count);
+  bool vertices = false, faces = false, strips = false;
+  for (const PlyElement& e : header.elements) {
+    ElementRole role = ElementRole::skip;
+    if (e.name == "vertex" && !std::exchange(vertices, true)) role = ElementRole::vertices;
+    if (e.name == "face" && !std::exchange(faces, true)) role = ElementRole::faces;
+    if (e.name == "tristrips" && !std::exchange(strips, true)) role = ElementRole::strips;
+    plan.element_roles.push_back(role);
+  }
+  return plan;
+}
 
+/// mesh.V (and mesh.N) for the vertex element, advised onto huge pages before they are written.
+void allocate_vertices(Mesh& mesh, const PlyElement& e, bool normals) {
+  mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
+  detail::advise_huge_pages(mesh.V.data(), sizeof(double) * mesh.V.size());
+  if (normals) {
+    mesh.N.resize(static_cast<Eigen::Index>(e.count), 3);
+    detail::advise_huge_pages(mesh.N.data(), sizeof(double) * mesh.N.size());
+  }
+}
+
+FaceLists face_lists(ElementRole role, const BodyPlan& plan) {
+  if (role == ElementRole::strips)
+    return {.strips = true, .first_source = plan.faces_before_strips};
+  return {};
+}
+
+/// Reads every element in file order with `Body` (BinaryBody or AsciiBody).
+template <class Body>
+Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, const BodyPlan& plan,
+               Body& body) {
   Mesh mesh;
   io_detail::TriangleCollector triangles;
-  bool vertices_done = false;
-  bool faces_done = false;
-  bool strips_done = false;
   bool faces_direct = false;  // read_triangle_faces() filled mesh.F and mesh.face_source
-  for (const PlyElement& e : header.elements) {
+  for (std::size_t j = 0; j < header.elements.size(); ++j) {
+    const PlyElement& e = header.elements[j];
+    const ElementRole role = plan.element_roles[j];
     body.check_fits(e);
-    if (e.name == "vertex" && !vertices_done) {
-      mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
-      detail::advise_huge_pages(mesh.V.data(), sizeof(double) * mesh.V.size());
-      if (has_normals) {
-        mesh.N.resize(static_cast<Eigen::Index>(e.count), 3);
-        detail::advise_huge_pages(mesh.N.data(), sizeof(double) * mesh.N.size());
-      }
-      body.read_vertices(e, roles, mesh.V.data(), has_normals ? mesh.N.data() : nullptr);
-      vertices_done = true;
-    } else if (e.name == "face" && !faces_done) {
+    if (role == ElementRole::vertices) {
+      allocate_vertices(mesh, e, plan.has_normals);
+      body.read_vertices(e, plan.roles, mesh.V.data(), plan.has_normals ? mesh.N.data() : nullptr);
+    } else if (role == ElementRole::faces || role == ElementRole::strips) {
       const std::size_t list_prop = face_list_property(path, e);
       if constexpr (std::is_same_v<Body, BinaryBody>) {
-        if (!has_strips) faces_direct = body.read_triangle_faces(e, list_prop, vertex_count, mesh);
+        if (role == ElementRole::faces && !plan.has_strips) {
+          faces_direct = body.read_triangle_faces(e, list_prop, plan.vertex_count, mesh);
+        }
       }
       if (!faces_direct) {
-        triangles.reserve(static_cast<std::size_t>(e.count));
-        body.read_faces(e, list_prop, vertex_count, FaceLists{}, triangles);
+        if (role == ElementRole::faces) triangles.reserve(static_cast<std::size_t>(e.count));
+        body.read_faces(e, list_prop, plan.vertex_count, face_lists(role, plan), triangles);
       }
-      faces_done = true;
-    } else if (e.name == "tristrips" && !strips_done) {
-      body.read_faces(e, face_list_property(path, e), vertex_count,
-                      FaceLists{.strips = true, .first_source = faces_before_strips}, triangles);
-      strips_done = true;
     } else {
       body.skip_element(e);
     }
   }
   if (!faces_direct) triangles.move_into(mesh);
+  return mesh;
+}
+
+/// Where the ascii body's elements start, counted in lines with tokens (elements without
+/// properties take no line), and each face element's list property.
+struct AsciiLayout {
+  std::vector<std::uint64_t> start;  // per header element, then the total
+  std::vector<std::size_t> list_prop;
+};
+
+/// The elements whose lines fall in one run of the ascii body; `g` counts the lines with tokens
+/// before the run.
+void read_ascii_run(const std::filesystem::path& path, const PlyHeader& header,
+                    const BodyPlan& plan, const AsciiLayout& layout, std::string_view text,
+                    std::uint64_t g, Mesh& mesh, io_detail::TriangleCollector& triangles) {
+  AsciiBody body(path, text, 1);
+  std::vector<std::int32_t> corners;
+  std::size_t j = 0;
+  for (; g < layout.start.back() && body.next_line(); ++g) {
+    while (layout.start[j + 1] <= g) ++j;
+    const PlyElement& e = header.elements[j];
+    const std::uint64_t i = g - layout.start[j];
+    const ElementRole role = plan.element_roles[j];
+    if (role == ElementRole::vertices) {
+      body.read_vertex(e, plan.roles, i, mesh.V.data(), plan.has_normals ? mesh.N.data() : nullptr);
+    } else if (role == ElementRole::faces || role == ElementRole::strips) {
+      body.read_face(e, layout.list_prop[j], plan.vertex_count, face_lists(role, plan), i, corners,
+                     triangles);
+    } else {
+      body.check_element(e, i);
+    }
+  }
+}
+
+/// The ascii body read as runs of lines in parallel, as parse_obj reads an OBJ: a first pass
+/// counts each run's lines with tokens, so each run knows the element (and its index) its first
+/// line holds; a second reads the runs with AsciiBody's own read_vertex / read_face /
+/// check_element. Nothing when the body is too small to split, ends early, or a run meets an
+/// error (or a face element lacks its list property): the serial read then gives the exact error.
+std::optional<Mesh> read_ascii_runs(const std::filesystem::path& path, const PlyHeader& header,
+                                    const BodyPlan& plan, std::string_view body, int threads,
+                                    std::size_t run_bytes) {
+  const std::vector<std::size_t> cuts = io_detail::line_aligned_cuts(body, run_bytes);
+  const std::size_t runs = cuts.size() - 1;
+  if (runs < 2 || detail::thread_count(threads) < 2) return std::nullopt;
+  AsciiLayout layout{{0}, {}};
+  for (std::size_t j = 0; j < header.elements.size(); ++j) {
+    const PlyElement& e = header.elements[j];
+    const bool text = !e.properties.empty();
+    // Counts the serial read's check_fits would refuse (the lines counted below always fit).
+    if (text && e.count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
+      return std::nullopt;
+    }
+    std::size_t list_prop = 0;
+    if (plan.element_roles[j] == ElementRole::faces ||
+        plan.element_roles[j] == ElementRole::strips) {
+      try {
+        list_prop = face_list_property(path, e);
+      } catch (const IoError&) {
+        return std::nullopt;
+      }
+    }
+    layout.list_prop.push_back(list_prop);
+    layout.start.push_back(layout.start.back() + (text ? e.count : 0));
+  }
+  const auto run = [&](std::size_t r) { return body.substr(cuts[r], cuts[r + 1] - cuts[r]); };
+  std::vector<std::uint64_t> first(runs + 1, 0);  // lines with tokens before each run
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    io_detail::LineCursor cursor(run(r));
+    std::string_view line;
+    while (cursor.next(line)) first[r + 1] += io_detail::has_token(line);
+  });
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  if (first.back() < layout.start.back()) return std::nullopt;
+
+  Mesh mesh;
+  for (std::size_t j = 0; j < header.elements.size(); ++j) {
+    if (plan.element_roles[j] == ElementRole::vertices) {
+      allocate_vertices(mesh, header.elements[j], plan.has_normals);
+    }
+  }
+  std::vector<Mesh> faces(runs);  // each run's triangles
+  std::atomic<bool> serial{false};
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    if (serial.load(std::memory_order_relaxed)) return;
+    try {
+      io_detail::TriangleCollector triangles;
+      read_ascii_run(path, header, plan, layout, run(r), first[r], mesh, triangles);
+      triangles.move_into(faces[r]);
+    } catch (const IoError&) {
+      serial.store(true, std::memory_order_relaxed);
+    }
+  });
+  if (serial.load()) return std::nullopt;
+  io_detail::join_triangles(faces, threads, mesh);
   return mesh;
 }
 
@@ -793,15 +947,34 @@ Mesh parse_ply(const std::filesystem::path& path, std::string_view data) {
 }
 
 Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads) {
+  return parse_ply(path, data, threads, kTextChunkBytes);
+}
+
+std::optional<Mesh> parse_ply_in_chunks(const std::filesystem::path& path, std::string_view data,
+                                        int threads, std::size_t chunk_bytes) {
   const PlyHeader header = parse_header(path, data);
+  if (header.encoding != PlyEncoding::ascii) return std::nullopt;
+  const BodyPlan plan = plan_body(path, header);
+  return read_ascii_runs(path, header, plan, data.substr(header.body_offset), threads, chunk_bytes);
+}
+
+Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads,
+               std::size_t chunk_bytes) {
+  const PlyHeader header = parse_header(path, data);
+  const BodyPlan plan = plan_body(path, header);
   if (header.encoding == PlyEncoding::ascii) {
-    AsciiBody body(path, data.substr(header.body_offset), header.body_line);
-    return read_body(path, header, body);
+    const std::string_view text = data.substr(header.body_offset);
+    if (std::optional<Mesh> mesh =
+            read_ascii_runs(path, header, plan, text, threads, chunk_bytes)) {
+      return std::move(*mesh);
+    }
+    AsciiBody body(path, text, header.body_line);
+    return read_body(path, header, plan, body);
   }
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
   const bool host_big = std::endian::native == std::endian::big;
   BinaryBody body(path, data, header.body_offset, file_big != host_big, threads);
-  return read_body(path, header, body);
+  return read_body(path, header, plan, body);
 }
 
 }  // namespace io_detail

@@ -39,7 +39,7 @@ enum class MeshFormat { obj, ply, off, stl, xyz };
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
 struct ReadOptions {
-  /// Threads of the parallel passes (binary PLY): 0 for FOCAL_NUM_THREADS if set, else all
+  /// Threads of the parallel passes (binary PLY, OBJ, OFF): 0 for FOCAL_NUM_THREADS if set, else all
   /// hardware threads. The mesh read does not depend on it.
   int threads = 0;
   /// STL: weld facet corners into shared vertices (false: every corner is its own vertex, in file
