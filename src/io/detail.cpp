@@ -1,5 +1,6 @@
 #include "io/detail.h"
 
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <system_error>
 
 #include "core/parallel.h"
@@ -244,6 +246,25 @@ void TriangleCollector::move_into(Mesh& mesh) {
   source_ = {};
 }
 
+std::vector<std::int64_t> lines_before_runs(std::string_view body,
+                                            std::span<const std::size_t> cuts, int threads,
+                                            bool (*counts)(std::string_view)) {
+  const std::size_t runs = cuts.size() - 1;
+  std::vector<std::int64_t> first(runs + 1, 0);
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    LineCursor cursor(body.substr(cuts[r], cuts[r + 1] - cuts[r]));
+    std::string_view line;
+    while (cursor.next(line)) first[r + 1] += counts(line);
+  });
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  return first;
+}
+
+namespace {
+
+/// The triangles (F, face_source) of runs read in parallel, one run after the other, into
+/// mesh.F and mesh.face_source (copied on `threads` threads).
 void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh) {
   std::vector<Eigen::Index> start(runs.size() + 1, 0);
   for (std::size_t r = 0; r < runs.size(); ++r) start[r + 1] = start[r] + runs[r].F.rows();
@@ -254,6 +275,28 @@ void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh) {
     mesh.F.middleRows(start[r], runs[r].F.rows()) = runs[r].F;
     mesh.face_source.segment(start[r], runs[r].F.rows()) = runs[r].face_source;
   });
+}
+
+}  // namespace
+
+bool read_runs_joined(std::size_t runs, int threads, Mesh& mesh,
+                      const std::function<void(std::size_t, TriangleCollector&)>& read_run) {
+  std::vector<Mesh> faces(runs);  // each run's triangles
+  std::atomic<bool> failed{false};
+  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
+    const auto r = static_cast<std::size_t>(c);
+    if (failed.load(std::memory_order_relaxed)) return;
+    try {
+      TriangleCollector triangles;
+      read_run(r, triangles);
+      triangles.move_into(faces[r]);
+    } catch (const IoError&) {
+      failed.store(true, std::memory_order_relaxed);
+    }
+  });
+  if (failed.load()) return false;
+  join_triangles(faces, threads, mesh);
+  return true;
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -135,9 +136,19 @@ class TriangleCollector {
   std::vector<std::int32_t> source_;
 };
 
-/// The triangles (F, face_source) of runs read in parallel, one run after the other, into
-/// mesh.F and mesh.face_source (copied on `threads` threads).
-void join_triangles(std::span<const Mesh> runs, int threads, Mesh& mesh);
+/// For the runs of `body` cut at `cuts` (runs + 1 offsets), how many of its lines before each
+/// run `counts` (prefix sums: runs + 1 entries, the last the whole body's), counted in parallel.
+[[nodiscard]] std::vector<std::int64_t> lines_before_runs(std::string_view body,
+                                                          std::span<const std::size_t> cuts,
+                                                          int threads,
+                                                          bool (*counts)(std::string_view));
+
+/// Reads the runs in parallel, read_run(r, triangles) each, and joins their triangles into
+/// mesh.F and mesh.face_source in run order. False, mesh's faces unset, when a run throws
+/// IoError: the caller then reads serially, which gives the exact error (its line number).
+[[nodiscard]] bool read_runs_joined(
+    std::size_t runs, int threads, Mesh& mesh,
+    const std::function<void(std::size_t, TriangleCollector&)>& read_run);
 
 /// Appends the shortest text that reads back to exactly `value`; NaN as `nan`, infinities as
 /// `inf` / `-inf`.

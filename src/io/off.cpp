@@ -6,9 +6,7 @@
 // The keyword's order tells the two apart; the colour (0 to 4 numbers) and texture coordinates
 // are skipped. Face lines are `n i0 .. in-1 [colour]`. `#` starts a comment.
 
-#include <atomic>
 #include <cmath>
-#include <numeric>
 #include <optional>
 
 #include "core/parallel.h"
@@ -281,35 +279,20 @@ std::optional<Mesh> read_off_runs(const std::filesystem::path& path, std::string
   const std::size_t runs = cuts.size() - 1;
   if (runs < 2 || detail::thread_count(threads) < 2) return std::nullopt;
   const auto run = [&](std::size_t r) { return body.substr(cuts[r], cuts[r + 1] - cuts[r]); };
-  std::vector<std::int64_t> first(runs + 1, 0);  // element lines before each run
-  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
-    const auto r = static_cast<std::size_t>(c);
-    io_detail::LineCursor cursor(run(r));
-    std::string_view line;
-    while (cursor.next(line)) first[r + 1] += io_detail::has_token_before_comment(line);
-  });
-  std::partial_sum(first.begin(), first.end(), first.begin());
+  const std::vector<std::int64_t> first =  // element lines before each run
+      io_detail::lines_before_runs(body, cuts, threads, io_detail::has_token_before_comment);
   const std::int64_t elements = header.vertices + header.faces;
   if (first.back() < elements) return std::nullopt;
 
   Mesh mesh;
   mesh.V.resize(header.vertices, 3);
   if (header.layout.normals) mesh.N.resize(header.vertices, 3);
-  std::vector<Mesh> faces(runs);  // each run's triangles
-  std::atomic<bool> serial{false};
-  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
-    const auto r = static_cast<std::size_t>(c);
-    if (first[r] >= elements || serial.load(std::memory_order_relaxed)) return;
-    try {
-      io_detail::TriangleCollector triangles;
-      OffReader(path, run(r)).read_run(header, first[r], mesh, triangles);
-      triangles.move_into(faces[r]);
-    } catch (const IoError&) {
-      serial.store(true, std::memory_order_relaxed);
-    }
-  });
-  if (serial.load()) return std::nullopt;
-  io_detail::join_triangles(faces, threads, mesh);
+  const bool read = io_detail::read_runs_joined(
+      runs, threads, mesh, [&](std::size_t r, io_detail::TriangleCollector& triangles) {
+        if (first[r] < elements)
+          OffReader(path, run(r)).read_run(header, first[r], mesh, triangles);
+      });
+  if (!read) return std::nullopt;
   return mesh;
 }
 

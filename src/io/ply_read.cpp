@@ -2,10 +2,8 @@
 // the writer are in io/ply.h.
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <limits>
-#include <numeric>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -900,15 +898,9 @@ std::optional<Mesh> read_ascii_runs(const std::filesystem::path& path, const Ply
     layout.start.push_back(layout.start.back() + (text ? e.count : 0));
   }
   const auto run = [&](std::size_t r) { return body.substr(cuts[r], cuts[r + 1] - cuts[r]); };
-  std::vector<std::uint64_t> first(runs + 1, 0);  // lines with tokens before each run
-  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
-    const auto r = static_cast<std::size_t>(c);
-    io_detail::LineCursor cursor(run(r));
-    std::string_view line;
-    while (cursor.next(line)) first[r + 1] += io_detail::has_token(line);
-  });
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  if (first.back() < layout.start.back()) return std::nullopt;
+  const std::vector<std::int64_t> first =  // lines with tokens before each run
+      io_detail::lines_before_runs(body, cuts, threads, io_detail::has_token);
+  if (static_cast<std::uint64_t>(first.back()) < layout.start.back()) return std::nullopt;
 
   Mesh mesh;
   for (std::size_t j = 0; j < header.elements.size(); ++j) {
@@ -916,21 +908,12 @@ std::optional<Mesh> read_ascii_runs(const std::filesystem::path& path, const Ply
       allocate_vertices(mesh, header.elements[j], plan.has_normals);
     }
   }
-  std::vector<Mesh> faces(runs);  // each run's triangles
-  std::atomic<bool> serial{false};
-  detail::parallel_chunks(static_cast<std::int64_t>(runs), threads, [&](std::int64_t c) {
-    const auto r = static_cast<std::size_t>(c);
-    if (serial.load(std::memory_order_relaxed)) return;
-    try {
-      io_detail::TriangleCollector triangles;
-      read_ascii_run(path, header, plan, layout, run(r), first[r], mesh, triangles);
-      triangles.move_into(faces[r]);
-    } catch (const IoError&) {
-      serial.store(true, std::memory_order_relaxed);
-    }
-  });
-  if (serial.load()) return std::nullopt;
-  io_detail::join_triangles(faces, threads, mesh);
+  const bool read = io_detail::read_runs_joined(
+      runs, threads, mesh, [&](std::size_t r, io_detail::TriangleCollector& triangles) {
+        read_ascii_run(path, header, plan, layout, run(r), static_cast<std::uint64_t>(first[r]),
+                       mesh, triangles);
+      });
+  if (!read) return std::nullopt;
   return mesh;
 }
 
