@@ -112,6 +112,54 @@ done
 mesh=$(bunny 0)
 for t in 1 2; do report "bunny/0" "$mesh" "$t" ""; done
 
+# Readers: the read stage of `focal -v info FILE` (parse, and for STL the weld) on the 1M torus in
+# every format, 1 and 2 threads (FOCAL_NUM_THREADS), fastest of $reps; OBJ and OFF from `focal
+# generate`, STL binary and ascii exported by trimesh from the peers' venv when it is there.
+read_ms() {
+  local file=$1 threads=$2 best="" rss_max=0  # $3: the format's name
+  for ((r = 0; r < reps; r++)); do
+    FOCAL_NUM_THREADS=$threads /usr/bin/time -f "%M" -o "$scratch/time" \
+      "$focal" -v info "$file" 2>"$scratch/log" >/dev/null
+    local ms rss
+    ms=$(awk '$1 == "read:" && $NF == "ms" {t = $2} END {print t + 0}' "$scratch/log")
+    rss=$(tail -n1 "$scratch/time")
+    ((rss > rss_max)) && rss_max=$rss
+    if [[ -z $best ]] || awk -v a="$ms" -v b="$best" 'BEGIN {exit !(a < b)}'; then best=$ms; fi
+  done
+  printf "| %-11s | %6.0f | %d | %7.0f | %6.0f |\n" "$3" \
+    "$(($(stat -c %s "$file") / 1000000))" "$threads" "$best" "$((rss_max / 1024))"
+}
+if ((max >= 1000000)); then
+  echo
+  echo "Readers: focal -v info FILE, the 1M-vertex torus; read stage (ms) of the fastest of $reps,"
+  echo "largest peak RSS"
+  echo
+  echo "| format      |     MB | T | read ms | RSS MB |"
+  echo "|-------------|-------:|--:|--------:|-------:|"
+  for ext in obj off; do
+    [[ -f $data/torus-1000000.$ext ]] ||
+      "$focal" generate torus --vertices 1000000 -o "$data/torus-1000000.$ext" >&2
+  done
+  if [[ -x $(dirname "$0")/peers/.venv/bin/python && ! -f $data/torus-1000000-ascii.stl ]]; then
+    "$(dirname "$0")/peers/.venv/bin/python" - "$(torus 1000000)" "$data/torus-1000000" <<'PY' >&2
+import sys, trimesh
+mesh = trimesh.load(sys.argv[1], process=False)
+mesh.export(sys.argv[2] + "-binary.stl")
+with open(sys.argv[2] + "-ascii.stl", "w") as f:
+    f.write(trimesh.exchange.stl.export_stl_ascii(mesh))
+PY
+  fi
+  for t in 1 2; do
+    read_ms "$(torus 1000000)" "$t" "PLY binary"
+    read_ms "$data/torus-1000000.obj" "$t" "OBJ"
+    read_ms "$data/torus-1000000.off" "$t" "OFF"
+    for kind in binary ascii; do
+      file=$data/torus-1000000-$kind.stl
+      if [[ -f $file ]]; then read_ms "$file" "$t" "STL $kind"; fi
+    done
+  done
+fi
+
 # Peers (libigl, pymeshlab, trimesh, VTK) on the bunny as ratios to focal, from their own venv
 # made by bench/peers/setup.sh; skipped, with a line saying so, when it is not there. Then the
 # side-by-side table of issue 19 on the 1M-vertex torus: focal default and --paper (compute and

@@ -1,11 +1,15 @@
-// The parallel text readers (issue 19: OBJ, OFF, ascii PLY): a file read in runs of lines on any
-// number of threads gives the serial reader's Mesh bit for bit, and its errors word for word.
+// The parallel text readers (issue 19: OBJ, OFF, ascii PLY, ascii STL): a file read in runs of
+// lines on any number of threads gives the serial reader's Mesh bit for bit, and its errors word
+// for word; the STL weld gives the same vertices on any number of threads.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cstring>
+#include <limits>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -558,6 +562,151 @@ TEST(PlyParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
 TEST(PlyParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
   // Edits in the header give header errors, which both reads report before reading any run.
   expect_same_outcomes(static_cast<Parser>(&io_detail::parse_ply), ply_text(), 2026);
+}
+
+// ASCII STL: runs cut where a facet opens, each read as a file of its own and renumbered.
+
+const std::filesystem::path kStlPath = "grid.stl";
+
+/// The facet through `corners` (each corner a grid vertex r * kCols + c), keyword case and
+/// layout varied by `form`.
+void append_facet(std::string& out, const std::vector<int>& corners, int form) {
+  const bool upper = form % 7 == 0;
+  out += form % 5 == 0 ? "\tfacet normal 0 0 1\r\n"
+                       : (upper ? "FACET NORMAL 0 0 1\n" : "facet normal 0 0 1\n");
+  out += upper ? "  OUTER LOOP\n" : "  outer loop\n";
+  for (const int v : corners) {
+    const double x = 0.1 * (v % kCols) + 1e-7, y = 0.1 * (v / kCols), z = 0.01 * (v % 13);
+    out += (upper ? "    VERTEX " : "    vertex ") + number(x) + " " + number(y) + "\t" +
+           number(z) + "\n";
+  }
+  out += upper ? "  ENDLOOP\nENDFACET\n" : "  endloop\nendfacet\n";
+  if (form % 11 == 0) out += "# a comment line\n\n";
+}
+
+/// Two solids over the grid's cells: triangles, quads (two triangles each) and upper-case
+/// keywords, CRLF, tabs, comments and blank lines between facets.
+std::string stl_text() {
+  std::string out = "solid grid\n";
+  for (int r = 0; r + 1 < kRows; ++r) {
+    if (r == kRows / 2) out += "endsolid grid\nsolid second half\n";
+    for (int c = 0; c + 1 < kCols; ++c) {
+      const int a = r * kCols + c, b = a + 1, d = a + kCols + 1, e = a + kCols;
+      if (c % 4 == 1) {
+        append_facet(out, {a, b, d, e}, r + c);
+      } else {
+        append_facet(out, {a, b, d}, r + c);
+        append_facet(out, {a, d, e}, r + c + 1);
+      }
+    }
+  }
+  return out + "endsolid second half\n";
+}
+
+TEST(StlParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
+  const std::string text = stl_text();
+  const Mesh serial = io_detail::parse_stl(kStlPath, text, 1, io_detail::kTextChunkBytes);
+  // Per row of cells: 15 quads (cells c = 1, 5, ...) and 44 pairs of triangles.
+  const int facets_per_row = 15 + 2 * 44;
+  ASSERT_EQ(serial.F.rows(), (kRows - 1) * (15 * 2 + 44 * 2));
+  EXPECT_EQ(serial.face_source.maxCoeff(), (kRows - 1) * facets_per_row - 1);
+  EXPECT_EQ(serial.V.rows(), (kRows - 1) * (15 * 4 + 44 * 6));
+  for (const std::size_t run : kRunBytes) {
+    for (const int threads : kThreads) {
+      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
+      expect_same_mesh(io_detail::parse_stl(kStlPath, text, threads, run), serial);
+      const std::optional<Mesh> parallel =
+          io_detail::parse_stl_in_chunks(kStlPath, text, threads, run);
+      ASSERT_EQ(parallel.has_value(), threads > 1);
+      if (parallel) expect_same_mesh(*parallel, serial);
+    }
+  }
+}
+
+std::string stl_error(std::string_view text, int threads, std::size_t run_bytes) {
+  try {
+    (void)io_detail::parse_stl(kStlPath, text, threads, run_bytes);
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(StlParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
+  const std::string text = stl_text();
+  const std::size_t v_line = line_in_the_middle(text, "    vertex ");
+  const std::size_t f_line = line_in_the_middle(text, "facet normal");
+  const std::vector<std::string> broken{
+      with_line(text, v_line, "    vertex 1 2"),
+      with_line(text, v_line, "    vertex 1 2x 3"),
+      with_line(text, v_line, "    vertx 1 2 3"),
+      with_line(text, f_line, "  outer loop"),   // a facet without its `facet` line
+      with_line(text, f_line, "endsolid grid"),  // a solid closed inside another's facets
+      with_line(text, v_line, "endfacet"),       // a facet cut before its loop ends
+      text.substr(0, line_start(text, f_line)),  // the file ends inside a solid
+  };
+  for (std::size_t b = 0; b < broken.size(); ++b) {
+    const std::string serial = stl_error(broken[b], 1, io_detail::kTextChunkBytes);
+    EXPECT_NE(serial, "no error") << b;
+    for (const std::size_t run : kRunBytes) {
+      for (const int threads : kThreads) {
+        EXPECT_EQ(stl_error(broken[b], threads, run), serial)
+            << "case " << b << ", run bytes " << run << ", threads " << threads;
+      }
+    }
+  }
+}
+
+TEST(StlParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
+  expect_same_outcomes(static_cast<Parser>(&io_detail::parse_stl), stl_text(), 2027);
+}
+
+// The exact weld: the first corner of each position, on any number of threads, by hashes first
+// (then checked) or by positions throughout.
+
+TEST(StlWeld, FirstEqualCornersAreTheSameOnEveryThreadCountAndEitherWay) {
+  std::mt19937 rng(7);
+  RowMatrixX3d V(200000, 3);  // 200,000 corners over about 20,000 positions, -0 and NaN among them
+  std::vector<std::array<double, 3>> positions(20000);
+  for (auto& p : positions) {
+    for (double& x : p) x = static_cast<double>(rng() % 1000) / 7.0 - 50.0;
+  }
+  positions[3] = {0.0, 0.0, 0.0};
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const auto& p = positions[rng() % positions.size()];
+    V.row(i) << p[0], p[1], p[2];
+    if (p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0 && i % 2 == 1) V(i, 1) = -0.0;
+    if (i % 997 == 0) V(i, 2) = std::numeric_limits<double>::quiet_NaN();
+  }
+  // The serial definition: the first earlier corner with the same coordinates (-0 == 0, NaN
+  // equal to nothing).
+  std::vector<std::int32_t> expected(static_cast<std::size_t>(V.rows()));
+  std::map<std::array<double, 3>, std::int32_t> first_of;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    expected[i] = static_cast<std::int32_t>(i);
+    if (!V.row(i).allFinite()) continue;
+    const std::array<double, 3> key{V(i, 0) + 0.0, V(i, 1) + 0.0, V(i, 2) + 0.0};
+    expected[i] = first_of.emplace(key, static_cast<std::int32_t>(i)).first->second;
+  }
+  EXPECT_GT(first_of.size(), 15000u);
+  for (const int threads : kThreads) {
+    for (const bool hashes_first : {true, false}) {
+      SCOPED_TRACE("threads " + std::to_string(threads) + (hashes_first ? ", hashes" : ""));
+      EXPECT_EQ(io_detail::first_equal_corners(V, threads, hashes_first), expected);
+    }
+  }
+  // The weld itself: vertices in first-corner order on every thread count.
+  Mesh one;
+  one.V = V;
+  one.F.resize(V.rows() / 3, 3);
+  for (Eigen::Index f = 0; f < one.F.rows(); ++f) one.F.row(f) << 3 * f, 3 * f + 1, 3 * f + 2;
+  Mesh many = one;
+  io_detail::weld_corners(one, 0.0, true, 1);
+  io_detail::weld_corners(many, 0.0, true, 3);
+  EXPECT_TRUE(same_bits(one.V, many.V));
+  EXPECT_TRUE(same_bits(one.F, many.F));
+  EXPECT_TRUE(same_bits(one.corner_vertex, many.corner_vertex));
+  EXPECT_EQ(one.V.rows(), static_cast<Eigen::Index>(first_of.size()) + 201);  // + NaN corners
 }
 
 }  // namespace

@@ -184,8 +184,16 @@ inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index 
 /// order; replaces V by the welded vertices (first-appearance order), remaps F and fills
 /// Mesh::corner_vertex. tolerance 0: exactly equal coordinates (-0 == 0; non-finite corners stay
 /// apart); > 0: a corner joins the first vertex within that distance. weld false: identity.
+/// The exact weld runs on `threads` threads (0: the default); the result does not depend on it.
 /// \throw InvalidInput for a negative or non-finite tolerance.
-void weld_corners(Mesh& mesh, double tolerance, bool weld);
+void weld_corners(Mesh& mesh, double tolerance, bool weld, int threads);
+/// The exact weld's matching: for every corner of V, the first corner with exactly its position
+/// (-0 == 0; itself for a first and for a non-finite corner). `hashes_first`: corners are matched
+/// by 64-bit hashes alone and the matches then checked, positions compared throughout only if a
+/// check fails (what weld_corners does); false: positions compared throughout. The same answer
+/// either way and for any `threads`; the choice is exposed for tests.
+[[nodiscard]] std::vector<std::int32_t> first_equal_corners(const RowMatrixX3d& V, int threads,
+                                                            bool hashes_first);
 
 // The per-format readers, dispatched by read_mesh().
 /// `threads` as ReadOptions::threads (the mesh does not depend on it).
@@ -194,7 +202,7 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path, int threads);
 /// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
 [[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
-[[nodiscard]] Mesh read_stl(const std::filesystem::path& path);
+[[nodiscard]] Mesh read_stl(const std::filesystem::path& path, int threads);
 
 // The same readers on the contents of a file already in memory (read_X(path) is
 // parse_X(path, read_whole_file(path))); `path` only names the file in messages. The fuzz targets
@@ -232,5 +240,15 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld);
                                                       std::string_view data, int threads,
                                                       std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data);
+/// parse_stl with binary facets read on `threads` threads and an ascii text read in runs of about
+/// `chunk_bytes` cut where facets open: the serial reader's Mesh or error for any thread count
+/// and run size.
+[[nodiscard]] Mesh parse_stl(const std::filesystem::path& path, std::string_view data, int threads,
+                             std::size_t chunk_bytes);
+/// Its parallel ascii read alone: nothing where it falls back to the serial read (and for binary
+/// files). For tests.
+[[nodiscard]] std::optional<Mesh> parse_stl_in_chunks(const std::filesystem::path& path,
+                                                      std::string_view data, int threads,
+                                                      std::size_t chunk_bytes);
 
 }  // namespace focal::io_detail

@@ -35,8 +35,8 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
       if (!(options.weld_tolerance >= 0.0) || !std::isfinite(options.weld_tolerance)) {
         throw InvalidInput("read_mesh: weld_tolerance must be finite and >= 0");
       }
-      Mesh mesh = io_detail::read_stl(path);
-      io_detail::weld_corners(mesh, options.weld_tolerance, options.weld);
+      Mesh mesh = io_detail::read_stl(path, options.threads);
+      io_detail::weld_corners(mesh, options.weld_tolerance, options.weld, options.threads);
       return mesh;
     }
     case MeshFormat::xyz:
