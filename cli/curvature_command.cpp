@@ -128,7 +128,7 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "  focal curvature bunny.off -o bunny.csv          # the recommended estimator\n"
       "  focal curvature bunny.off -o bunny.csv --paper  # the paper's method as written\n"
       "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v\n"
-      "  focal curvature scan.ply -o scan.csv --float32   # floats: about half the bytes\n"
+      "  focal curvature scan.ply -o scan.csv --float32   # floats: CSV ~40% smaller\n"
       "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
