@@ -22,6 +22,17 @@ struct CurvatureFlags {
   bool force = false;
   int tiles = 0;  ///< --tiles: 0, the whole mesh at once
   EstimatorFlags estimator;
+  OutputFlags out;
+
+  [[nodiscard]] WriteOptions csv_options() const {
+    return {.threads = estimator.threads, .precision = out.precision()};
+  }
+  [[nodiscard]] PlyWriteOptions ply_options() const {
+    return {.binary = !ascii,
+            .comments = {},
+            .threads = estimator.threads,
+            .precision = out.precision()};
+  }
 };
 
 struct FocalMeshFlags {
@@ -31,6 +42,7 @@ struct FocalMeshFlags {
   bool force = false;
   EstimatorFlags estimator;
   FocalMeshOptions focal;
+  OutputFlags out;
 };
 
 /// A point cloud's fields: the CSV, or the cloud (with the normals used) and its fields as PLY.
@@ -38,10 +50,9 @@ void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
   CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv")
-    return write_curvature_csv(f.output, c.curvature, {}, f.estimator.threads);
+    return write_curvature_csv(f.output, c.curvature, {}, f.csv_options());
   input.mesh.N = std::move(c.N);
-  write_curvature_ply(f.output, input.mesh, c.curvature,
-                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads});
+  write_curvature_ply(f.output, input.mesh, c.curvature, f.ply_options());
 }
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
@@ -49,22 +60,20 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
   if (f.tiles > 0) {
     const TileEstimate c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
     Stage stage(log, "write");
-    return write_curvature_csv(f.output, c.curvature, c.crease, f.estimator.threads);
+    return write_curvature_csv(f.output, c.curvature, c.crease, f.csv_options());
   }
   if (input.cloud) return run_cloud_curvature(f, input, log);
   Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
-    write_curvature_csv(f.output, e.curvature, e.crease, f.estimator.threads);
+    write_curvature_csv(f.output, e.curvature, e.crease, f.csv_options());
     return;
   }
   // The mesh as the estimator saw it (input.prepared is not used after this).
   Mesh& mesh = input.mesh;
   if (e.F) mesh.F = std::move(*e.F);
   if (e.N) mesh.N = std::move(*e.N);
-  write_curvature_ply(f.output, mesh, e.curvature,
-                      {.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads},
-                      e.crease);
+  write_curvature_ply(f.output, mesh, e.curvature, f.ply_options(), e.crease);
 }
 
 /// The focal meshes of a mesh, or the focal point clouds (no faces) of a point cloud.
@@ -85,7 +94,10 @@ void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
   const Input input(f.input, f.estimator, log);
   const FocalMeshes meshes = focal_meshes_of(input, f, log);
   Stage stage(log, "write");
-  const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .threads = f.estimator.threads};
+  const PlyWriteOptions o{.binary = !f.ascii,
+                          .comments = {},
+                          .threads = f.estimator.threads,
+                          .precision = f.out.precision()};
   // All or nothing: a failed run leaves neither new focal mesh, and existing files as they were.
   write_focal_meshes_ply(f.prefix + ".focal1.ply", f.prefix + ".focal2.ply", meshes, o);
   std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),
@@ -107,6 +119,7 @@ void add_curvature_command(CLI::App& app, const Log& log) {
                   "estimator)")
       ->required();
   cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
+  f->out.add_to(*cmd);
   f->estimator.add_to(*cmd);
   cmd->footer(
       "Columns: k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class (k1 >= k2; outward normals;\n"
@@ -115,6 +128,7 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "  focal curvature bunny.off -o bunny.csv          # the recommended estimator\n"
       "  focal curvature bunny.off -o bunny.csv --paper  # the paper's method as written\n"
       "  focal curvature scan.ply -o scan-curvature.ply --rings 2 --normals max -v\n"
+      "  focal curvature scan.ply -o scan.csv --float32   # floats: CSV ~40% smaller\n"
       "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
       "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
@@ -148,6 +162,7 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
   cmd->add_flag("--drop-infinite", f->focal.drop_faces_at_infinity,
                 "leave out faces touching a focal point at infinity or undefined");
   cmd->add_flag("--ascii", f->ascii, "write ascii PLY instead of binary");
+  f->out.add_to(*cmd);
   f->estimator.add_to(*cmd);
   cmd->footer(
       "Example:\n  focal focal-mesh bunny.off -o bunny   # bunny.focal1.ply, bunny.focal2.ply");

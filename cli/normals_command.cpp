@@ -25,6 +25,7 @@ struct NormalsFlags {
   std::string output;
   bool force = false;
   EstimatorFlags estimator;
+  OutputFlags out;
 };
 
 void run_normals(NormalsFlags& f, const Log& log) {
@@ -46,7 +47,8 @@ void run_normals(NormalsFlags& f, const Log& log) {
   }
   Stage stage(log, "write");
   input.mesh.N = std::move(N);
-  write_mesh(f.output, input.mesh);
+  write_mesh(f.output, input.mesh,
+             {.threads = f.estimator.threads, .precision = f.out.precision()});
 }
 
 }  // namespace
@@ -60,6 +62,7 @@ void add_normals_command(CLI::App& app, const Log& log) {
   cmd->add_option("-o,--output", f->output,
                   "OUT.ply, .obj, .off or .xyz: positions, faces, normals")
       ->required();
+  f->out.add_to(*cmd);
   f->estimator.add_to(*cmd);
   cmd->add_flag("--force", f->force, "replace a read-only output file");
   cmd->footer(

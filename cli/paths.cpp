@@ -7,6 +7,13 @@
 
 namespace focal::cli {
 
+void OutputFlags::add_to(CLI::App& command) {
+  command.add_flag("--float32", float32,
+                   "write real numbers as float32: PLY `float` positions, normals and fields; "
+                   "CSV/text numbers as the shortest text of the float (smaller files; about 7 "
+                   "significant digits instead of bit-exact doubles)");
+}
+
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),

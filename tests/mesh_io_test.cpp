@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -1494,15 +1495,26 @@ TEST_F(MeshIo, PlyBinaryParallelReadFallsBackWithTheSameResultsAndErrors) {
 }
 
 /// The bytes the serial writer produced: each vertex x y z (nx ny nz) double then each property
-/// in its type, little endian; faces as uchar 3 and three ints.
-std::string reference_ply_body(const Mesh& m, const std::vector<focal::VertexProperty>& props) {
+/// in its type, little endian; faces as uchar 3 and three ints. With Precision::float32 the
+/// positions, normals and float64 properties as static_cast<float> of their values.
+std::string reference_ply_body(const Mesh& m, const std::vector<focal::VertexProperty>& props,
+                               focal::Precision precision = focal::Precision::float64) {
+  const bool f32 = precision == focal::Precision::float32;
   Bytes b;
+  const auto put_real = [&](double v) {
+    if (f32) {
+      b.put(static_cast<float>(v));
+    } else {
+      b.put(v);
+    }
+  };
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
-    for (int c = 0; c < 3; ++c) b.put(m.V(i, c));
-    for (int c = 0; c < 3 && m.has_normals(); ++c) b.put(m.N(i, c));
+    for (int c = 0; c < 3; ++c) put_real(m.V(i, c));
+    for (int c = 0; c < 3 && m.has_normals(); ++c) put_real(m.N(i, c));
     for (const auto& prop : props) {
       const double v = prop.values[i];
-      switch (prop.type) {
+      switch (f32 && prop.type == focal::PropertyType::float64 ? focal::PropertyType::float32
+                                                               : prop.type) {
         case focal::PropertyType::float32:
           b.put(static_cast<float>(v));
           break;
@@ -1606,20 +1618,259 @@ TEST_F(MeshIo, CurvaturePlyIsWritePlyOfTheFields) {
   }
   focal::write_ply(file("plain.ply"), m, props, {.binary = true, .comments = {comment}});
   const std::string expected = slurp(file("plain.ply"));
-  for (const bool binary : {true, false}) {
-    if (!binary) {
-      focal::write_ply(file("plain.ply"), m, props, {.binary = false, .comments = {comment}});
-    }
-    for (const int threads : {1, 2}) {
-      focal::write_curvature_ply(file("fields.ply"), m, r,
-                                 {.binary = binary, .comments = {}, .threads = threads});
-      EXPECT_TRUE(slurp(file("fields.ply")) == slurp(file("plain.ply"))) << binary << threads;
+  for (const auto precision : {focal::Precision::float64, focal::Precision::float32}) {
+    for (const bool binary : {true, false}) {
+      focal::write_ply(file("plain.ply"), m, props,
+                       {.binary = binary, .comments = {comment}, .precision = precision});
+      for (const int threads : {1, 2}) {
+        focal::write_curvature_ply(
+            file("fields.ply"), m, r,
+            {.binary = binary, .comments = {}, .threads = threads, .precision = precision});
+        EXPECT_TRUE(slurp(file("fields.ply")) == slurp(file("plain.ply")))
+            << binary << threads << static_cast<int>(precision);
+      }
     }
   }
   EXPECT_TRUE(body_of(expected) == reference_ply_body(m, props));
   r.H.resize(3);
   expect_error<focal::InvalidInput>([&] { focal::write_curvature_ply(file("bad.ply"), m, r); },
                                     {"property 'H' has 3 values but the mesh has 20000 vertices"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// float32 outputs (Precision::float32): every real number v is written as static_cast<float>(v)
+
+/// m with each value rounded to float (static_cast<float>) and widened back.
+RowMatrixX3d as_floats(const RowMatrixX3d& m) { return m.cast<float>().cast<double>(); }
+
+/// The shortest text that reads back to v (std::to_chars), `nan`, `inf` or `-inf`.
+std::string float_text(float v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  return {buf, std::to_chars(buf, buf + sizeof buf, v).ptr};
+}
+
+/// The bit pattern of a float, NaNs all alike (the writers write every NaN as the same `nan`).
+std::uint32_t float_bits(float v) {
+  return std::isnan(v) ? 0x7fc00000u : std::bit_cast<std::uint32_t>(v);
+}
+
+TEST_F(MeshIo, PlyFloat32HoldsTheFloatOfEveryValue) {
+  // More vertices than one block of the binary writer; values that float rounds (1/3), that
+  // underflow (1e-300) or overflow (1e300) it, a float subnormal (1e-40), NaN, infinities, -0.
+  const Eigen::Index nv = 70000;
+  const Eigen::Index nf = 1000;
+  Mesh m;
+  m.V = RowMatrixX3d::Random(nv, 3) * 1e3;
+  m.V.row(0) << 1.0 / 3.0, 1e-300, 1e300;
+  m.V.row(1) << kNaN, -kInf, -0.0;
+  m.N = RowMatrixX3d::Random(nv, 3);
+  m.N.row(2) << -1e300, 1e-40, kNaN;
+  m.F.resize(nf, 3);
+  std::mt19937 rng(5);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    for (int c = 0; c < 3; ++c) m.F(f, c) = static_cast<std::int32_t>(rng() % nv);
+  }
+  m.face_source = Eigen::VectorXi::LinSpaced(nf, 0, static_cast<int>(nf - 1));
+  Eigen::VectorXd d = Eigen::VectorXd::Random(nv);
+  d.head(3) << kNaN, 1e300, -1e-300;
+  const std::vector<focal::VertexProperty> props = {
+      {"f", Eigen::VectorXd::Random(nv) * 1e3, focal::PropertyType::float32},
+      {"d", d, focal::PropertyType::float64},
+      {"u", Eigen::VectorXd::LinSpaced(nv, 0, 255).array().floor(), focal::PropertyType::uint8},
+      {"i", Eigen::VectorXd::LinSpaced(nv, -1e6, 2e9).array().floor(), focal::PropertyType::int32}};
+  for (const bool normals : {true, false}) {
+    if (!normals) m.N.resize(0, 3);
+    const std::string body = reference_ply_body(m, props, focal::Precision::float32);
+    std::string expected_header = "property float x\nproperty float y\nproperty float z\n";
+    if (normals) expected_header += "property float nx\nproperty float ny\nproperty float nz\n";
+    expected_header +=
+        "property float f\nproperty float d\nproperty uchar u\nproperty int i\nelement face";
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE("normals " + std::to_string(normals) + ", threads " + std::to_string(threads));
+      const fs::path p = file("f32.ply");
+      focal::write_ply(p, m, props,
+                       {.binary = true,
+                        .comments = {},
+                        .threads = threads,
+                        .precision = focal::Precision::float32});
+      const std::string bytes = slurp(p);
+      const std::string header = bytes.substr(0, bytes.find("end_header\n"));
+      EXPECT_NE(header.find(expected_header), std::string::npos) << header;
+      EXPECT_EQ(header.find("double"), std::string::npos) << header;
+      EXPECT_TRUE(body_of(bytes) == body);
+      const Mesh r = focal::read_mesh(p);
+      expect_same(as_floats(m.V), r.V);
+      EXPECT_EQ(r.has_normals(), normals);
+      if (normals) expect_same(as_floats(m.N), r.N);
+      EXPECT_TRUE(r.F == m.F);
+    }
+  }
+  // The default is unchanged: doubles, bit for bit.
+  focal::write_ply(file("f64.ply"), m, props);
+  EXPECT_TRUE(body_of(slurp(file("f64.ply"))) == reference_ply_body(m, props));
+  EXPECT_NE(slurp(file("f64.ply")).find("property double x\n"), std::string::npos);
+}
+
+TEST_F(MeshIo, PlyAsciiFloat32IsTheShortestTextOfTheFloat) {
+  const Mesh m = sample_mesh(true);
+  Eigen::VectorXd d(5);
+  d << 1.0 / 3.0, kNaN, kInf, 0.1, -2.5;
+  const std::vector<focal::VertexProperty> props = {{"d", d, focal::PropertyType::float64}};
+  const fs::path p = file("f32a.ply");
+  focal::write_ply(p, m, props,
+                   {.binary = false, .comments = {}, .precision = focal::Precision::float32});
+  const std::string text = slurp(p);
+  EXPECT_NE(text.find("property float x\n"), std::string::npos);
+  EXPECT_NE(text.find("property float nz\nproperty float d\n"), std::string::npos);
+  EXPECT_EQ(text.find("double"), std::string::npos);
+  // 1e-300 underflows to 0; 1/3 is 0.3333333432674408 as a float, written 0.33333334.
+  EXPECT_NE(text.find("end_header\n"
+                      "0.1 -2.5 0 0 0 1 0.33333334\n"
+                      "0.33333334 0.6666667 7 0.6 0.8 0 nan\n"
+                      "-0 5e+10 3.1415927 -1 0 0 inf\n"),
+            std::string::npos)
+      << text;
+  // A text reader parses to the double nearest the decimal, which rounds to the float written.
+  const Mesh r = focal::read_mesh(p);
+  expect_same(as_floats(m.V), as_floats(r.V));
+  expect_same(as_floats(m.N), as_floats(r.N));
+}
+
+// Text files read back as the double nearest each decimal written, which rounds to the float
+// (binary PLY: the float itself).
+TEST_F(MeshIo, TextMeshesFloat32ReadBackAsTheFloats) {
+  const Mesh m = sample_mesh(true);
+  for (const char* name : {"m.obj", "m.off", "m.xyz", "m.ply"}) {
+    SCOPED_TRACE(name);
+    focal::write_mesh(file(std::string("f64-") + name), m);
+    focal::write_mesh(file(name), m, {.threads = 0, .precision = focal::Precision::float32});
+    const Mesh r = focal::read_mesh(file(name));
+    const bool binary = std::string_view(name) == "m.ply";
+    expect_same(as_floats(m.V), binary ? r.V : as_floats(r.V));
+    expect_same(as_floats(m.N), binary ? r.N : as_floats(r.N));
+    EXPECT_LT(fs::file_size(file(name)), fs::file_size(file(std::string("f64-") + name)));
+  }
+  EXPECT_EQ(slurp(file("m.obj")).rfind("v 0.1 -2.5 0\nv 0.33333334 0.6666667 7\n", 0), 0u);
+  EXPECT_EQ(slurp(file("m.off")).rfind("NOFF\n5 4 0\n0.1 -2.5 0 0 0 1\n", 0), 0u);
+  EXPECT_EQ(slurp(file("m.xyz")).rfind("0.1 -2.5 0 0 0 1\n0.33333334 0.6666667 7 0.6 0.8 0\n", 0),
+            0u);
+}
+
+TEST_F(MeshIo, CurvatureCsvFloat32HoldsTheFloatOfEveryValue) {
+  const Eigen::Index nv = 2048 * 16 + 333;  // more than one batch of the CSV writer
+  focal::CurvatureResult r;
+  r.k1 = Eigen::VectorXd::Random(nv) * 10;
+  r.k2 = Eigen::VectorXd::Random(nv);
+  r.H = Eigen::VectorXd::Random(nv);
+  r.K = Eigen::VectorXd::Random(nv) * 1e-3;
+  r.d1 = RowMatrixX3d::Random(nv, 3);
+  r.d2 = RowMatrixX3d::Random(nv, 3);
+  r.residual = Eigen::VectorXd::Random(nv).cwiseAbs() * 1e-9;
+  r.point_class = focal::VectorXu8::LinSpaced(nv, 0, 4);
+  // Undefined rows: every value NaN, class undefined, as the estimators leave them.
+  for (const Eigen::Index i : {Eigen::Index{7}, nv - 1}) {
+    r.k1[i] = r.k2[i] = r.H[i] = r.K[i] = r.residual[i] = kNaN;
+    r.d1.row(i).setConstant(kNaN);
+    r.d2.row(i).setConstant(kNaN);
+    r.point_class[i] = static_cast<std::uint8_t>(focal::PointClass::undefined);
+  }
+  r.k1[8] = kInf;
+  r.k2[8] = -kInf;
+  r.H[9] = 1e300;   // beyond float: inf
+  r.K[9] = 1e-300;  // below float: 0
+  r.residual[10] = -0.0;
+  focal::VectorXu8 crease = focal::VectorXu8::Zero(nv);
+  crease.tail(100).setOnes();
+  const auto& names = focal::curvature_field_names();
+  const std::vector<const double*> columns = {r.k1.data(),     r.k2.data(),      r.H.data(),
+                                              r.K.data(),      r.d1.data(),      r.d1.data() + 1,
+                                              r.d1.data() + 2, r.d2.data(),      r.d2.data() + 1,
+                                              r.d2.data() + 2, r.residual.data()};
+  const std::vector<Eigen::Index> strides = {1, 1, 1, 1, 3, 3, 3, 3, 3, 3, 1};
+
+  focal::write_curvature_csv(file("f64.csv"), r, crease);
+  focal::write_curvature_csv(file("f64-options.csv"), r, crease, focal::WriteOptions{});
+  EXPECT_TRUE(slurp(file("f64.csv")) == slurp(file("f64-options.csv")));
+  const std::string doubles = slurp(file("f64.csv"));
+  std::string first;
+  for (const int threads : {1, 2, 3}) {
+    focal::write_curvature_csv(file("f32.csv"), r, crease,
+                               {.threads = threads, .precision = focal::Precision::float32});
+    const std::string text = slurp(file("f32.csv"));
+    if (first.empty()) first = text;
+    EXPECT_TRUE(text == first) << threads << " threads";
+  }
+  EXPECT_LT(first.size(), doubles.size() * 2 / 3);
+  std::istringstream f32(first);
+  std::istringstream f64(doubles);
+  std::string line32;
+  std::string line64;
+  ASSERT_TRUE(std::getline(f32, line32) && std::getline(f64, line64));
+  EXPECT_EQ(line32, line64);  // the header
+  EXPECT_EQ(line32, "k1,k2,H,K,d1x,d1y,d1z,d2x,d2y,d2z,residual,class,crease");
+  Eigen::Index row = 0;
+  int mismatches = 0;
+  while (std::getline(f32, line32) && std::getline(f64, line64)) {
+    std::vector<std::string> cells;
+    std::stringstream s(line32);
+    for (std::string cell; std::getline(s, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 13u) << line32;
+    for (std::size_t c = 0; c < 11; ++c) {
+      float v = 0;
+      const char* end = cells[c].data() + cells[c].size();
+      const auto [ptr, ec] = std::from_chars(cells[c].data(), end, v);
+      const float want = static_cast<float>(columns[c][row * strides[c]]);
+      if (ec != std::errc() || ptr != end || float_bits(v) != float_bits(want) ||
+          cells[c] != float_text(want)) {
+        if (++mismatches <= 5) {
+          ADD_FAILURE() << "row " << row << " " << names[c] << ": '" << cells[c] << "', want "
+                        << want;
+        }
+      }
+    }
+    // class and crease: the words and flags of the double file.
+    const auto class_and_crease = [](const std::string& line) {
+      std::size_t at = 0;
+      for (int commas = 0; commas < 11; ++commas) at = line.find(',', at) + 1;
+      return line.substr(at);
+    };
+    EXPECT_EQ(class_and_crease(line32), class_and_crease(line64)) << row;
+    ++row;
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(row, nv);
+  EXPECT_FALSE(std::getline(f64, line64));
+  // Undefined rows and infinities are written as the double file writes them.
+  EXPECT_NE(first.find("\nnan,nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,undefined,0\n"),
+            std::string::npos);
+  EXPECT_NE(first.find("\ninf,-inf,"), std::string::npos);
+}
+
+TEST_F(MeshIo, FocalMeshFloat32KeepsTheFlags) {
+  focal::FocalMeshes meshes;
+  for (focal::FocalMesh* g : {&meshes.gamma1, &meshes.gamma2}) {
+    g->mesh.V = rows({{1.0 / 3.0, 0, 0}, {0, 1e6 + 0.1, 0}, {0, 0, 0.1}});
+    g->mesh.F.resize(1, 3);
+    g->mesh.F << 0, 1, 2;
+    g->flag.resize(3);
+    g->flag << 0, 1, 2;  // finite, infinite (clamped), undefined (the base vertex)
+  }
+  focal::write_focal_meshes_ply(
+      file("g.focal1.ply"), file("g.focal2.ply"), meshes,
+      {.binary = true, .comments = {}, .precision = focal::Precision::float32});
+  const std::vector<focal::VertexProperty> flag = {
+      {"focal_flag", meshes.gamma1.flag.cast<double>(), focal::PropertyType::uint8}};
+  for (const char* name : {"g.focal1.ply", "g.focal2.ply"}) {
+    const std::string bytes = slurp(file(name));
+    EXPECT_NE(bytes.find("property float x\nproperty float y\nproperty float z\n"
+                         "property uchar focal_flag\n"),
+              std::string::npos);
+    EXPECT_TRUE(body_of(bytes) ==
+                reference_ply_body(meshes.gamma1.mesh, flag, focal::Precision::float32));
+    expect_same(as_floats(meshes.gamma1.mesh.V), focal::read_mesh(file(name)).V);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -298,13 +298,16 @@ def read_mesh(path: "str | os.PathLike", *, threads: Optional[int] = None) -> Me
     return Mesh(d["V"], d["F"], d["N"])
 
 
-def write_mesh(path: "str | os.PathLike", V: Any, F: Any, N: Any = None) -> None:
+def write_mesh(
+    path: "str | os.PathLike", V: Any, F: Any, N: Any = None, *, float32: bool = False
+) -> None:
     """Writes V (n, 3), F (m, 3) and optionally N (n, 3) as .ply (binary), .obj or .off, chosen
-    by the extension. Numbers are written so that they read back exactly. The file is written
-    through a temporary and renamed, so a failed write leaves nothing behind. Raises
+    by the extension. Numbers are written so that they read back exactly; with ``float32`` as
+    float32 (PLY ``float``; text: the shortest form of the float), for smaller files. The file is
+    written through a temporary and renamed, so a failed write leaves nothing behind. Raises
     InvalidInputError for invalid arrays, FocalIOError on failure or for .stl."""
     Va, Fa, Na = _mesh_arrays(V, F, N)
-    _ext.write_mesh(os.fspath(path), Va, Fa, Na)
+    _ext.write_mesh(os.fspath(path), Va, Fa, Na, bool(float32))
 
 
 def write_fields(
@@ -316,8 +319,11 @@ def write_fields(
     *,
     ascii: bool = False,
     threads: Optional[int] = None,
+    float32: bool = False,
 ) -> None:
-    """Writes a Curvature as ``focal curvature -o`` does (the same bytes for the same estimate).
+    """Writes a Curvature as ``focal curvature -o`` does (the same bytes for the same estimate;
+    ``float32=True`` as ``--float32``: every real number written as the float32 nearest to it,
+    PLY positions and normals as ``float``, CSV numbers as the shortest text of the float).
 
     ``.csv``: one row per vertex, columns k1,k2,H,K,d1x..d1z,d2x..d2z,residual,class (the class
     as a word, NaN as ``nan``), and crease (0/1) when ``curvature.crease`` is not None; V, F, N
@@ -341,7 +347,7 @@ def write_fields(
         if fields[name].shape[0] != n:
             raise _shape_error(name, f"({n}, 3)", fields[name].shape)
     if ext == ".csv":
-        _ext.write_fields(path, fields, None, None, None, True, _threads(threads))
+        _ext.write_fields(path, fields, None, None, None, True, _threads(threads), bool(float32))
         return
     if ext != ".ply":
         raise InvalidInputError(f"{path}: fields are written as .csv or .ply, not {ext!r}")
@@ -352,7 +358,7 @@ def write_fields(
     Va, Fa, Na = _mesh_arrays(V, used_F, used_N)
     if Va.shape[0] != n:
         raise _shape_error("V", f"({n}, 3) like the fields", Va.shape)
-    _ext.write_fields(path, fields, Va, Fa, Na, not ascii, _threads(threads))
+    _ext.write_fields(path, fields, Va, Fa, Na, not ascii, _threads(threads), bool(float32))
 
 
 _PAPER_OPTIONS = {

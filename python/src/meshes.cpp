@@ -271,15 +271,19 @@ nb::dict read_mesh(const std::string& path, int threads) {
   return mesh_dict(std::move(mesh));
 }
 
+focal::Precision precision_of(bool float32) {
+  return float32 ? focal::Precision::float32 : focal::Precision::float64;
+}
+
 void write_mesh(const std::string& path, const DoubleRows& V, const IntRows& F,
-                const std::optional<DoubleRows>& N) {
+                const std::optional<DoubleRows>& N, bool float32) {
   nb::gil_scoped_release release;
   // The writers take a Mesh, which owns its arrays: one copy, made here.
   focal::Mesh mesh;
   mesh.V = view(V);
   mesh.F = view(F);
   if (N) mesh.N = view(*N);
-  focal::write_mesh(path, mesh);
+  focal::write_mesh(path, mesh, {.threads = 0, .precision = precision_of(float32)});
 }
 
 template <class Vector, class Scalar>
@@ -309,22 +313,25 @@ focal::CurvatureResult curvature_result(const nb::dict& c) {
 /// writers take owning structs: the arrays are copied once, here.
 void write_fields(const std::string& path, const nb::dict& fields,
                   const std::optional<DoubleRows>& V, const std::optional<IntRows>& F,
-                  const std::optional<DoubleRows>& N, bool binary, int threads) {
+                  const std::optional<DoubleRows>& N, bool binary, int threads, bool float32) {
   const focal::CurvatureResult r = curvature_result(fields);
   const focal::VectorXu8 crease = fields.contains("crease")
                                       ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])
                                       : focal::VectorXu8();
   nb::gil_scoped_release release;
   if (!V) {
-    focal::write_curvature_csv(path, r, crease, threads);
+    focal::write_curvature_csv(path, r, crease,
+                               {.threads = threads, .precision = precision_of(float32)});
     return;
   }
   focal::Mesh mesh;
   mesh.V = view(*V);
   mesh.F = view(*F);
   if (N) mesh.N = view(*N);
-  focal::write_curvature_ply(path, mesh, r, {.binary = binary, .comments = {}, .threads = threads},
-                             crease);
+  focal::write_curvature_ply(
+      path, mesh, r,
+      {.binary = binary, .comments = {}, .threads = threads, .precision = precision_of(float32)},
+      crease);
 }
 
 nb::dict generate_surface(const std::string& kind, const std::string& triangulation,
@@ -369,9 +376,9 @@ void bind_meshes(nb::module_& m) {
         "threads"_a);
   m.def("read_mesh", &read_mesh, "path"_a, "threads"_a);
   m.def("write_mesh", &write_mesh, "path"_a, "V"_a.noconvert(), "F"_a.noconvert(),
-        "N"_a.none().noconvert());
+        "N"_a.none().noconvert(), "float32"_a);
   m.def("write_fields", &write_fields, "path"_a, "fields"_a, "V"_a.none().noconvert(),
-        "F"_a.none().noconvert(), "N"_a.none().noconvert(), "binary"_a, "threads"_a);
+        "F"_a.none().noconvert(), "N"_a.none().noconvert(), "binary"_a, "threads"_a, "float32"_a);
   m.def("generate_surface", &generate_surface, "kind"_a, "triangulation"_a, "target_vertices"_a,
         "seed"_a, "a"_a, "b"_a, "c"_a);
 }

@@ -217,6 +217,78 @@ def test_write_fields_errors(tmp_path, sphere):
     assert not (tmp_path / "no").exists() and not list(tmp_path.iterdir())
 
 
+def read_binary_ply(path):
+    """(header lines, vertex records as a NumPy structured array) of a binary little-endian PLY
+    with scalar vertex properties."""
+    data = pathlib.Path(path).read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    types = {"float": "<f4", "double": "<f8", "uchar": "u1", "int": "<i4"}
+    n, fields, in_vertex = 0, [], False
+    for line in header:
+        words = line.split()
+        if words[:2] == ["element", "vertex"]:
+            n, in_vertex = int(words[2]), True
+        elif words[0] == "element":
+            in_vertex = False
+        elif words[0] == "property" and in_vertex:
+            fields.append((words[2], types[words[1]]))
+    return header, np.frombuffer(data, dtype=np.dtype(fields), count=n, offset=end)
+
+
+def test_write_fields_float32_holds_the_float_of_every_value(tmp_path, torus):
+    c = focal.curvature(torus.V, torus.F, torus.N)
+    k1 = np.array(c.k1)
+    assert np.isnan(k1).sum() == 0  # undefined rows below are made by hand
+    c.k1[:3] = [np.nan, np.inf, 1e300]  # undefined, infinite, beyond float: inf
+    names = ["k1", "k2", "H", "K", "d1x", "d1y", "d1z", "d2x", "d2y", "d2z", "residual"]
+    values = np.column_stack([c.k1, c.k2, c.H, c.K, c.d1, c.d2, c.residual])
+    with np.errstate(over="ignore"):  # 1e300 becomes inf, as in the writer
+        values32 = values.astype(np.float32)
+    nan = np.isnan(values)
+    # CSV: each number the shortest text of its float; class and crease as the double file has.
+    focal.write_fields(tmp_path / "f64.csv", c)
+    focal.write_fields(tmp_path / "f32.csv", c, float32=True)
+    rows32 = list(csv.reader((tmp_path / "f32.csv").open()))
+    rows64 = list(csv.reader((tmp_path / "f64.csv").open()))
+    assert rows32[0] == rows64[0] == names + ["class", "crease"]
+    got = np.array([[np.float32(x) for x in r[:11]] for r in rows32[1:]], dtype=np.float32)
+    assert np.array_equal(np.isnan(got), nan) and same_bits(got[~nan], values32[~nan])
+    assert [r[11:] for r in rows32] == [r[11:] for r in rows64]
+    assert [r[0] for r in rows32[1:4]] == ["nan", "inf", "inf"]
+    assert (tmp_path / "f32.csv").stat().st_size < (tmp_path / "f64.csv").stat().st_size * 2 / 3
+    # Binary PLY: positions and normals as float too, the class and crease codes unchanged.
+    focal.write_fields(tmp_path / "f32.ply", c, torus.V, torus.F, torus.N, float32=True)
+    header, v = read_binary_ply(tmp_path / "f32.ply")
+    assert not any("double" in line for line in header)
+    assert "property float x" in header and "property float nz" in header
+    for name, column in zip(["x", "y", "z"], torus.V.T):
+        assert same_bits(v[name], column.astype(np.float32))
+    for i, name in enumerate(names):
+        defined = ~nan[:, i]
+        assert same_bits(np.isnan(v[name]), nan[:, i])
+        assert same_bits(v[name][defined], values32[defined, i])
+    assert same_bits(v["class"], np.asarray(c.point_class, dtype=np.uint8))
+    assert same_bits(v["crease"], np.asarray(c.crease, dtype=np.uint8))
+    m = focal.read_mesh(tmp_path / "f32.ply")
+    assert same_bits(m.V, torus.V.astype(np.float32).astype(np.float64))
+    # The default stays doubles.
+    focal.write_fields(tmp_path / "f64.ply", c, torus.V, torus.F, torus.N)
+    header, v = read_binary_ply(tmp_path / "f64.ply")
+    assert "property double x" in header and same_bits(v["x"], torus.V[:, 0])
+
+
+def test_write_mesh_float32(tmp_path, torus):
+    # Binary PLY reads back as the floats; text as the doubles nearest the decimals written,
+    # which round to the floats.
+    for ext in (".ply", ".obj", ".off", ".xyz"):
+        focal.write_mesh(tmp_path / ("m" + ext), torus.V, torus.F, torus.N, float32=True)
+        m = focal.read_mesh(tmp_path / ("m" + ext))
+        V, N = (m.V, m.N) if ext == ".ply" else (m.V.astype(np.float32), m.N.astype(np.float32))
+        assert same_bits(V, torus.V.astype(np.float32).astype(V.dtype)), ext
+        assert same_bits(N, torus.N.astype(np.float32).astype(N.dtype)), ext
+
+
 # --- inputs: dtypes, layouts, one conversion ------------------------------------------------
 
 

@@ -38,6 +38,12 @@ void append_field(std::string& out, std::string_view text) {
 }  // namespace
 
 void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns, int threads) {
+  write_csv(path, columns, WriteOptions{.threads = threads});
+}
+
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
+               const WriteOptions& options) {
+  const int threads = options.threads;
   if (threads < 0) throw InvalidInput("write_csv: threads must be >= 0");
   const Eigen::Index rows = columns.empty() ? 0 : column_length(columns.front());
   for (const auto& column : columns) {
@@ -51,7 +57,7 @@ void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> col
     for (std::size_t c = 0; c < columns.size(); ++c) {
       if (c > 0) out += ',';
       if (const auto* numbers = std::get_if<Eigen::VectorXd>(&columns[c].values)) {
-        io_detail::append_number(out, (*numbers)[r]);
+        io_detail::append_real(out, (*numbers)[r], options.precision);
       } else {
         append_field(out, std::get<std::vector<std::string>>(
                               columns[c].values)[static_cast<std::size_t>(r)]);

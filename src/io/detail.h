@@ -156,6 +156,16 @@ void append_number(std::string& out, double value);
 void append_number(std::string& out, float value);
 void append_number(std::string& out, std::int64_t value);
 
+/// append_number of `value`, or of static_cast<float>(value) with Precision::float32: the one
+/// place where the text writers convert to float32 outputs.
+inline void append_real(std::string& out, double value, Precision precision) {
+  if (precision == Precision::float32) {
+    append_number(out, static_cast<float>(value));
+  } else {
+    append_number(out, value);
+  }
+}
+
 /// "3 a b c\n": one triangle as OFF and ascii PLY write it.
 inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMatrixX3i>& F,
                                   Eigen::Index f) {
@@ -168,14 +178,15 @@ inline void append_ascii_triangle(std::string& out, const Eigen::Ref<const RowMa
 }
 
 /// "x y z[ nx ny nz]\n": vertex i as OFF and point-cloud text write it (normals when `normals`).
-inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index i, bool normals) {
+inline void append_vertex_line(std::string& out, const Mesh& mesh, Eigen::Index i, bool normals,
+                               Precision precision) {
   for (int c = 0; c < 3; ++c) {
     if (c > 0) out += ' ';
-    append_number(out, mesh.V(i, c));
+    append_real(out, mesh.V(i, c), precision);
   }
   for (int c = 0; normals && c < 3; ++c) {
     out += ' ';
-    append_number(out, mesh.N(i, c));
+    append_real(out, mesh.N(i, c), precision);
   }
   out += '\n';
 }

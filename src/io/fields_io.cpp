@@ -55,6 +55,11 @@ const std::vector<std::string>& curvature_field_names() {
 
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
                          const VectorXu8& crease, int threads) {
+  write_curvature_csv(path, fields, crease, WriteOptions{.threads = threads});
+}
+
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         const VectorXu8& crease, const WriteOptions& options) {
   check_crease(crease, fields, "write_curvature_csv");
   std::vector<CsvColumn> columns;
   for (auto& [name, values] : numeric_fields(fields)) columns.push_back({name, std::move(values)});
@@ -64,7 +69,7 @@ void write_curvature_csv(const std::filesystem::path& path, const CurvatureResul
   }
   columns.push_back({"class", std::move(words)});
   if (crease.size() > 0) columns.push_back({"crease", Eigen::VectorXd(crease.cast<double>())});
-  write_csv(path, columns, threads);
+  write_csv(path, columns, options);
 }
 
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,

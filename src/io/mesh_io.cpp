@@ -45,19 +45,23 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
   io_detail::fail(path, "unknown mesh format");
 }
 
-void write_mesh(const std::filesystem::path& path, const Mesh& mesh) {
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
   switch (mesh_format_from_path(path)) {
     case MeshFormat::ply:
-      write_ply(path, mesh);
+      write_ply(path, mesh, {},
+                {.binary = true,
+                 .comments = {},
+                 .threads = options.threads,
+                 .precision = options.precision});
       return;
     case MeshFormat::obj:
-      write_obj(path, mesh);
+      write_obj(path, mesh, options);
       return;
     case MeshFormat::off:
-      write_off(path, mesh);
+      write_off(path, mesh, options);
       return;
     case MeshFormat::xyz:
-      write_xyz(path, mesh);
+      write_xyz(path, mesh, options);
       return;
     case MeshFormat::stl:
       break;

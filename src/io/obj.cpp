@@ -441,7 +441,7 @@ Mesh read_obj(const std::filesystem::path& path, int threads) {
 
 }  // namespace io_detail
 
-void write_obj(const std::filesystem::path& path, const Mesh& mesh) {
+void write_obj(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
   validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_obj: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
@@ -452,7 +452,7 @@ void write_obj(const std::filesystem::path& path, const Mesh& mesh) {
         out += keyword;
         for (int c = 0; c < 3; ++c) {
           out += ' ';
-          io_detail::append_number(out, rows(i, c));
+          io_detail::append_real(out, rows(i, c), options.precision);
         }
         out += '\n';
         sink.maybe_flush();

@@ -326,7 +326,7 @@ Mesh read_off(const std::filesystem::path& path, int threads) {
 
 }  // namespace io_detail
 
-void write_off(const std::filesystem::path& path, const Mesh& mesh) {
+void write_off(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
   validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
@@ -334,7 +334,7 @@ void write_off(const std::filesystem::path& path, const Mesh& mesh) {
     out += normals ? "NOFF\n" : "OFF\n";
     out += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      io_detail::append_vertex_line(out, mesh, i, normals);
+      io_detail::append_vertex_line(out, mesh, i, normals, options.precision);
       sink.maybe_flush();
     }
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {

@@ -1,6 +1,7 @@
-// PLY writing: binary little endian (the default) or ascii, positions and normals as doubles,
-// per-vertex properties, triangles as `list uchar int vertex_indices`. The types, names and byte
-// order shared with the reader are in io/ply.h.
+// PLY writing: binary little endian (the default) or ascii, positions and normals as doubles
+// (floats with Precision::float32), per-vertex properties, triangles as
+// `list uchar int vertex_indices`. The types, names and byte order shared with the reader are in
+// io/ply.h.
 
 #include <algorithm>
 #include <cmath>
@@ -27,6 +28,11 @@ std::string_view ply_type_name(PropertyType t) { return scalar_name(scalar_of(t)
 
 /// Bytes of one binary value of a property of type t.
 std::size_t property_bytes(PropertyType t) { return scalar_size(scalar_of(t)); }
+
+/// The type positions and normals are written as.
+PropertyType real_type(Precision precision) {
+  return precision == Precision::float32 ? PropertyType::float32 : PropertyType::float64;
+}
 
 bool valid_property_name(std::string_view name) {
   if (name.empty()) return false;
@@ -80,15 +86,19 @@ std::string ply_header(const Mesh& mesh, std::span<const PlyColumn> columns,
   h += options.binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
   for (const auto& comment : options.comments) h += "comment " + comment + "\n";
   h += "element vertex " + std::to_string(mesh.V.rows()) + "\n";
-  h += "property double x\nproperty double y\nproperty double z\n";
-  if (mesh.has_normals()) h += "property double nx\nproperty double ny\nproperty double nz\n";
-  for (const auto& column : columns) {
+  const auto property = [&h](std::string_view type, std::string_view name) {
     h += "property ";
-    h += ply_type_name(column.type);
+    h += type;
     h += ' ';
-    h += column.name;
+    h += name;
     h += '\n';
+  };
+  const std::string_view real = ply_type_name(real_type(options.precision));
+  for (const char* name : {"x", "y", "z"}) property(real, name);
+  if (mesh.has_normals()) {
+    for (const char* name : {"nx", "ny", "nz"}) property(real, name);
   }
+  for (const auto& column : columns) property(ply_type_name(column.type), column.name);
   h += "element face " + std::to_string(mesh.F.rows()) + "\n";
   h += "property list uchar int vertex_indices\nend_header\n";
   return h;
@@ -110,13 +120,13 @@ void append_property_ascii(std::string& out, PropertyType t, double v) {
 }
 
 void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
-                          std::span<const PlyColumn> columns) {
+                          std::span<const PlyColumn> columns, Precision precision) {
   std::string& out = sink.buffer();
   const bool normals = mesh.has_normals();
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     for (int c = 0; c < (normals ? 6 : 3); ++c) {
       if (c > 0) out += ' ';
-      io_detail::append_number(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3));
+      io_detail::append_real(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3), precision);
     }
     for (const auto& column : columns) {
       out += ' ';
@@ -155,6 +165,19 @@ void write_fixed_records(io_detail::OutputSink& sink, std::int64_t count, std::s
   }
 }
 
+/// Stores x y z (and nx ny nz) of records [begin, end) as T at the start of each record of `out`.
+template <class T>
+void put_positions(char* out, std::size_t record, std::int64_t begin, std::int64_t end,
+                   const Mesh& mesh, bool normals) {
+  for (std::int64_t i = begin; i < end; ++i) {
+    char* p = out + static_cast<std::size_t>(i - begin) * record;
+    for (int c = 0; c < 3; ++c) p = put_little_endian(p, static_cast<T>(mesh.V(i, c)));
+    if (normals) {
+      for (int c = 0; c < 3; ++c) p = put_little_endian(p, static_cast<T>(mesh.N(i, c)));
+    }
+  }
+}
+
 /// Stores column values for records [begin, end) at `offset` in each record of `out`.
 template <class T, class Source>
 void put_column(char* out, std::size_t record, std::int64_t begin, std::int64_t end,
@@ -186,21 +209,21 @@ void put_column_as(PropertyType type, char* out, std::size_t record, std::int64_
 }
 
 void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
-                           std::span<const PlyColumn> columns, int threads) {
+                           std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   const bool normals = mesh.has_normals();
-  std::size_t record = (normals ? 6 : 3) * sizeof(double);
+  const bool f32 = options.precision == Precision::float32;
+  const std::size_t positions = (normals ? 6 : 3) * property_bytes(real_type(options.precision));
+  std::size_t record = positions;
   for (const auto& column : columns) record += property_bytes(column.type);
   // Column by column within a block, so that each type is dispatched once per block.
-  write_fixed_records(sink, mesh.V.rows(), record, threads,
+  write_fixed_records(sink, mesh.V.rows(), record, options.threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
-                        for (std::int64_t i = begin; i < end; ++i) {
-                          char* p = out + static_cast<std::size_t>(i - begin) * record;
-                          for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.V(i, c));
-                          if (normals) {
-                            for (int c = 0; c < 3; ++c) p = put_little_endian(p, mesh.N(i, c));
-                          }
+                        if (f32) {
+                          put_positions<float>(out, record, begin, end, mesh, normals);
+                        } else {
+                          put_positions<double>(out, record, begin, end, mesh, normals);
                         }
-                        std::size_t offset = (normals ? 6 : 3) * sizeof(double);
+                        std::size_t offset = positions;
                         for (const auto& column : columns) {
                           char* at = out + offset;
                           const Eigen::Index s = column.stride;
@@ -212,7 +235,7 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
                           offset += property_bytes(column.type);
                         }
                       });
-  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), threads,
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), options.threads,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         char* p = out;
                         for (std::int64_t f = begin; f < end; ++f) {
@@ -229,12 +252,20 @@ namespace io_detail {
 void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
                        std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   validate_for_ply(path, mesh, columns, options);
+  // float32 outputs: the double columns are declared `float` and converted as they are written
+  // (put_column_as, append_property_ascii), by the same code as the columns that are always float.
+  std::vector<PlyColumn> file_columns(columns.begin(), columns.end());
+  if (options.precision == Precision::float32) {
+    for (auto& column : file_columns) {
+      if (column.type == PropertyType::float64) column.type = PropertyType::float32;
+    }
+  }
   write_atomically(path, [&](OutputSink& sink) {
-    sink.buffer() += ply_header(mesh, columns, options);
+    sink.buffer() += ply_header(mesh, file_columns, options);
     if (options.binary) {
-      write_ply_body_binary(sink, mesh, columns, options.threads);
+      write_ply_body_binary(sink, mesh, file_columns, options);
     } else {
-      write_ply_body_ascii(sink, mesh, columns);
+      write_ply_body_ascii(sink, mesh, file_columns, options.precision);
     }
   });
 }

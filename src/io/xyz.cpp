@@ -173,13 +173,13 @@ Mesh read_xyz(const std::filesystem::path& path) {
 
 }  // namespace io_detail
 
-void write_xyz(const std::filesystem::path& path, const Mesh& mesh) {
+void write_xyz(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
   validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_xyz: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
     std::string& out = sink.buffer();
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      io_detail::append_vertex_line(out, mesh, i, normals);
+      io_detail::append_vertex_line(out, mesh, i, normals, options.precision);
       sink.maybe_flush();
     }
   });

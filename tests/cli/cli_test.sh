@@ -337,6 +337,60 @@ check "PLY: a comment lists the class codes" \
 run info c.ply
 check "PLY output reads back with $NV vertices" bash -c '[[ $1 -eq 0 ]] && grep -Eq "^vertices: +$2\$" "$3"' _ "$rc" "$NV" "$OUT"
 
+# --float32: every real number written as a float (the library's tests check each value is the
+# float of the double); here: the same rows, words and flags, shorter numbers, `float` in PLY.
+# max_digits FILE COLS: the most significant digits of a number in the listed columns (fields
+# split on commas and blanks); a float needs at most 9, a double up to 17.
+max_digits() {
+  awk -F'[ ,]' -v cols="$2" 'BEGIN { n = split(cols, c, " ") }
+    function digits(x) { sub(/^-/, "", x); sub(/[eE].*/, "", x); sub(/[.]/, "", x); sub(/^0+/, "", x); return length(x) }
+    NR > 1 || FILENAME !~ /csv$/ { for (i = 1; i <= n; i++) { d = digits($(c[i])); if (d > m) m = d } }
+    END { print m + 0 }' "$1" 2>/dev/null || echo 99
+}
+run curvature s.ply -o c32.csv --float32
+check "--float32 CSV: exit 0, the header and row count of the double file" \
+  bash -c '[[ $1 -eq 0 && $(head -1 c32.csv) == "$(head -1 c.csv)" && $(awk "END { print NR }" c32.csv) -eq $(awk "END { print NR }" c.csv) ]]' _ "$rc"
+check "--float32 CSV: class and crease columns are the double file's" \
+  bash -c 'cmp -s <(cut -d, -f12- c.csv) <(cut -d, -f12- c32.csv)'
+check_within "--float32 CSV: k1, k2 = 1 within 1e-6" "$(max_dev c32.csv "1 2" 1)" 1e-6
+check_within "--float32 CSV: at most 9 significant digits (float shortest form)" \
+  "$(max_digits c32.csv "1 2 3 4 5 6 7 8 9 10 11")" 9
+check "the double CSV has numbers of more than 9 digits (max_digits sees the difference)" \
+  bash -c '[[ $1 -gt 9 ]]' _ "$(max_digits c.csv "1 2 3 4 5 6 7 8 9 10 11")"
+check "--float32 CSV is smaller than the double one" \
+  bash -c '[[ $(wc -c <c32.csv) -lt $(wc -c <c.csv) ]]'
+run curvature s.ply -o c32.ply --float32
+ply_header c32.ply >c32.header
+check "--float32 PLY: positions, normals and fields are float, class and crease uchar" \
+  bash -c '[[ $1 -eq 0 ]] && grep -qx "property float x" c32.header && grep -qx "property float nz" c32.header &&
+           grep -qx "property float k1" c32.header && grep -qx "property uchar crease" c32.header &&
+           ! grep -q double c32.header' _ "$rc"
+# 6 reals of 4 bytes less per vertex, and "float" is one letter shorter than "double" in 6 lines.
+check "--float32 PLY: 24 bytes less per vertex than the double file (and 6 in the header)" \
+  bash -c '[[ $(( $(wc -c <c.ply) - $(wc -c <c32.ply) )) -eq $(( 24 * $1 + 6 )) ]]' _ "$NV"
+run info c32.ply
+check "--float32 PLY reads back with $NV vertices" bash -c '[[ $1 -eq 0 ]] && grep -Eq "^vertices: +$2\$" "$3"' _ "$rc" "$NV" "$OUT"
+run curvature s.ply -o ca32.ply --ascii --float32
+ply_vertex_lines ca32.ply >ca32.vertices
+check "--float32 --ascii PLY: $NV vertex lines of 19 values, class and crease as in the double file" \
+  bash -c '[[ $(wc -l <ca32.vertices) -eq $1 ]] && cmp -s <(cut -d" " -f18- ca.vertices) <(cut -d" " -f18- ca32.vertices)' _ "$NV"
+check_within "--float32 --ascii PLY: at most 9 significant digits" \
+  "$(max_digits ca32.vertices "$(seq -s " " 1 17)")" 9
+run focal-mesh s.ply -o p64 --ascii
+run focal-mesh s.ply -o p32 --float32 --ascii
+check "focal-mesh --float32: float focal points, uchar focal_flag" \
+  bash -c '[[ $1 -eq 0 ]] && for j in 1 2; do h=$(sed "/^end_header/q" p32.focal$j.ply) &&
+           grep -qx "property float x" <<<"$h" && grep -qx "property uchar focal_flag" <<<"$h" &&
+           ! grep -q double <<<"$h" || exit 1; done' _ "$rc"
+check "focal-mesh --float32: the flags of the double files" \
+  bash -c 'flags() { awk "/^element vertex / { n = \$3 } body && n > 0 { print \$4; n-- } /^end_header/ { body = 1 }" "$1"; }
+           [[ -s p64.focal1.ply ]] && cmp -s <(flags p64.focal1.ply) <(flags p32.focal1.ply) &&
+           cmp -s <(flags p64.focal2.ply) <(flags p32.focal2.ply)'
+run normals s.ply -o n32.xyz --float32
+check "normals --float32: exit 0, $NV points" \
+  bash -c '[[ $1 -eq 0 && $(wc -l <n32.xyz) -eq $2 ]]' _ "$rc" "$NV"
+check_within "normals --float32: at most 9 significant digits" "$(max_digits n32.xyz "1 2 3 4 5 6")" 9
+
 # ---------------------------------------------------------------------------------------------
 # Estimator options on the sphere
 variant() { # NAME BOUND ARGS...: runs curvature with ARGS into v.csv, checks |k - 1| <= BOUND

@@ -19,15 +19,22 @@ namespace focal {
 /// \throw InvalidInput when `crease` is neither empty nor of the fields' length.
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
                          const VectorXu8& crease = {}, int threads = 0);
+/// write_curvature_csv with the options' threads and precision (Precision::float32: each number
+/// as the shortest text of the float nearest to it; `nan` stays `nan`, class words and crease
+/// flags are unchanged).
+void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
+                         const VectorXu8& crease, const WriteOptions& options);
 
 /// The mesh with the fields as per-vertex PLY properties (floats; class as a uchar whose codes
 /// are listed in a header comment), so MeshLab and ParaView can colour by them; with `crease`
-/// (as above) a last uchar property `crease`.
+/// (as above) a last uchar property `crease`. Positions and normals are doubles, or floats with
+/// PlyWriteOptions::precision = Precision::float32.
 void write_curvature_ply(const std::filesystem::path& path, const Mesh& mesh,
                          const CurvatureResult& fields, const PlyWriteOptions& options = {},
                          const VectorXu8& crease = {});
 
-/// A focal mesh with its per-vertex `focal_flag` (uchar; codes listed in a header comment).
+/// A focal mesh with its per-vertex `focal_flag` (uchar; codes listed in a header comment); the
+/// focal points as doubles, or floats with Precision::float32 (the flags are the same).
 void write_focal_mesh_ply(const std::filesystem::path& path, const FocalMesh& focal,
                           const PlyWriteOptions& options = {});
 

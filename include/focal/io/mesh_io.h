@@ -18,7 +18,7 @@
 /// Writers go through a temporary file in the destination folder that is renamed at the end, so
 /// a failed write never leaves a half-written file behind (and an existing file stays as it was).
 /// Numbers are written in the shortest form that reads back exactly (doubles round-trip bit for
-/// bit through PLY, OBJ and OFF).
+/// bit through PLY, OBJ and OFF), or, with Precision::float32, as floats.
 
 #include <filesystem>
 #include <span>
@@ -39,8 +39,8 @@ enum class MeshFormat { obj, ply, off, stl, xyz };
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
 struct ReadOptions {
-  /// Threads of the parallel passes (binary PLY, OBJ, OFF): 0 for FOCAL_NUM_THREADS if set, else all
-  /// hardware threads. The mesh read does not depend on it.
+  /// Threads of the parallel passes (binary PLY, OBJ, OFF): 0 for FOCAL_NUM_THREADS if set, else
+  /// all hardware threads. The mesh read does not depend on it.
   int threads = 0;
   /// STL: weld facet corners into shared vertices (false: every corner is its own vertex, in file
   /// order, as the file stores them; no triangle then shares an edge).
@@ -64,6 +64,17 @@ struct ReadOptions {
 /// weld_tolerance.
 [[nodiscard]] Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 
+/// Precision of the real numbers a writer puts in a file.
+enum class Precision {
+  /// double: every value reads back bit for bit (binary PLY `double`; text in the shortest form
+  /// that reads back to the same double). The default.
+  float64,
+  /// float: each value v is written as static_cast<float>(v) (binary PLY `float`, 4 bytes; text
+  /// in the shortest form that reads back to the same float), for smaller files. Rounds to
+  /// float's 24-bit significand; values beyond float's range become +-inf; NaN stays NaN.
+  float32,
+};
+
 /// Scalar type a per-vertex property is stored as in PLY.
 enum class PropertyType { float32, float64, uint8, int32 };
 
@@ -80,11 +91,25 @@ struct PlyWriteOptions {
   /// Threads of the checks and of the binary encoding: 0 for FOCAL_NUM_THREADS if set, else all
   /// hardware threads. The bytes written do not depend on it.
   int threads = 0;
+  /// float32: positions, normals and `float64` properties written as `float` (the converted
+  /// values, see Precision); other property types are unchanged.
+  Precision precision = Precision::float64;
+};
+
+/// Options of the text writers (CSV, OBJ, OFF, point-cloud text) and of write_mesh.
+struct WriteOptions {
+  /// Threads of the CSV formatting and of binary PLY (write_mesh): 0 for FOCAL_NUM_THREADS if
+  /// set, else all hardware threads. The bytes written do not depend on it.
+  int threads = 0;
+  /// float32: every real number (coordinates, normals, CSV numbers) written as the float nearest
+  /// to it (Precision); PLY as `float` properties.
+  Precision precision = Precision::float64;
 };
 
 /// Writes V, F, the normals when present and any extra per-vertex properties as PLY:
-/// x y z (and nx ny nz) as `double` so that positions round-trip exactly, each property with its
-/// PropertyType, faces as `list uchar int vertex_indices`.
+/// x y z (and nx ny nz) as `double` so that positions round-trip exactly (`float` with
+/// Precision::float32), each property with its PropertyType (float64 ones as `float` with
+/// Precision::float32), faces as `list uchar int vertex_indices`.
 /// \throw InvalidInput when F indexes outside V, N has neither 0 nor #V rows, a property has not
 /// one value per vertex, a property name is empty, has blanks or repeats another, a uint8/int32
 /// property value is not an integer in range, or a comment holds a line break;
@@ -95,20 +120,24 @@ void write_ply(const std::filesystem::path& path, const Mesh& mesh,
 
 /// Writes V, F (and `vn` normals when present, faces as `v//vn`) as OBJ.
 /// \throw InvalidInput for invalid arrays (see write_ply); IoError naming the path on failure.
-void write_obj(const std::filesystem::path& path, const Mesh& mesh);
+void write_obj(const std::filesystem::path& path, const Mesh& mesh,
+               const WriteOptions& options = {});
 
 /// Writes V, F as OFF (NOFF when normals are present).
 /// \throw InvalidInput for invalid arrays (see write_ply); IoError naming the path on failure.
-void write_off(const std::filesystem::path& path, const Mesh& mesh);
+void write_off(const std::filesystem::path& path, const Mesh& mesh,
+               const WriteOptions& options = {});
 
 /// Writes V (and N when present) as point-cloud text: one `x y z [nx ny nz]` line per point,
 /// faces left out. \throw InvalidInput for invalid arrays; IoError naming the path on failure.
-void write_xyz(const std::filesystem::path& path, const Mesh& mesh);
+void write_xyz(const std::filesystem::path& path, const Mesh& mesh,
+               const WriteOptions& options = {});
 
 /// Writes a mesh in the format named by the extension (.ply binary, .obj, .off; .xyz and the
-/// other point-cloud text extensions: write_xyz).
+/// other point-cloud text extensions: write_xyz), with the options' precision and threads.
 /// \throw IoError for .stl (it cannot keep shared vertices) and unknown extensions.
-void write_mesh(const std::filesystem::path& path, const Mesh& mesh);
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
+                const WriteOptions& options = {});
 
 /// One column of a CSV table: numbers (shortest round-trip form; NaN written as `nan`, infinities
 /// as `inf` / `-inf`) or words (written as they are; quoted only when they hold a comma, a quote
@@ -123,6 +152,10 @@ struct CsvColumn {
 /// \throw InvalidInput when the columns differ in length or threads < 0; IoError on write failure.
 void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
                int threads = 0);
+/// write_csv with the numbers in the options' precision (Precision::float32: the shortest text of
+/// the float nearest to each number; `nan`, `inf`, `-inf` as above).
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
+               const WriteOptions& options);
 
 /// Writes a text file (a report, a Markdown table) through the same temporary-file-and-rename
 /// path as the other writers. \throw IoError on write failure.
