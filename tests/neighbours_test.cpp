@@ -93,6 +93,12 @@ TEST(NearestNeighbours, SameForAnyThreadCount) {
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.indices, two.indices);
   EXPECT_EQ(one.indices, five.indices);
+  // The spacing: per point in parallel, summed in row order as a serial loop would.
+  double sum = 0.0;
+  for (int i = 0; i < V.rows(); ++i) sum += (V.row(*one.begin(i)) - V.row(i)).norm();
+  EXPECT_EQ(detail::mean_spacing(V, one, 1), sum / static_cast<double>(V.rows()));
+  EXPECT_EQ(detail::mean_spacing(V, one, 2), sum / static_cast<double>(V.rows()));
+  EXPECT_EQ(mean_spacing(V, one), sum / static_cast<double>(V.rows()));
   const Neighbourhoods r1 = radius_neighbours(V, 0.1, 0, 1);
   const Neighbourhoods r2 = radius_neighbours(V, 0.1, 0, 2);
   EXPECT_EQ(r1.indices, r2.indices);

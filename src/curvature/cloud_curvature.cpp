@@ -145,7 +145,7 @@ CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
         options);
     if (any_flag(out.outlier)) out.neighbours = neighbourhoods_without(V, options, out.outlier);
   }
-  out.spacing = mean_spacing(V, out.neighbours);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
   out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
   out.file_normals_used = N.has_value();
   out.normals_estimated = !N;
@@ -213,7 +213,7 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   } else {
     out.neighbours = nearest_neighbours(V, out.k, options.threads);
   }
-  out.spacing = mean_spacing(V, out.neighbours);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
   CloudNormalOptions normals = normal_options(options);
   JetNormals jets = detail::cloud_jets(V, out.neighbours, normals);
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;

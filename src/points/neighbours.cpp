@@ -493,10 +493,10 @@ Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded,
   const std::size_t size =
       count > 0 ? NearestQuery(tree, static_cast<std::size_t>(k)).list_size() : 0;
   std::vector<int> sizes(static_cast<std::size_t>(V.rows()), 0);
-  for (std::int64_t p = 0; p < count; ++p) {
+  detail::parallel_for(count, threads, [&](std::int64_t p) {
     sizes[static_cast<std::size_t>(tree.row(static_cast<std::uint32_t>(p)))] =
         static_cast<int>(size);
-  }
+  });
   Neighbourhoods out;
   out.offsets = offsets_of(sizes);
   out.indices.resize(out.offsets[V.rows()]);
@@ -639,22 +639,22 @@ std::vector<char> detail::outlier_points(PositionsRef V, const Neighbourhoods& n
     throw InvalidInput("outlier_points: the measures are not the neighbourhoods'");
   }
   std::vector<char> outlier(static_cast<std::size_t>(n), 0);
-  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<double> around;
-    for (std::int64_t i = begin; i < end; ++i) {
-      const int p = static_cast<int>(i);
-      around.clear();
-      for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
-        if (std::isfinite(reach[static_cast<std::size_t>(*j)])) {
-          around.push_back(reach[static_cast<std::size_t>(*j)]);
-        }
-      }
-      if (around.empty()) continue;
-      const auto middle = around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2);
-      std::nth_element(around.begin(), middle, around.end());
-      const double r = reach[static_cast<std::size_t>(i)];
-      outlier[static_cast<std::size_t>(i)] = r > ratio * *middle;
+  // r > ratio x (the median m of the neighbours' finite reaches, element size / 2 of them
+  // sorted) without the median: x -> ratio * x is monotone in floating point too, so the test
+  // holds exactly when more than size / 2 of them have ratio * reach < r (then the sorted
+  // elements 0 .. size / 2 do, m among them; and conversely). The same flags as an nth_element
+  // per point.
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    const int p = static_cast<int>(i);
+    const double r = reach[static_cast<std::size_t>(i)];
+    int finite = 0, below = 0;
+    for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
+      const double a = reach[static_cast<std::size_t>(*j)];
+      if (!std::isfinite(a)) continue;
+      ++finite;
+      below += r > ratio * a;
     }
+    outlier[static_cast<std::size_t>(i)] = finite > 0 && below > finite / 2;
   });
   return outlier;
 }
@@ -743,11 +743,25 @@ std::vector<char> detail::off_surface_points(PositionsRef V, const Neighbourhood
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {
+  return detail::mean_spacing(V, neighbours, 0);
+}
+
+double detail::mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads) {
+  check_threads(threads);
+  // The distances in parallel (each a read of a row scattered over V), their sum in row order
+  // as before: the same bits for any thread count.
+  const int n = neighbours.vertex_count();
+  std::vector<double> nearest(static_cast<std::size_t>(n), NAN);
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    const int p = static_cast<int>(i);
+    if (neighbours.size(p) == 0) return;
+    nearest[static_cast<std::size_t>(i)] = (V.row(*neighbours.begin(p)) - V.row(p)).norm();
+  });
   double sum = 0.0;
   std::int64_t count = 0;
-  for (int i = 0; i < neighbours.vertex_count(); ++i) {
+  for (int i = 0; i < n; ++i) {
     if (neighbours.size(i) == 0) continue;
-    sum += (V.row(*neighbours.begin(i)) - V.row(i)).norm();
+    sum += nearest[static_cast<std::size_t>(i)];
     ++count;
   }
   return count > 0 ? sum / static_cast<double>(count) : 0.0;

@@ -46,4 +46,7 @@ std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbour
 std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
                                      const OutlierMeasures& measures, double ratio, int threads);
 
+/// mean_spacing(V, neighbours) on `threads` threads (the same value for any count).
+double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads);
+
 }  // namespace focal::detail
