@@ -4,7 +4,7 @@
 // (the tree's leaf-ordered copy, in cache); the tests over V's rows read them again, scattered
 // over all of V on a randomly ordered cloud. Measured on the 997,026-point torus of
 // docs/POINTS.md ("Speed and memory"): the same tests over a spatially sorted copy of it took
-// 0.7 s instead of 1.1-2.1 s on one thread.
+// 0.7-0.9 s instead of 1.0-1.4 s on one thread.
 
 #include <cmath>
 #include <vector>
