@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "points/neighbours_detail.h"
 
 namespace focal {
 namespace {
@@ -67,6 +69,22 @@ TEST(NearestNeighbours, MatchBruteForceWithTiesBrokenByIndex) {
   for (int k : {1, 6, 7, 20}) expect_lists(nearest_neighbours(grid, k, 2), grid, k, 0.0);
 }
 
+// The tree's top 8 levels are split one level at a time and the subtrees below built in
+// parallel: a cloud large enough for all of it (20000 points, 256 subtrees), with duplicates and
+// a flat part where coordinates tie, against brute force at every 37th point.
+TEST(NearestNeighbours, MatchBruteForceOnALargeCloudBuiltInParallel) {
+  RowMatrixX3d V = random_cloud(20000, 9);
+  for (int i = 0; i < 2000; ++i) V.row(10000 + i) = V.row(i);  // duplicates
+  for (int i = 12000; i < 14000; ++i) V(i, 2) = 0.25;          // a plane z = 0.25
+  for (int threads : {1, 2}) {
+    const Neighbourhoods nb = nearest_neighbours(V, 16, threads);
+    for (int i = 0; i < V.rows(); i += 37) {
+      const std::vector<int> got(nb.begin(i), nb.end(i));
+      ASSERT_EQ(got, brute_force(V, i, 16, 0.0)) << "point " << i << ", threads " << threads;
+    }
+  }
+}
+
 TEST(NearestNeighbours, SameForAnyThreadCount) {
   const RowMatrixX3d V = random_cloud(20000, 3);
   const Neighbourhoods one = nearest_neighbours(V, 16, 1);
@@ -75,6 +93,15 @@ TEST(NearestNeighbours, SameForAnyThreadCount) {
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.indices, two.indices);
   EXPECT_EQ(one.indices, five.indices);
+  // The spacing: per point in parallel, summed in row order as a serial loop would.
+  double sum = 0.0;
+  for (int i = 0; i < V.rows(); ++i) sum += (V.row(*one.begin(i)) - V.row(i)).norm();
+  EXPECT_EQ(detail::mean_spacing(V, one, 1), sum / static_cast<double>(V.rows()));
+  EXPECT_EQ(detail::mean_spacing(V, one, 2), sum / static_cast<double>(V.rows()));
+  EXPECT_EQ(mean_spacing(V, one), sum / static_cast<double>(V.rows()));
+  const Neighbourhoods r1 = radius_neighbours(V, 0.1, 0, 1);
+  const Neighbourhoods r2 = radius_neighbours(V, 0.1, 0, 2);
+  EXPECT_EQ(r1.indices, r2.indices);
 }
 
 TEST(NearestNeighbours, NonFinitePointsAreLeftOutAndFewPointsGiveShortLists) {
@@ -255,6 +282,143 @@ TEST(Neighbours, OffSurfacePointsKeepThePolesOfRings) {
   const std::vector<char> off = off_surface_points(V, nearest_neighbours(V, 16), 10.0);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     EXPECT_EQ(off[static_cast<std::size_t>(i)], i == moved ? 1 : 0) << i;
+  }
+}
+
+/// A unit sphere of n random points moved by noise of 0.1 spacing, 3% of them moved to random
+/// places in its bounding box and 2% moved 1-3 spacings along the normal (seeded).
+RowMatrixX3d noisy_sphere_with_outliers(int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double spacing = std::sqrt(4.0 * M_PI / n);
+  RowMatrixX3d V(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::RowVector3d p =
+        Eigen::RowVector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+    V.row(i) = p + 0.1 * spacing * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    const double kind = 0.5 * (u(rng) + 1.0);
+    if (kind < 0.03) V.row(i) << u(rng), u(rng), u(rng);
+    if (kind >= 0.03 && kind < 0.05)
+      V.row(i) = p * (1.0 + (2.0 * u(rng) + (u(rng) > 0 ? 1 : -1) * 2.0) * spacing);
+  }
+  return V;
+}
+
+/// outlier_points by its definition over brute-force lists, every point in row order.
+std::vector<char> reference_outliers(const RowMatrixX3d& V,
+                                     const std::vector<std::vector<int>>& lists, double ratio) {
+  const auto n = static_cast<std::size_t>(V.rows());
+  std::vector<double> reach(n, NAN);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (lists[i].empty()) continue;
+    double sum = 0.0;
+    for (int j : lists[i]) sum += (V.row(j) - V.row(static_cast<Eigen::Index>(i))).norm();
+    reach[i] = sum / static_cast<double>(lists[i].size());
+  }
+  std::vector<char> out(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<double> around;
+    for (int j : lists[i]) {
+      if (std::isfinite(reach[static_cast<std::size_t>(j)])) {
+        around.push_back(reach[static_cast<std::size_t>(j)]);
+      }
+    }
+    if (around.empty()) continue;
+    std::nth_element(around.begin(),
+                     around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2), around.end());
+    out[i] = reach[i] > ratio * around[around.size() / 2];
+  }
+  return out;
+}
+
+/// The distance of point p to the least-squares plane of its list without `without`, and that
+/// list's RMS distance to the plane (floored at 1e-9 x its mean distance to p), as
+/// neighbours.h states them; NaN for fewer than 3.
+std::pair<double, double> reference_plane(const RowMatrixX3d& V,
+                                          const std::vector<std::vector<int>>& lists, int p,
+                                          int without) {
+  const Eigen::RowVector3d origin = V.row(p);
+  Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+  double reach = 0.0;
+  int count = 0;
+  for (int j : lists[static_cast<std::size_t>(p)]) {
+    if (j == without) continue;
+    const Eigen::RowVector3d q = V.row(j) - origin;
+    sum += q;
+    moment += q.transpose() * q;
+    reach += q.norm();
+    ++count;
+  }
+  if (count < 3) return {NAN, NAN};
+  const Eigen::RowVector3d centroid = sum / count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(moment / count - centroid.transpose() * centroid);
+  const Eigen::RowVector3d normal = eig.eigenvectors().col(0).transpose();
+  if (!normal.allFinite()) return {NAN, NAN};
+  return {std::abs(centroid.dot(normal)),
+          std::max(std::sqrt(std::max(eig.eigenvalues()[0], 0.0)), 1e-9 * reach / count)};
+}
+
+/// off_surface_points by its definition over brute-force lists, every point in row order.
+std::vector<char> reference_off_surface(const RowMatrixX3d& V,
+                                        const std::vector<std::vector<int>>& lists, double ratio) {
+  std::vector<char> out(static_cast<std::size_t>(V.rows()), 0);
+  for (int p = 0; p < V.rows(); ++p) {
+    const auto [distance, spread] = reference_plane(V, lists, p, -1);
+    if (!(distance > ratio * spread)) continue;
+    std::vector<double> around;
+    for (int j : lists[static_cast<std::size_t>(p)]) {
+      const double d = reference_plane(V, lists, j, p).first;
+      if (std::isfinite(d)) around.push_back(d);
+    }
+    double typical = NAN;
+    if (!around.empty()) {
+      std::nth_element(around.begin(),
+                       around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2),
+                       around.end());
+      typical = around[around.size() / 2];
+    }
+    out[static_cast<std::size_t>(p)] = !(distance <= 0.5 * ratio * typical);
+  }
+  return out;
+}
+
+// Both outlier tests take the points in the tree's leaf order (Neighbourhoods::order), in
+// parallel: their flags are those of the definitions over brute-force lists in row order, for
+// several seeds and thread counts, and with the order dropped (row order) the same.
+TEST(Neighbours, OutlierTestsMatchTheirDefinitionsInAnyOrder) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const RowMatrixX3d V = noisy_sphere_with_outliers(3000, seed);
+    std::vector<std::vector<int>> lists(static_cast<std::size_t>(V.rows()));
+    for (int i = 0; i < V.rows(); ++i)
+      lists[static_cast<std::size_t>(i)] = brute_force(V, i, 16, 0.0);
+    const std::vector<char> isolated = reference_outliers(V, lists, 3.0);
+    const std::vector<char> off = reference_off_surface(V, lists, 10.0);
+    EXPECT_GT(std::count(isolated.begin(), isolated.end(), 1), 5) << seed;
+    EXPECT_GT(std::count(off.begin(), off.end(), 1), 5) << seed;
+    for (int threads : {1, 2, 5}) {
+      const Neighbourhoods nb = nearest_neighbours(V, 16, threads);
+      EXPECT_EQ(outlier_points(V, nb, 3.0, threads), isolated) << seed << " " << threads;
+      EXPECT_EQ(off_surface_points(V, nb, 10.0, threads), off) << seed << " " << threads;
+      // The cloud estimators' path: the measures taken by the kNN query itself, from the tree's
+      // copies of the points; the same lists, the same flags.
+      const detail::MeasuredNeighbours measured =
+          detail::measured_nearest_neighbours(V, 16, {}, threads);
+      EXPECT_EQ(measured.neighbours.offsets, nb.offsets);
+      EXPECT_EQ(measured.neighbours.indices, nb.indices);
+      EXPECT_EQ(detail::outlier_points(V, nb, measured.measures.reach, 3.0, threads), isolated)
+          << seed << " " << threads;
+      EXPECT_EQ(detail::off_surface_points(V, nb, measured.measures, 10.0, threads), off)
+          << seed << " " << threads;
+      // Without the isolated outliers (the lists the off-surface test takes when some are).
+      const detail::MeasuredNeighbours rest =
+          detail::measured_nearest_neighbours(V, 16, isolated, threads);
+      EXPECT_EQ(detail::off_surface_points(V, rest.neighbours, rest.measures, 10.0, threads),
+                off_surface_points(V, nearest_neighbours(V, 16, isolated, threads), 10.0, threads))
+          << seed << " " << threads;
+    }
   }
 }
 

@@ -19,6 +19,7 @@
 #include "mesh/prepared_detail.h"
 #include "normals/cloud_normals_detail.h"
 #include "points/natural_ring.h"
+#include "points/neighbours_detail.h"
 
 namespace focal {
 namespace {
@@ -86,20 +87,30 @@ bool any_flag(const std::vector<char>& flags) {
   return std::find(flags.begin(), flags.end(), 1) != flags.end();
 }
 
-/// The outlier tests of the options over `nearest16`, the 16 nearest of every point: statistical
-/// outliers, then points off the surface of their 16 nearest among the rest. Empty when both
-/// tests are off.
-std::vector<char> outlier_flags(PositionsRef V, const Neighbourhoods& nearest16,
+bool tests_on(const CloudOptions& o) { return o.outlier_ratio > 0.0 || o.off_surface_ratio > 0.0; }
+
+/// The outlier tests of the options over `nearest16`, the 16 nearest of every point (with their
+/// measures, points/neighbours_detail.h): statistical outliers, then points off the surface of
+/// their 16 nearest among the rest. Empty when both tests are off.
+std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours& nearest16,
                                 const CloudOptions& o) {
   std::vector<char> flags;
-  if (o.outlier_ratio > 0.0) flags = outlier_points(V, nearest16, o.outlier_ratio, o.threads);
+  if (o.outlier_ratio > 0.0) {
+    flags = detail::outlier_points(V, nearest16.neighbours, nearest16.measures.reach,
+                                   o.outlier_ratio, o.threads);
+  }
   if (o.off_surface_ratio == 0.0) return flags;
   // The planes without the isolated outliers, which would tilt them.
-  const std::vector<char> off = off_surface_points(
-      V,
-      any_flag(flags) ? nearest_neighbours(V, default_cloud_neighbours, flags, o.threads)
-                      : nearest16,
-      o.off_surface_ratio, o.threads);
+  std::vector<char> off;
+  if (any_flag(flags)) {
+    const detail::MeasuredNeighbours rest =
+        detail::measured_nearest_neighbours(V, default_cloud_neighbours, flags, o.threads);
+    off = detail::off_surface_points(V, rest.neighbours, rest.measures, o.off_surface_ratio,
+                                     o.threads);
+  } else {
+    off = detail::off_surface_points(V, nearest16.neighbours, nearest16.measures,
+                                     o.off_surface_ratio, o.threads);
+  }
   if (flags.empty()) return off;
   for (std::size_t i = 0; i < flags.size(); ++i) flags[i] = flags[i] || off[i];
   return flags;
@@ -115,19 +126,26 @@ CloudNormalOptions normal_options(const CloudOptions& o) {
 CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
                                 const CloudOptions& options) {
   CloudCurvature out;
-  out.neighbours = neighbourhoods_without(V, options, {});
-  if (options.outlier_ratio > 0.0 || options.off_surface_ratio > 0.0) {
-    // The tests are over the 16 nearest (where their ratios were measured): the lists at hand
-    // when they are those, else a query of their own.
-    const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
-                         options.k == default_cloud_neighbours;
+  // The tests are over the 16 nearest (where their ratios were measured): the lists asked for
+  // when they are those, else a query of their own.
+  const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
+                       options.k == default_cloud_neighbours;
+  if (!tests_on(options)) {
+    out.neighbours = neighbourhoods_without(V, options, {});
+  } else if (sixteen) {
+    detail::MeasuredNeighbours nearest16 =
+        detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads);
+    out.outlier = outlier_flags(V, nearest16, options);
+    out.neighbours = any_flag(out.outlier) ? neighbourhoods_without(V, options, out.outlier)
+                                           : std::move(nearest16.neighbours);
+  } else {
+    out.neighbours = neighbourhoods_without(V, options, {});
     out.outlier = outlier_flags(
-        V,
-        sixteen ? out.neighbours : nearest_neighbours(V, default_cloud_neighbours, options.threads),
+        V, detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads),
         options);
     if (any_flag(out.outlier)) out.neighbours = neighbourhoods_without(V, options, out.outlier);
   }
-  out.spacing = mean_spacing(V, out.neighbours);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
   out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
   out.file_normals_used = N.has_value();
   out.normals_estimated = !N;
@@ -185,14 +203,17 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
                              const CloudOptions& options) {
   CloudCurvature out;
   out.k = default_cloud_neighbours;
-  out.neighbours = nearest_neighbours(V, out.k, options.threads);
-  if (options.outlier_ratio > 0.0 || options.off_surface_ratio > 0.0) {
-    out.outlier = outlier_flags(V, out.neighbours, options);
-    if (any_flag(out.outlier)) {
-      out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
-    }
+  if (tests_on(options)) {
+    detail::MeasuredNeighbours nearest16 =
+        detail::measured_nearest_neighbours(V, out.k, {}, options.threads);
+    out.outlier = outlier_flags(V, nearest16, options);
+    out.neighbours = any_flag(out.outlier)
+                         ? nearest_neighbours(V, out.k, out.outlier, options.threads)
+                         : std::move(nearest16.neighbours);
+  } else {
+    out.neighbours = nearest_neighbours(V, out.k, options.threads);
   }
-  out.spacing = mean_spacing(V, out.neighbours);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
   CloudNormalOptions normals = normal_options(options);
   JetNormals jets = detail::cloud_jets(V, out.neighbours, normals);
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
