@@ -235,22 +235,28 @@ MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail de
   return t;
 }
 
-int degenerate_face_count(PositionsRef V, FacesRef F, int threads) {
+DegenerateFaces degenerate_faces(PositionsRef V, FacesRef F, int threads) {
   constexpr std::int64_t kBlock = 1 << 14;
   const std::int64_t blocks = (F.rows() + kBlock - 1) / kBlock;
-  std::vector<int> count(static_cast<std::size_t>(blocks), 0);
+  std::vector<DegenerateFaces> count(static_cast<std::size_t>(blocks));
   parallel_blocks(
       F.rows(), kBlock, threads, [&](std::int64_t b, std::int64_t begin, std::int64_t end) {
-        int n = 0;
+        DegenerateFaces n;
         for (auto f = begin; f < end; ++f) {
-          n += has_repeated_index(F, f) ||
-               is_degenerate_triangle(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
-                                      V.row(F(f, 2)).transpose());
+          if (has_repeated_index(F, f)) {
+            ++n.repeated_index;
+          } else {
+            n.zero_area += is_degenerate_triangle(
+                V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+          }
         }
         count[static_cast<std::size_t>(b)] = n;
       });
-  int total = 0;
-  for (const int n : count) total += n;
+  DegenerateFaces total;
+  for (const DegenerateFaces& n : count) {
+    total.repeated_index += n.repeated_index;
+    total.zero_area += n.zero_area;
+  }
   return total;
 }
 
@@ -267,7 +273,8 @@ MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads) {
     stats.max_corner = V.colwise().maxCoeff().transpose();
   }
   stats.mean_edge_length = mesh.mean_edge_length();
-  stats.degenerate_face_count = detail::degenerate_face_count(V, F, threads);
+  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, threads);
+  stats.degenerate_face_count = static_cast<int>(degenerate.repeated_index + degenerate.zero_area);
   const detail::MeshTopology t = detail::mesh_topology(*detail::incidence(mesh), F,
                                                        detail::TopologyDetail::statistics, threads);
   stats.component_count = t.components.count;
