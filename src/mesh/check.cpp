@@ -86,7 +86,7 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::Verte
   // Area weights: the face normals' own average, NaN where it does not exist (no usable face).
   const RowMatrixX3d from_faces =
       detail::vertex_normals_from(V, F, incidence, NormalWeighting::area, threads);
-  const std::vector<int>& component = topology.components.vertex_component;
+  const auto& component = topology.components.vertex_component;
   struct Tally {  // vertices with both normals, those against the faces, those pointing inside
     int compared = 0, against = 0, inside = 0, judged = 0;
     Tally& operator+=(const Tally& o) {

@@ -321,8 +321,8 @@ inline void unite(std::vector<int>& parent, int a, int b) {
 
 /// Connected components of faces, where faces sharing a vertex are connected.
 struct FaceComponents {
-  std::vector<int> face_component;    ///< #F, numbered in order of each component's first face
-  std::vector<int> vertex_component;  ///< #V, -1 for vertices in no face
+  UninitVector<int> face_component;    ///< #F, numbered in order of each component's first face
+  UninitVector<int> vertex_component;  ///< #V, -1 for vertices in no face
   int count = 0;
 };
 
@@ -358,7 +358,7 @@ inline void unite_shared(int* parent, int a, int b) {
 
 /// Numbers the sets of `root` (#V, each vertex's set root) in order of their first face:
 /// label[r] for each root r of a face's corners, -1 elsewhere. Returns the number of sets.
-inline int label_components_by_first_face(FacesRef F, const std::vector<int>& root,
+inline int label_components_by_first_face(FacesRef F, const UninitVector<int>& root,
                                           std::vector<int>& label, int threads) {
   // first[r]: the smallest face of set r, by an atomic minimum (the same for any schedule).
   std::vector<int> first(root.size(), std::numeric_limits<int>::max());
@@ -410,7 +410,7 @@ inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F, int
     unite_shared(parent.data(), F(f, 0), F(f, 1));
     unite_shared(parent.data(), F(f, 0), F(f, 2));
   });
-  std::vector<int> root(n);
+  UninitVector<int> root(n);
   parallel_for(vertex_count, threads, [&](std::int64_t v) {
     root[static_cast<std::size_t>(v)] = find_shared_root(parent.data(), static_cast<int>(v));
   });
