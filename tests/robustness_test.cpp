@@ -18,13 +18,15 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
-#include "focal/curvature/curvature.h"
 #include "focal/core/error.h"
+#include "focal/curvature/curvature.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
+#include "focal/mesh/prepared.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
@@ -560,16 +562,20 @@ std::vector<int> reference_face_components(const Mesh& m) {
   return out;
 }
 
-TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
-  const Mesh m = messy_big_mesh();
-  // Reference edge counts: incident faces per undirected edge, each face once per edge.
+// Edge and face counts by plain maps: incident faces per undirected edge (each face once per
+// edge), and faces repeating the vertex set of an earlier one.
+struct ReferenceCounts {
+  int edges = 0, boundary = 0, non_manifold = 0, duplicates = 0;
+};
+
+ReferenceCounts reference_counts(const Mesh& m) {
   std::map<std::pair<int, int>, int> faces_of_edge;
   std::set<std::array<int, 3>> triples;
-  int duplicates = 0;
+  ReferenceCounts r;
   for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
     std::array<int, 3> t{m.F(f, 0), m.F(f, 1), m.F(f, 2)};
     std::sort(t.begin(), t.end());
-    duplicates += triples.insert(t).second ? 0 : 1;
+    r.duplicates += triples.insert(t).second ? 0 : 1;
     std::set<std::pair<int, int>> edges;
     for (int c = 0; c < 3; ++c) {
       const int a = m.F(f, c), b = m.F(f, (c + 1) % 3);
@@ -577,14 +583,17 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     }
     for (const auto& e : edges) ++faces_of_edge[e];
   }
-  int boundary = 0, non_manifold = 0;
+  r.edges = static_cast<int>(faces_of_edge.size());
   for (const auto& [edge, count] : faces_of_edge) {
-    boundary += count == 1 ? 1 : 0;
-    non_manifold += count >= 3 ? 1 : 0;
+    r.boundary += count == 1 ? 1 : 0;
+    r.non_manifold += count >= 3 ? 1 : 0;
   }
-  const std::vector<int> components = reference_face_components(m);
-  // Reference normal counts against the faces' area-weighted normals (the second grid's faces
-  // are flipped, so its normals point against them).
+  return r;
+}
+
+// Vertices whose normals point against (and are compared with) the faces' area-weighted normals,
+// from the whole matrix of those normals.
+std::pair<int, int> reference_against_and_compared(const Mesh& m) {
   const RowMatrixX3d area = vertex_normals(m.V, m.F, NormalWeighting::area);
   int against = 0, compared = 0;
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
@@ -593,14 +602,23 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     ++compared;
     against += dot < 0.0 ? 1 : 0;
   }
+  return {against, compared};
+}
+
+TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
+  const Mesh m = messy_big_mesh();
+  const ReferenceCounts reference = reference_counts(m);
+  const std::vector<int> components = reference_face_components(m);
+  // The second grid's faces are flipped, so its normals point against them.
+  const auto [against, compared] = reference_against_and_compared(m);
   ASSERT_GT(against, 10000);
 
   for (const int threads : {1, 2, 3}) {
     const MeshStatistics s = mesh_statistics(m.V, m.F, threads);
-    EXPECT_EQ(s.edge_count, static_cast<int>(faces_of_edge.size()));
-    EXPECT_EQ(s.boundary_edge_count, boundary);
-    EXPECT_EQ(s.non_manifold_edge_count, non_manifold);
-    EXPECT_EQ(s.duplicate_face_count, duplicates);
+    EXPECT_EQ(s.edge_count, reference.edges);
+    EXPECT_EQ(s.boundary_edge_count, reference.boundary);
+    EXPECT_EQ(s.non_manifold_edge_count, reference.non_manifold);
+    EXPECT_EQ(s.duplicate_face_count, reference.duplicates);
     EXPECT_EQ(s.duplicate_face_count, 1);
     EXPECT_EQ(s.unreferenced_vertex_count, 1);
     EXPECT_EQ(s.non_manifold_vertex_count, 1);  // vertex 0: its grid fan and the joining face
@@ -641,6 +659,108 @@ TEST(Robustness, InwardNormalComponentsAreCountedAlikeForAnyThreadCount) {
     EXPECT_EQ(f.inward_normal_component_count, 1) << threads << " threads";
     EXPECT_EQ(f.normals_against_faces_count, n + n / 3) << threads << " threads";
     EXPECT_EQ(f.normals_compared_count, 3 * n) << threads << " threads";
+  }
+}
+
+// Gadgets for the topology pass's two paths (a regular vertex: one closed, consistent fan of 3
+// to 16 faces; any other vertex: its sorted edge sides), 300 copies with their faces shuffled:
+// two octahedra sharing a vertex (two closed fans there: non-manifold), a tetrahedron with one
+// face flipped, a cone of 20 sides closed by a fan (two vertices of valence 20), a 3 x 3 grid
+// (boundary), and a triangle twice, once reversed (duplicate; two faces at each corner).
+Mesh fan_gadgets(int copies) {
+  const std::vector<std::array<int, 3>> octahedron = {{0, 2, 3}, {0, 3, 4}, {0, 4, 5}, {0, 5, 2},
+                                                      {1, 3, 2}, {1, 4, 3}, {1, 5, 4}, {1, 2, 5}};
+  std::vector<std::array<int, 3>> gadget;
+  for (const auto& f : octahedron) gadget.push_back(f);  // vertices 0-5, apex 0
+  for (const auto& f : octahedron) {                     // 0 and 6-10: 0 is its other apex
+    const auto to = [](int c) { return c == 1 ? 0 : (c == 0 ? 6 : c + 5); };
+    gadget.push_back({to(f[0]), to(f[1]), to(f[2])});
+  }
+  for (const auto& f : std::vector<std::array<int, 3>>{{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 2, 3}})
+    gadget.push_back({f[0] + 11, f[1] + 11, f[2] + 11});  // the last face flipped
+  for (int i = 0; i < 20; ++i) {                          // apex 15, rim 16-35, bottom 36
+    gadget.push_back({15, 16 + i, 16 + (i + 1) % 20});
+    gadget.push_back({36, 16 + (i + 1) % 20, 16 + i});
+  }
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) {  // grid 37-45
+      const int a = 37 + 3 * i + j;
+      gadget.push_back({a, a + 1, a + 4});
+      gadget.push_back({a, a + 4, a + 3});
+    }
+  }
+  gadget.push_back({46, 47, 48});
+  gadget.push_back({46, 48, 47});
+  constexpr int kVertices = 49;
+  Mesh m;
+  m.V.resize(copies * kVertices, 3);
+  m.F.resize(copies * static_cast<Eigen::Index>(gadget.size()), 3);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    m.V.row(i) << unit(random) + static_cast<double>(i / kVertices) * 3.0, unit(random),
+        unit(random);
+  }
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(m.F.rows()));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::shuffle(order.begin(), order.end(), random);
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const auto& g = gadget[static_cast<std::size_t>(f) % gadget.size()];
+    const int base = static_cast<int>(f / static_cast<Eigen::Index>(gadget.size())) * kVertices;
+    m.F.row(order[static_cast<std::size_t>(f)]) << base + g[0], base + g[1], base + g[2];
+  }
+  m.N = vertex_normals(m.V, m.F, NormalWeighting::area);  // NaN on the doubled triangle
+  for (Eigen::Index i = 0; i < m.V.rows(); i += 7) m.N.row(i) *= -1.0;
+  return m;
+}
+
+TEST(Robustness, FindingsAndRingOfEveryKindOfFanAreAlikeForAnyThreadCount) {
+  constexpr int kCopies = 300;
+  const Mesh m = fan_gadgets(kCopies);
+  const ReferenceCounts reference = reference_counts(m);
+  const auto [against, compared] = reference_against_and_compared(m);
+  const Neighbourhoods ring = vertex_adjacency(static_cast<int>(m.V.rows()), m.F, 1);
+  const auto fields = [](const MeshFindings& f) {
+    return std::vector<int>{f.non_finite_vertex_count,
+                            f.repeated_index_face_count,
+                            f.degenerate_face_count,
+                            f.duplicate_face_count,
+                            f.unreferenced_vertex_count,
+                            f.non_manifold_edge_count,
+                            f.non_manifold_vertex_count,
+                            f.inconsistent_component_count,
+                            f.inward_component_count,
+                            f.non_finite_normal_count,
+                            f.zero_normal_count,
+                            f.non_unit_normal_count,
+                            f.normals_against_faces_count,
+                            f.normals_compared_count,
+                            f.inward_normal_component_count,
+                            f.boundary_edge_count,
+                            f.component_count};
+  };
+  std::vector<int> first;
+  for (const int threads : {1, 2, 3, 8}) {
+    const MeshStatistics s = mesh_statistics(m.V, m.F, threads);
+    EXPECT_EQ(s.edge_count, reference.edges) << threads << " threads";
+    EXPECT_EQ(s.boundary_edge_count, reference.boundary) << threads << " threads";
+    EXPECT_EQ(s.non_manifold_edge_count, reference.non_manifold) << threads << " threads";
+    EXPECT_EQ(s.duplicate_face_count, kCopies) << threads << " threads";
+    EXPECT_EQ(s.non_manifold_vertex_count, kCopies) << threads << " threads";  // the shared apex
+    EXPECT_EQ(s.component_count, 5 * kCopies) << threads << " threads";
+    const PreparedMesh p(m.V, m.F, m.N, {.threads = threads});
+    const MeshFindings f = check_mesh(p);
+    EXPECT_EQ(f.boundary_edge_count, reference.boundary);
+    EXPECT_EQ(f.duplicate_face_count, kCopies);
+    EXPECT_EQ(f.non_manifold_vertex_count, kCopies);
+    EXPECT_EQ(f.inconsistent_component_count, kCopies);  // the tetrahedra
+    EXPECT_EQ(f.normals_against_faces_count, against);
+    EXPECT_EQ(f.normals_compared_count, compared);
+    if (first.empty()) first = fields(f);
+    EXPECT_EQ(fields(f), first) << threads << " threads";
+    const Neighbourhoods& checked = p.one_ring();
+    EXPECT_EQ(checked.offsets, ring.offsets) << threads << " threads";
+    EXPECT_EQ(checked.indices, ring.indices) << threads << " threads";
   }
 }
 

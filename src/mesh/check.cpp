@@ -86,7 +86,7 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::Verte
   // Area weights: the face normals' own average, NaN where it does not exist (no usable face).
   const RowMatrixX3d from_faces =
       detail::vertex_normals_from(V, F, incidence, NormalWeighting::area, threads);
-  const std::vector<int>& component = topology.components.vertex_component;
+  const auto& component = topology.components.vertex_component;
   struct Tally {  // vertices with both normals, those against the faces, those pointing inside
     int compared = 0, against = 0, inside = 0, judged = 0;
     Tally& operator+=(const Tally& o) {
@@ -136,11 +136,10 @@ MeshFindings find_problems(const PreparedMesh& mesh) {
   MeshFindings out;
   out.non_finite_vertex_count =
       parallel_count(V.rows(), threads, [&](std::int64_t i) { return !V.row(i).allFinite(); });
-  out.repeated_index_face_count = parallel_count(
-      F.rows(), threads, [&](std::int64_t f) { return detail::has_repeated_index(F, f); });
-  // degenerate_face_count counts faces with a repeated index as degenerate too.
-  out.degenerate_face_count =
-      detail::degenerate_face_count(V, F, threads) - out.repeated_index_face_count;
+  // Both in one pass over the faces.
+  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, threads);
+  out.repeated_index_face_count = static_cast<int>(degenerate.repeated_index);
+  out.degenerate_face_count = static_cast<int>(degenerate.zero_area);
   out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
   out.unreferenced_vertex_count = static_cast<int>(topology.unreferenced_vertex_count);
   out.non_manifold_edge_count = static_cast<int>(topology.non_manifold_edge_count);

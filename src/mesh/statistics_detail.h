@@ -41,8 +41,13 @@ enum class TopologyDetail { orientation, statistics };
 MeshTopology mesh_topology(const VertexFaces& inc, FacesRef F, TopologyDetail detail, int threads,
                            Neighbourhoods* one_ring = nullptr);
 
-/// Faces with a repeated index or numerically zero area (is_degenerate_triangle), in parallel.
-/// F must already be validated against V.
-int degenerate_face_count(PositionsRef V, FacesRef F, int threads);
+/// Counts of the faces that span no triangle.
+struct DegenerateFaces {
+  std::int64_t repeated_index = 0;  ///< faces with a repeated index (has_repeated_index)
+  std::int64_t zero_area = 0;  ///< the others of numerically zero area (is_degenerate_triangle)
+};
+
+/// DegenerateFaces of F in one parallel pass. F must already be validated against V.
+DegenerateFaces degenerate_faces(PositionsRef V, FacesRef F, int threads);
 
 }  // namespace focal::detail

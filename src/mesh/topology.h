@@ -15,6 +15,8 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -102,11 +104,38 @@ inline bool is_degenerate_triangle(const Eigen::Vector3d& a, const Eigen::Vector
   return (b - a).cross(c - a).norm() <= kDegenerateArea * longest_sq;
 }
 
+/// An allocator whose value-less construct() leaves a new element uninitialised, so that
+/// resize() does not zero the array: for arrays of ints that a parallel pass then writes in full.
+/// Zeroing them first wrote every page on one thread (its page faults included) before the
+/// parallel pass wrote it again.
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <class U>
+  explicit DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+/// A std::vector whose resize() leaves new ints uninitialised (DefaultInitAllocator).
+template <class T>
+using UninitVector = std::vector<T, DefaultInitAllocator<T>>;
+
 /// Faces containing each vertex in CSR form: `faces[offsets[v] .. offsets[v+1])`, ascending, each
 /// face once even when it repeats the vertex.
 struct VertexFaces {
-  std::vector<int> offsets;  ///< #V + 1
-  std::vector<int> faces;
+  UninitVector<int> offsets;  ///< #V + 1
+  UninitVector<int> faces;
 
   [[nodiscard]] int begin(std::int64_t v) const { return offsets[static_cast<std::size_t>(v)]; }
   [[nodiscard]] int end(std::int64_t v) const { return offsets[static_cast<std::size_t>(v) + 1]; }
@@ -292,8 +321,8 @@ inline void unite(std::vector<int>& parent, int a, int b) {
 
 /// Connected components of faces, where faces sharing a vertex are connected.
 struct FaceComponents {
-  std::vector<int> face_component;    ///< #F, numbered in order of each component's first face
-  std::vector<int> vertex_component;  ///< #V, -1 for vertices in no face
+  UninitVector<int> face_component;    ///< #F, numbered in order of each component's first face
+  UninitVector<int> vertex_component;  ///< #V, -1 for vertices in no face
   int count = 0;
 };
 
@@ -329,7 +358,7 @@ inline void unite_shared(int* parent, int a, int b) {
 
 /// Numbers the sets of `root` (#V, each vertex's set root) in order of their first face:
 /// label[r] for each root r of a face's corners, -1 elsewhere. Returns the number of sets.
-inline int label_components_by_first_face(FacesRef F, const std::vector<int>& root,
+inline int label_components_by_first_face(FacesRef F, const UninitVector<int>& root,
                                           std::vector<int>& label, int threads) {
   // first[r]: the smallest face of set r, by an atomic minimum (the same for any schedule).
   std::vector<int> first(root.size(), std::numeric_limits<int>::max());
@@ -374,14 +403,14 @@ inline int label_components_by_first_face(FacesRef F, const std::vector<int>& ro
 /// the same for any thread count. F must already be validated against vertex_count.
 inline FaceComponents face_components(std::int64_t vertex_count, FacesRef F, int threads) {
   const auto n = static_cast<std::size_t>(vertex_count);
-  std::vector<int> parent(n);
+  UninitVector<int> parent(n);  // written in full by the parallel pass below
   parallel_for(vertex_count, threads,
                [&](std::int64_t v) { parent[static_cast<std::size_t>(v)] = static_cast<int>(v); });
   parallel_for(F.rows(), threads, [&](std::int64_t f) {
     unite_shared(parent.data(), F(f, 0), F(f, 1));
     unite_shared(parent.data(), F(f, 0), F(f, 2));
   });
-  std::vector<int> root(n);
+  UninitVector<int> root(n);
   parallel_for(vertex_count, threads, [&](std::int64_t v) {
     root[static_cast<std::size_t>(v)] = find_shared_root(parent.data(), static_cast<int>(v));
   });
