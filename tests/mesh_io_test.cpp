@@ -286,6 +286,48 @@ TEST_F(MeshIo, PlyBinaryRoundTripIsExact) {
   }
 }
 
+TEST_F(MeshIo, TextWritersGiveTheSameBytesOnAnyThreadCount) {
+  // 40,000 vertices and faces: more lines than one batch of the parallel blocks (32,768), so
+  // blocks, batches and the header before them all meet.
+  Mesh m;
+  const int n = 40000;
+  m.V.resize(n, 3);
+  m.N.resize(n, 3);
+  m.F.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    m.V.row(i) << 0.001 * i, std::sin(0.37 * i), 1.0 / (i + 1);
+    m.N.row(i) << 0.0, std::cos(0.37 * i), i % 7 == 0 ? -0.0 : 1e-300 * i;
+    m.F.row(i) << i, (i + 1) % n, (i + 2) % n;
+  }
+  const std::vector<focal::CsvColumn> columns{{"x", Eigen::VectorXd(m.V.col(0))},
+                                              {"word", std::vector<std::string>(n, "a,b")}};
+  for (const focal::Precision precision : {focal::Precision::float64, focal::Precision::float32}) {
+    std::vector<std::string> first;
+    for (const int threads : {1, 2, 3}) {
+      SCOPED_TRACE("threads " + std::to_string(threads));
+      const focal::WriteOptions o{.threads = threads, .precision = precision};
+      focal::write_obj(file("t.obj"), m, o);
+      focal::write_off(file("t.off"), m, o);
+      focal::write_xyz(file("t.xyz"), m, o);
+      focal::write_ply(
+          file("t.ply"), m, {},
+          {.binary = false, .comments = {}, .threads = threads, .precision = precision});
+      focal::write_csv(file("t.csv"), columns, o);
+      const std::vector<std::string> bytes{slurp(file("t.obj")), slurp(file("t.off")),
+                                           slurp(file("t.xyz")), slurp(file("t.ply")),
+                                           slurp(file("t.csv"))};
+      if (first.empty()) first = bytes;
+      for (std::size_t k = 0; k < bytes.size(); ++k) EXPECT_TRUE(bytes[k] == first[k]) << k;
+    }
+    // And what the writers wrote is the mesh (OBJ as a check that the lines are complete).
+    const Mesh back = focal::read_mesh(file("t.obj"));
+    EXPECT_EQ(back.V.rows(), n);
+    EXPECT_EQ(back.F.rows(), n);
+  }
+  expect_error<focal::InvalidInput>([&] { focal::write_obj(file("t.obj"), m, {.threads = -1}); },
+                                    {"write_obj", "threads"});
+}
+
 TEST_F(MeshIo, PlyAsciiRoundTripIsExact) {
   for (const bool normals : {false, true}) {
     const Mesh m = sample_mesh(normals);

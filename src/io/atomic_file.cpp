@@ -1,5 +1,6 @@
 #include "io/atomic_file.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <charconv>
@@ -8,6 +9,7 @@
 #include <random>
 #include <system_error>
 
+#include "core/parallel.h"
 #include "focal/io/mesh_io.h"
 #include "io/detail.h"
 
@@ -165,6 +167,29 @@ void write_atomically(const std::filesystem::path& path,
     group->adopt(std::move(file));
   } else {
     file->commit();
+  }
+}
+
+void write_lines(OutputSink& sink, std::int64_t count, int threads,
+                 const std::function<void(std::string&, std::int64_t)>& append_line) {
+  // Blocks of 2,048 items, a batch of 16 blocks at a time, each block into a text of its own.
+  constexpr std::int64_t kBlock = 2048;
+  constexpr std::int64_t kBlocksPerBatch = 16;
+  std::vector<std::string> texts(static_cast<std::size_t>(kBlocksPerBatch));
+  for (std::int64_t first = 0; first < count; first += kBlock * kBlocksPerBatch) {
+    const std::int64_t n = std::min<std::int64_t>(kBlock * kBlocksPerBatch, count - first);
+    detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+      // Formatted into a string object of this thread's own: the texts' objects share cache
+      // lines, and a length updated there on every append made two threads slower than one.
+      std::string text = std::move(texts[static_cast<std::size_t>(begin / kBlock)]);
+      text.clear();
+      for (auto i = begin; i < end; ++i) append_line(text, first + i);
+      texts[static_cast<std::size_t>(begin / kBlock)] = std::move(text);
+    });
+    for (std::int64_t b = 0; b * kBlock < n; ++b) {
+      const std::string& text = texts[static_cast<std::size_t>(b)];
+      sink.write(text.data(), text.size());
+    }
   }
 }
 

@@ -15,6 +15,7 @@
 /// protects against half-written files from failures in the process, not against power loss.
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -80,6 +81,12 @@ class OutputSink {
   AtomicFile& file_;
   std::string buffer_;
 };
+
+/// Writes the lines of items [0, count), append_line(out, i) for item i, formatted in parallel
+/// blocks on `threads` threads (0: the default) and written in item order after whatever the
+/// sink's buffer holds, so the bytes do not depend on the thread count.
+void write_lines(OutputSink& sink, std::int64_t count, int threads,
+                 const std::function<void(std::string&, std::int64_t)>& append_line);
 
 /// Several files written all or nothing (a two-phase commit): while a group is open on a thread,
 /// write_atomically on that thread writes and closes its temporary file but leaves the rename to

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
 #include "io/atomic_file.h"
@@ -72,26 +71,7 @@ void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> col
       append_field(out, columns[c].name);
     }
     out += '\n';
-    // Rows formatted in parallel blocks, a batch of blocks at a time, each block into a text of
-    // its own; the texts go out in row order, so the bytes do not depend on the thread count.
-    constexpr std::int64_t kBlock = 2048;
-    constexpr std::int64_t kBlocksPerBatch = 16;
-    std::vector<std::string> texts(static_cast<std::size_t>(kBlocksPerBatch));
-    for (std::int64_t first = 0; first < rows; first += kBlock * kBlocksPerBatch) {
-      const std::int64_t n = std::min<std::int64_t>(kBlock * kBlocksPerBatch, rows - first);
-      detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
-        // Formatted into a string object of this thread's own: the texts' objects share cache
-        // lines, and a length updated there on every append made two threads slower than one.
-        std::string text = std::move(texts[static_cast<std::size_t>(begin / kBlock)]);
-        text.clear();
-        for (auto r = begin; r < end; ++r) append_row(text, first + r);
-        texts[static_cast<std::size_t>(begin / kBlock)] = std::move(text);
-      });
-      for (std::int64_t b = 0; b * kBlock < n; ++b) {
-        const std::string& text = texts[static_cast<std::size_t>(b)];
-        sink.write(text.data(), text.size());
-      }
-    }
+    io_detail::write_lines(sink, rows, threads, append_row);
   });
 }
 

@@ -442,38 +442,39 @@ Mesh read_obj(const std::filesystem::path& path, int threads) {
 }  // namespace io_detail
 
 void write_obj(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_obj: " + path.string()).c_str());
+  if (options.threads < 0) throw InvalidInput("write_obj: threads must be >= 0");
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_obj: " + path.string()).c_str(),
+                       options.threads);
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    std::string& out = sink.buffer();
     // `v x y z` lines, then `vn x y z` lines.
     const auto append_rows = [&](std::string_view keyword, const RowMatrixX3d& rows) {
-      for (Eigen::Index i = 0; i < rows.rows(); ++i) {
-        out += keyword;
-        for (int c = 0; c < 3; ++c) {
-          out += ' ';
-          io_detail::append_real(out, rows(i, c), options.precision);
-        }
-        out += '\n';
-        sink.maybe_flush();
-      }
+      io_detail::write_lines(sink, rows.rows(), options.threads,
+                             [&](std::string& out, std::int64_t i) {
+                               out += keyword;
+                               for (int c = 0; c < 3; ++c) {
+                                 out += ' ';
+                                 io_detail::append_real(out, rows(i, c), options.precision);
+                               }
+                               out += '\n';
+                             });
     };
     append_rows("v", mesh.V);
     if (normals) append_rows("vn", mesh.N);
-    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-      out += 'f';
-      for (int c = 0; c < 3; ++c) {
-        const auto index = static_cast<std::int64_t>(mesh.F(f, c)) + 1;
-        out += ' ';
-        io_detail::append_number(out, index);
-        if (normals) {
-          out += "//";
-          io_detail::append_number(out, index);
-        }
-      }
-      out += '\n';
-      sink.maybe_flush();
-    }
+    io_detail::write_lines(sink, mesh.F.rows(), options.threads,
+                           [&](std::string& out, std::int64_t f) {
+                             out += 'f';
+                             for (int c = 0; c < 3; ++c) {
+                               const auto index = static_cast<std::int64_t>(mesh.F(f, c)) + 1;
+                               out += ' ';
+                               io_detail::append_number(out, index);
+                               if (normals) {
+                                 out += "//";
+                                 io_detail::append_number(out, index);
+                               }
+                             }
+                             out += '\n';
+                           });
   });
 }
 

@@ -327,20 +327,22 @@ Mesh read_off(const std::filesystem::path& path, int threads) {
 }  // namespace io_detail
 
 void write_off(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str());
+  if (options.threads < 0) throw InvalidInput("write_off: threads must be >= 0");
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str(),
+                       options.threads);
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    std::string& out = sink.buffer();
-    out += normals ? "NOFF\n" : "OFF\n";
-    out += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
-    for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      io_detail::append_vertex_line(out, mesh, i, normals, options.precision);
-      sink.maybe_flush();
-    }
-    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-      io_detail::append_ascii_triangle(out, mesh.F, f);
-      sink.maybe_flush();
-    }
+    std::string& header = sink.buffer();
+    header += normals ? "NOFF\n" : "OFF\n";
+    header += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
+    io_detail::write_lines(
+        sink, mesh.V.rows(), options.threads, [&](std::string& line, std::int64_t i) {
+          io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
+        });
+    io_detail::write_lines(sink, mesh.F.rows(), options.threads,
+                           [&](std::string& line, std::int64_t f) {
+                             io_detail::append_ascii_triangle(line, mesh.F, f);
+                           });
   });
 }
 

@@ -120,10 +120,9 @@ void append_property_ascii(std::string& out, PropertyType t, double v) {
 }
 
 void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
-                          std::span<const PlyColumn> columns, Precision precision) {
-  std::string& out = sink.buffer();
+                          std::span<const PlyColumn> columns, Precision precision, int threads) {
   const bool normals = mesh.has_normals();
-  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
+  io_detail::write_lines(sink, mesh.V.rows(), threads, [&](std::string& out, std::int64_t i) {
     for (int c = 0; c < (normals ? 6 : 3); ++c) {
       if (c > 0) out += ' ';
       io_detail::append_real(out, c < 3 ? mesh.V(i, c) : mesh.N(i, c - 3), precision);
@@ -133,12 +132,10 @@ void write_ply_body_ascii(io_detail::OutputSink& sink, const Mesh& mesh,
       append_property_ascii(out, column.type, column.value(i));
     }
     out += '\n';
-    sink.maybe_flush();
-  }
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+  });
+  io_detail::write_lines(sink, mesh.F.rows(), threads, [&](std::string& out, std::int64_t f) {
     io_detail::append_ascii_triangle(out, mesh.F, f);
-    sink.maybe_flush();
-  }
+  });
 }
 
 /// Writes `count` fixed-size records of `record` bytes in batches of about 8 MiB, each filled in
@@ -265,7 +262,7 @@ void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
     if (options.binary) {
       write_ply_body_binary(sink, mesh, file_columns, options);
     } else {
-      write_ply_body_ascii(sink, mesh, file_columns, options.precision);
+      write_ply_body_ascii(sink, mesh, file_columns, options.precision, options.threads);
     }
   });
 }

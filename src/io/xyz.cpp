@@ -174,14 +174,15 @@ Mesh read_xyz(const std::filesystem::path& path) {
 }  // namespace io_detail
 
 void write_xyz(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_xyz: " + path.string()).c_str());
+  if (options.threads < 0) throw InvalidInput("write_xyz: threads must be >= 0");
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_xyz: " + path.string()).c_str(),
+                       options.threads);
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    std::string& out = sink.buffer();
-    for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-      io_detail::append_vertex_line(out, mesh, i, normals, options.precision);
-      sink.maybe_flush();
-    }
+    io_detail::write_lines(
+        sink, mesh.V.rows(), options.threads, [&](std::string& line, std::int64_t i) {
+          io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
+        });
   });
 }
 
