@@ -119,21 +119,62 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_TRUE(same_bits(a.face_source, b.face_source));
 }
 
-const std::filesystem::path kPath = "grid.obj";
+/// A reader on text in memory with threads and run size (parse_obj, parse_off, parse_ply,
+/// parse_stl), and its parallel read alone (parse_X_in_chunks: nothing where it falls back).
+using Parser = Mesh (*)(const std::filesystem::path&, std::string_view, int, std::size_t);
+using ChunkParser = std::optional<Mesh> (*)(const std::filesystem::path&, std::string_view, int,
+                                            std::size_t);
 
-Mesh serial_obj(std::string_view text) {
-  return io_detail::parse_obj(kPath, text, 1, io_detail::kTextChunkBytes);
+/// The serial read of `text`.
+Mesh serial_read(Parser parse, const std::filesystem::path& path, std::string_view text) {
+  return parse(path, text, 1, io_detail::kTextChunkBytes);
 }
 
-/// The message of the IoError that parse_obj throws on `text` with these threads and runs.
-std::string obj_error(std::string_view text, int threads, std::size_t run_bytes) {
+/// Every thread count and run size gives `serial` bit for bit, and the parallel read has run (not
+/// fallen back) wherever there are threads to run it.
+void expect_serial_mesh_everywhere(Parser parse, ChunkParser in_chunks,
+                                   const std::filesystem::path& path, std::string_view text,
+                                   const Mesh& serial) {
+  for (const std::size_t run : kRunBytes) {
+    for (const int threads : kThreads) {
+      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
+      expect_same_mesh(parse(path, text, threads, run), serial);
+      const std::optional<Mesh> parallel = in_chunks(path, text, threads, run);
+      ASSERT_EQ(parallel.has_value(), threads > 1);
+      if (parallel) expect_same_mesh(*parallel, serial);
+    }
+  }
+}
+
+/// The message of the IoError that `parse` throws on `text` with these threads and runs.
+std::string error_of(Parser parse, const std::filesystem::path& path, std::string_view text,
+                     int threads, std::size_t run_bytes) {
   try {
-    (void)io_detail::parse_obj(kPath, text, threads, run_bytes);
+    (void)parse(path, text, threads, run_bytes);
   } catch (const IoError& e) {
     return e.what();
   }
   return "no error";
 }
+
+/// The serial read's error on each broken text, after checking that every thread count and run
+/// size gives it word for word.
+std::vector<std::string> serial_errors_everywhere(Parser parse, const std::filesystem::path& path,
+                                                  const std::vector<std::string>& broken) {
+  std::vector<std::string> errors;
+  for (std::size_t b = 0; b < broken.size(); ++b) {
+    errors.push_back(error_of(parse, path, broken[b], 1, io_detail::kTextChunkBytes));
+    for (const std::size_t run : kRunBytes) {
+      for (const int threads : kThreads) {
+        EXPECT_EQ(error_of(parse, path, broken[b], threads, run), errors.back())
+            << "case " << b << ", run bytes " << run << ", threads " << threads;
+      }
+    }
+  }
+  return errors;
+}
+
+const std::filesystem::path kPath = "grid.obj";
 
 /// Offset of the start of `line` (1-based).
 std::size_t line_start(const std::string& text, std::size_t line) {
@@ -162,7 +203,7 @@ std::size_t line_in_the_middle(const std::string& text, std::string_view prefix,
 
 TEST(ObjParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
   const std::string text = obj_text();
-  const Mesh serial = serial_obj(text);
+  const Mesh serial = serial_read(static_cast<Parser>(&io_detail::parse_obj), kPath, text);
   ASSERT_EQ(serial.V.rows(), kRows * kCols);
   // Per row of cells: 6 hexagons (4 triangles each) covering 12 cells, 7 cells split in two, the
   // remaining 40 cells quads (2 triangles each); plus the forward-referencing triangle.
@@ -170,17 +211,8 @@ TEST(ObjParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
   EXPECT_EQ(serial.V(1, 0), 0.1 + 1e-7);
   EXPECT_EQ(serial.V(kRows * kCols - 1, 2), 1.0 / kRows / kCols);
   ASSERT_EQ(serial.N.rows(), serial.V.rows());
-  for (const std::size_t run : kRunBytes) {
-    for (const int threads : kThreads) {
-      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
-      expect_same_mesh(io_detail::parse_obj(kPath, text, threads, run), serial);
-      const std::optional<Mesh> parallel =
-          io_detail::parse_obj_in_chunks(kPath, text, threads, run);
-      // The parallel read must have run (not fallen back) wherever there are threads to run it.
-      ASSERT_EQ(parallel.has_value(), threads > 1);
-      if (parallel) expect_same_mesh(*parallel, serial);
-    }
-  }
+  expect_serial_mesh_everywhere(static_cast<Parser>(&io_detail::parse_obj),
+                                &io_detail::parse_obj_in_chunks, kPath, text, serial);
 }
 
 TEST(ObjParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
@@ -207,15 +239,10 @@ TEST(ObjParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
       "line " + std::to_string(f_line) + ": face ",
       "byte offset ",
   };
+  const std::vector<std::string> serial =
+      serial_errors_everywhere(static_cast<Parser>(&io_detail::parse_obj), kPath, broken);
   for (std::size_t b = 0; b < broken.size(); ++b) {
-    const std::string serial = obj_error(broken[b], 1, io_detail::kTextChunkBytes);
-    EXPECT_NE(serial.find(where[b]), std::string::npos) << serial;
-    for (const std::size_t run : kRunBytes) {
-      for (const int threads : kThreads) {
-        EXPECT_EQ(obj_error(broken[b], threads, run), serial)
-            << "run bytes " << run << ", threads " << threads;
-      }
-    }
+    EXPECT_NE(serial[b].find(where[b]), std::string::npos) << serial[b];
   }
 }
 
@@ -223,7 +250,7 @@ TEST(ObjParallelRead, RelativeIndicesFallBackToTheSerialRead) {
   const std::string text = obj_text();
   const std::size_t line = line_in_the_middle(text, "f ");
   const std::string relative = with_line(text, line, "f -1 -2/-3 -3//-4");
-  const Mesh serial = serial_obj(relative);
+  const Mesh serial = serial_read(static_cast<Parser>(&io_detail::parse_obj), kPath, relative);
   EXPECT_FALSE(io_detail::parse_obj_in_chunks(kPath, relative, 8, 4096).has_value());
   for (const int threads : kThreads) {
     expect_same_mesh(io_detail::parse_obj(kPath, relative, threads, 4096), serial);
@@ -307,39 +334,18 @@ std::string off_text(bool normals) {
          faces + "# end\n";
 }
 
-Mesh serial_off(std::string_view text) {
-  return io_detail::parse_off(kOffPath, text, 1, io_detail::kTextChunkBytes);
-}
-
-std::string off_error(std::string_view text, int threads, std::size_t run_bytes) {
-  try {
-    (void)io_detail::parse_off(kOffPath, text, threads, run_bytes);
-  } catch (const IoError& e) {
-    return e.what();
-  }
-  return "no error";
-}
-
 TEST(OffParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
   for (const bool normals : {false, true}) {
     const std::string text = off_text(normals);
-    const Mesh serial = serial_off(text);
+    const Mesh serial = serial_read(static_cast<Parser>(&io_detail::parse_off), kOffPath, text);
     ASSERT_EQ(serial.V.rows(), kRows * kCols);
     EXPECT_EQ(serial.F.rows(), (kRows - 1) * (6 * 4 + 7 * 2 + 40 * 2));
     EXPECT_EQ(serial.V(1, 0), 0.1 + 1e-7);
     EXPECT_EQ(serial.V(kRows * kCols - 1, 2), 1.0 / kRows / kCols);
     EXPECT_EQ(serial.N.rows(), normals ? serial.V.rows() : 0);
-    for (const std::size_t run : kRunBytes) {
-      for (const int threads : kThreads) {
-        SCOPED_TRACE("normals " + std::to_string(normals) + ", run bytes " + std::to_string(run) +
-                     ", threads " + std::to_string(threads));
-        expect_same_mesh(io_detail::parse_off(kOffPath, text, threads, run), serial);
-        const std::optional<Mesh> parallel =
-            io_detail::parse_off_in_chunks(kOffPath, text, threads, run);
-        ASSERT_EQ(parallel.has_value(), threads > 1);
-        if (parallel) expect_same_mesh(*parallel, serial);
-      }
-    }
+    SCOPED_TRACE("normals " + std::to_string(normals));
+    expect_serial_mesh_everywhere(static_cast<Parser>(&io_detail::parse_off),
+                                  &io_detail::parse_off_in_chunks, kOffPath, text, serial);
   }
 }
 
@@ -366,22 +372,15 @@ TEST(OffParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
       "line " + std::to_string(f_line) + ": face ",
       "file ends inside face ",
   };
+  const std::vector<std::string> serial =
+      serial_errors_everywhere(static_cast<Parser>(&io_detail::parse_off), kOffPath, broken);
   for (std::size_t b = 0; b < broken.size(); ++b) {
-    const std::string serial = off_error(broken[b], 1, io_detail::kTextChunkBytes);
-    EXPECT_NE(serial.find(where[b]), std::string::npos) << serial;
-    for (const std::size_t run : kRunBytes) {
-      for (const int threads : kThreads) {
-        EXPECT_EQ(off_error(broken[b], threads, run), serial)
-            << "run bytes " << run << ", threads " << threads;
-      }
-    }
+    EXPECT_NE(serial[b].find(where[b]), std::string::npos) << serial[b];
   }
 }
 
 // Differential: random edits anywhere in the files (bytes replaced, erased, inserted; the file
 // cut) must give the serial reader's mesh or its error, with 3 threads on 97-byte runs.
-
-using Parser = Mesh (*)(const std::filesystem::path&, std::string_view, int, std::size_t);
 
 /// The mesh, or the IoError's message.
 struct Outcome {
@@ -501,32 +500,15 @@ std::string ply_text() {
 
 TEST(PlyParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
   const std::string text = ply_text();
-  const Mesh serial = io_detail::parse_ply(kPlyPath, text, 1, io_detail::kTextChunkBytes);
+  const Mesh serial = serial_read(static_cast<Parser>(&io_detail::parse_ply), kPlyPath, text);
   ASSERT_EQ(serial.V.rows(), kRows * kCols);
   // Per row of cells: 6 hexagons (4 triangles each) and 47 quads (2 each); then the two strips,
   // 0 1 60 61 (ended by a -1) and 2 3 62 63, of two triangles each.
   EXPECT_EQ(serial.F.rows(), (kRows - 1) * (6 * 4 + 47 * 2) + 2 + 2);
   EXPECT_EQ(serial.V(1, 0), 0.1 + 1e-7);
   EXPECT_EQ(serial.N.rows(), serial.V.rows());
-  for (const std::size_t run : kRunBytes) {
-    for (const int threads : kThreads) {
-      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
-      expect_same_mesh(io_detail::parse_ply(kPlyPath, text, threads, run), serial);
-      const std::optional<Mesh> parallel =
-          io_detail::parse_ply_in_chunks(kPlyPath, text, threads, run);
-      ASSERT_EQ(parallel.has_value(), threads > 1);
-      if (parallel) expect_same_mesh(*parallel, serial);
-    }
-  }
-}
-
-std::string ply_error(std::string_view text, int threads, std::size_t run_bytes) {
-  try {
-    (void)io_detail::parse_ply(kPlyPath, text, threads, run_bytes);
-  } catch (const IoError& e) {
-    return e.what();
-  }
-  return "no error";
+  expect_serial_mesh_everywhere(static_cast<Parser>(&io_detail::parse_ply),
+                                &io_detail::parse_ply_in_chunks, kPlyPath, text, serial);
 }
 
 TEST(PlyParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
@@ -544,18 +526,14 @@ TEST(PlyParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
       with_line(text, f_line, "4 1 2 3 4"),
       cut,
   };
+  const std::vector<std::string> serial =
+      serial_errors_everywhere(static_cast<Parser>(&io_detail::parse_ply), kPlyPath, broken);
   for (std::size_t b = 0; b < broken.size(); ++b) {
-    const std::string serial = ply_error(broken[b], 1, io_detail::kTextChunkBytes);
     const std::size_t line = b < 3 ? v_line : f_line;
-    EXPECT_NE(serial.find(b < 6 ? "line " + std::to_string(line) + ": " : "file ends inside face"),
-              std::string::npos)
-        << serial;
-    for (const std::size_t run : kRunBytes) {
-      for (const int threads : kThreads) {
-        EXPECT_EQ(ply_error(broken[b], threads, run), serial)
-            << "run bytes " << run << ", threads " << threads;
-      }
-    }
+    EXPECT_NE(
+        serial[b].find(b < 6 ? "line " + std::to_string(line) + ": " : "file ends inside face"),
+        std::string::npos)
+        << serial[b];
   }
 }
 
@@ -605,31 +583,14 @@ std::string stl_text() {
 
 TEST(StlParallelRead, EveryThreadCountAndRunSizeGivesTheSerialMeshBitForBit) {
   const std::string text = stl_text();
-  const Mesh serial = io_detail::parse_stl(kStlPath, text, 1, io_detail::kTextChunkBytes);
+  const Mesh serial = serial_read(static_cast<Parser>(&io_detail::parse_stl), kStlPath, text);
   // Per row of cells: 15 quads (cells c = 1, 5, ...) and 44 pairs of triangles.
   const int facets_per_row = 15 + 2 * 44;
   ASSERT_EQ(serial.F.rows(), (kRows - 1) * (15 * 2 + 44 * 2));
   EXPECT_EQ(serial.face_source.maxCoeff(), (kRows - 1) * facets_per_row - 1);
   EXPECT_EQ(serial.V.rows(), (kRows - 1) * (15 * 4 + 44 * 6));
-  for (const std::size_t run : kRunBytes) {
-    for (const int threads : kThreads) {
-      SCOPED_TRACE("run bytes " + std::to_string(run) + ", threads " + std::to_string(threads));
-      expect_same_mesh(io_detail::parse_stl(kStlPath, text, threads, run), serial);
-      const std::optional<Mesh> parallel =
-          io_detail::parse_stl_in_chunks(kStlPath, text, threads, run);
-      ASSERT_EQ(parallel.has_value(), threads > 1);
-      if (parallel) expect_same_mesh(*parallel, serial);
-    }
-  }
-}
-
-std::string stl_error(std::string_view text, int threads, std::size_t run_bytes) {
-  try {
-    (void)io_detail::parse_stl(kStlPath, text, threads, run_bytes);
-  } catch (const IoError& e) {
-    return e.what();
-  }
-  return "no error";
+  expect_serial_mesh_everywhere(static_cast<Parser>(&io_detail::parse_stl),
+                                &io_detail::parse_stl_in_chunks, kStlPath, text, serial);
 }
 
 TEST(StlParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
@@ -645,16 +606,9 @@ TEST(StlParallelRead, ErrorsInTheMiddleOfARunAreTheSerialReadersWordForWord) {
       with_line(text, v_line, "endfacet"),       // a facet cut before its loop ends
       text.substr(0, line_start(text, f_line)),  // the file ends inside a solid
   };
-  for (std::size_t b = 0; b < broken.size(); ++b) {
-    const std::string serial = stl_error(broken[b], 1, io_detail::kTextChunkBytes);
-    EXPECT_NE(serial, "no error") << b;
-    for (const std::size_t run : kRunBytes) {
-      for (const int threads : kThreads) {
-        EXPECT_EQ(stl_error(broken[b], threads, run), serial)
-            << "case " << b << ", run bytes " << run << ", threads " << threads;
-      }
-    }
-  }
+  const std::vector<std::string> serial =
+      serial_errors_everywhere(static_cast<Parser>(&io_detail::parse_stl), kStlPath, broken);
+  for (std::size_t b = 0; b < broken.size(); ++b) EXPECT_NE(serial[b], "no error") << b;
 }
 
 TEST(StlParallelRead, RandomlyEditedFilesGiveTheSerialMeshOrError) {
