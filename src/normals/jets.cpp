@@ -328,6 +328,43 @@ FOCAL_LANE_INLINE auto solve_ldlt(L (&A)[m][m], const L (&r)[m], L (&y)[m]) {
   return ok;
 }
 
+/// True where every lane's pivot order is lane 0's: neighbouring vertices mostly share theirs
+/// (their moments differ little), and their systems are then gathered with one load per entry.
+template <int W, int m>
+FOCAL_LANE_INLINE bool same_pivot_order(const int (&perm)[W][m]) {
+  bool same = true;
+  for (int l = 1; l < W; ++l) {
+    for (int i = 0; i < m; ++i) same &= perm[l][i] == perm[0][i];
+  }
+  return same;
+}
+
+/// Every lane's permuted system A (on and below the diagonal) and right-hand side r from its
+/// moments, lane by lane in its own order perm[l], or with one load of all lanes per entry where
+/// the orders are `shared` (the same values either way).
+template <class L, int m>
+FOCAL_LANE_INLINE void gather_system(const double* xy, const double* rhs,
+                                     const int (&perm)[width<L>][m], bool shared, L (&A)[m][m],
+                                     L (&r)[m]) {
+  constexpr int W = width<L>;
+  if (shared) {
+    const int* p = perm[0];
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; j <= i; ++j)
+        A[i][j] = detail::load_lanes<L>(xy + kProductMoment.index[p[i]][p[j]] * W);
+      r[i] = detail::load_lanes<L>(rhs + p[i] * W);
+    }
+    return;
+  }
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      A[i][j] = lanes_from<L>(
+          [&](int l) { return xy[kProductMoment.index[perm[l][i]][perm[l][j]] * W + l]; });
+    }
+    r[i] = lanes_from<L>([&](int l) { return rhs[perm[l][i] * W + l]; });
+  }
+}
+
 /// Solves every lane's m x m normal equations A c = rhs, A[j][k] = xy[kProductMoment[j][k]], by
 /// LDL^T in its own pivot order (pivot_order): the matrix and right-hand side are gathered per
 /// lane in that order, then factored in lanes. Fixed size and unrolled: Eigen's LDLT runs
@@ -337,17 +374,16 @@ FOCAL_LANE_INLINE auto solve_normal_equations(const double* xy, const double* rh
   constexpr int W = width<L>;
   int perm[W][m];
   for (int l = 0; l < W; ++l) pivot_order<m>(xy + l, W, perm[l]);
+  const bool shared = same_pivot_order<W, m>(perm);
   L A[m][m], r[m], y[m];
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j <= i; ++j) {
-      A[i][j] = lanes_from<L>(
-          [&](int l) { return xy[kProductMoment.index[perm[l][i]][perm[l][j]] * W + l]; });
-    }
-    r[i] = lanes_from<L>([&](int l) { return rhs[perm[l][i] * W + l]; });
-  }
+  gather_system<L, m>(xy, rhs, perm, shared, A, r);
   const auto ok = solve_ldlt<L, m>(A, r, y);
-  for (int l = 0; l < W; ++l) {
-    for (int i = 0; i < m; ++i) c[perm[l][i] * W + l] = lane_of(y[i], l);
+  if (shared) {
+    for (int i = 0; i < m; ++i) detail::store_lanes(c + perm[0][i] * W, y[i]);
+  } else {
+    for (int l = 0; l < W; ++l) {
+      for (int i = 0; i < m; ++i) c[perm[l][i] * W + l] = lane_of(y[i], l);
+    }
   }
   return ok;
 }
@@ -581,6 +617,7 @@ void fit_batch(const JetInput& in, const int* v, int count, JetScratch& s, Local
       lane.alive = jets[l].scale > 0.0;
     }
     fit_heights(in, s, jets);
+    if (it + 1 == in.o.iterations) break;  // the last fit's normal is the caller's to compute
     for (int l = 0; l < in.width; ++l) {
       if (s.lanes[l].alive) s.lanes[l].n = jet_normal(jets[l]);
     }
