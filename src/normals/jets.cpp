@@ -177,7 +177,9 @@ constexpr int kMaxLanes = 8;
 /// numbered by degree). 28 moments per point for a cubic instead of 55 products, and a failed
 /// cubic falls back to lower degrees without another pass over the points.
 struct JetBatch {
-  const Point* points[kMaxLanes] = {};  ///< count[l] points of lane l (0: an idle lane)
+  /// points_max points per lane: lane l's count[l] points (0: an idle lane), then (0, 0, 0), so
+  /// that the kernel loads every lane's point p without asking whether it has one.
+  const Point* points[kMaxLanes] = {};
   int count[kMaxLanes] = {};
   int points_max = 0;  ///< the largest count
   /// Per point p, terms_stride(D) lane vectors from terms + p * terms_stride(D) * W: the
@@ -231,14 +233,16 @@ template <class L, int D>
 FOCAL_LANE_INLINE void accumulate_moments(JetBatch& b) {
   constexpr int W = width<L>, kProducts = coefficient_count(2 * D), kTerms = coefficient_count(D);
   L xy[kProducts] = {}, z[kTerms] = {};
+  const L count = lanes_from<L>([&](int l) { return static_cast<double>(b.count[l]); });
+  const L one = detail::broadcast<L>(1.0), zero{};
   double* out = b.terms;
   for (int p = 0; p < b.points_max; ++p) {
     const auto field = [&](double Point::*f) FOCAL_LANE_LAMBDA {
-      return lanes_from<L>([&](int l) { return p < b.count[l] ? b.points[l][p].*f : 0.0; });
+      return lanes_from<L>([&](int l) { return b.points[l][p].*f; });
     };
     const L x = field(&Point::x), y = field(&Point::y), height = field(&Point::z);
     L xp[2 * D + 1], yp[2 * D + 1];
-    xp[0] = lanes_from<L>([&](int l) { return p < b.count[l] ? 1.0 : 0.0; });
+    xp[0] = detail::broadcast<L>(static_cast<double>(p)) < count ? one : zero;
     yp[0] = detail::broadcast<L>(1.0);
 #pragma GCC unroll 16
     for (int k = 1; k <= 2 * D; ++k) xp[k] = xp[k - 1] * x, yp[k] = yp[k - 1] * y;
@@ -500,6 +504,7 @@ struct LaneScratch {
 struct JetScratch {
   std::vector<std::uint64_t> in_ring;  ///< gather_ring's marks
   LaneScratch lanes[kMaxLanes];
+  std::vector<Point> zeros;  ///< an idle lane's points
   std::vector<double> terms;
   JetBatch batch;
   std::vector<double> scalar_terms;  ///< the scalar path's, for a lane that failed degree D
@@ -509,10 +514,9 @@ struct JetScratch {
 /// The fit of the highest degree < D that succeeds, one lane alone, where degree D failed in
 /// its batch: the scalar path (moments and degree D again, the same bits, then lower degrees).
 template <int D>
-bool fit_lower_degrees(const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+bool fit_lower_degrees(const Point* points, int n, JetScratch& s, LocalJet& jet) {
   JetBatch& b = s.scalar;
-  const auto n = static_cast<int>(points.size());
-  b.points[0] = points.data();
+  b.points[0] = points;
   b.count[0] = b.points_max = n;
   s.scalar_terms.resize(static_cast<std::size_t>(n) * terms_stride(D));
   b.terms = s.scalar_terms.data();
@@ -536,16 +540,16 @@ bool fit_lower_degrees(const std::vector<Point>& points, JetScratch& s, LocalJet
   return false;
 }
 
-bool fit_lower_degrees(int degree, const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+bool fit_lower_degrees(int degree, const Point* points, int n, JetScratch& s, LocalJet& jet) {
   switch (degree) {
     case 4:
-      return fit_lower_degrees<4>(points, s, jet);
+      return fit_lower_degrees<4>(points, n, s, jet);
     case 3:
-      return fit_lower_degrees<3>(points, s, jet);
+      return fit_lower_degrees<3>(points, n, s, jet);
     case 2:
-      return fit_lower_degrees<2>(points, s, jet);
+      return fit_lower_degrees<2>(points, n, s, jet);
     default:
-      return fit_lower_degrees<1>(points, s, jet);
+      return fit_lower_degrees<1>(points, n, s, jet);
   }
 }
 
@@ -565,6 +569,22 @@ struct JetInput {
   int width;  ///< the kernel's lanes
 };
 
+/// b.points of every lane, padded with (0, 0, 0) to b.points_max (JetBatch::points); an idle
+/// lane's are all zero.
+void pad_points(int width, JetScratch& s, JetBatch& b) {
+  const auto n = static_cast<std::size_t>(b.points_max);
+  if (s.zeros.size() < n) s.zeros.resize(n, Point{0.0, 0.0, 0.0});
+  for (int l = 0; l < width; ++l) {
+    LaneScratch& lane = s.lanes[l];
+    if (b.count[l] == 0) {
+      b.points[l] = s.zeros.data();
+      continue;
+    }
+    lane.points.resize(n, Point{0.0, 0.0, 0.0});
+    b.points[l] = lane.points.data();
+  }
+}
+
 /// Each lane's degree-D fit from the kernel where it succeeded, the scalar path's lower degrees
 /// where not; a lane with no fit is no longer alive.
 void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
@@ -572,10 +592,10 @@ void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
   b.points_max = 0;
   for (int l = 0; l < in.width; ++l) {
     const LaneScratch& lane = s.lanes[l];
-    b.points[l] = lane.points.data();
     b.count[l] = lane.alive ? static_cast<int>(lane.points.size()) : 0;
     b.points_max = std::max(b.points_max, b.count[l]);
   }
+  pad_points(in.width, s, b);
   const int D = in.o.degree, m = coefficient_count(D);
   s.terms.resize(static_cast<std::size_t>(b.points_max) * terms_stride(D) * in.width);
   b.terms = s.terms.data();
@@ -585,7 +605,7 @@ void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
     if (!lane.alive) continue;
     LocalJet& jet = jets[l];
     if (!b.solved[l]) {
-      lane.alive = fit_lower_degrees(D, lane.points, s, jet);
+      lane.alive = fit_lower_degrees(D, lane.points.data(), b.count[l], s, jet);
       continue;
     }
     for (int k = 0; k < m; ++k) jet.c[k] = b.c[k * in.width + l];
