@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -86,6 +87,24 @@ struct Point {
 /// sums per entry (and bits) as one at a time.
 using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
+/// Where the marked vertices of `ring` lie within a few words of marks of each other (on a mesh
+/// whose nearby vertices have nearby indices), rewrites `ring` in ascending order by reading
+/// those words, clearing them as it goes, and returns true: the sorted ring without a sort.
+/// Otherwise leaves both as they are and returns false.
+bool read_marks_in_order(std::vector<int>& ring, std::uint64_t* bits) {
+  const auto [lowest, highest] = std::minmax_element(ring.begin(), ring.end());
+  const auto first = static_cast<std::size_t>(*lowest) / 64;
+  const auto last = static_cast<std::size_t>(*highest) / 64;
+  if (last - first >= 4 * ring.size()) return false;
+  int* out = ring.data();
+  for (std::size_t k = first; k <= last; ++k) {
+    for (std::uint64_t word = bits[k]; word != 0; word &= word - 1)
+      *out++ = static_cast<int>(64 * k) + std::countr_zero(word);
+    bits[k] = 0;
+  }
+  return true;
+}
+
 /// The vertices within `rings` edges of v (v included), sorted, into `ring`: breadth-first over
 /// the 1-ring with marks (`in_ring`: one bit per vertex, allocated on first use, #V / 8 bytes: it
 /// stays in cache; set while the vertex is in the neighbourhood being gathered, cleared after
@@ -117,6 +136,7 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::u
     }
     begin = end;
   }
+  if (ring.size() <= cap && read_marks_in_order(ring, bits)) return;
   for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
   if (ring.size() > cap) ring.resize(1);
   detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
