@@ -142,11 +142,16 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::u
   detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
 }
 
+/// A vertex's points: resize() leaves new entries unwritten (gather_points writes them).
+using Points = std::vector<Point, detail::DefaultInitAllocator<Point>>;
+
 /// The vertex itself (zero) and its ring in the frame, scaled by the largest offset, into
 /// `points`; non-finite neighbours are skipped. Returns the scale (0 when no usable neighbour).
 double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
-                     const std::vector<int>& ring, std::vector<Point>& points) {
-  points.assign(1, Point{0.0, 0.0, 0.0});
+                     const std::vector<int>& ring, Points& points) {
+  points.resize(ring.size() + 1);  // room for every point: written through a pointer, no checks
+  Point* out = points.data();
+  *out++ = {0.0, 0.0, 0.0};
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
   // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
   // GCC paired them by itself or not, depending on how the frame was built.
@@ -157,11 +162,13 @@ double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
   for (const int j : ring) {
     if (j == i) continue;
     const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
-    if (!std::isfinite(qx) || !std::isfinite(qy) || !std::isfinite(qz)) continue;
+    // All three finite (x - x is 0 for a finite x, NaN otherwise): one test instead of three.
+    if (!((qx - qx) + (qy - qy) + (qz - qz) == 0.0)) continue;
     const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
-    points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
+    *out++ = {tangential[0], tangential[1], nx * qx + ny * qy + nz * qz};
     scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
   }
+  points.resize(static_cast<std::size_t>(out - points.data()));
   const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
   if (scale > 0.0) {
     const double inv = 1.0 / scale;
@@ -515,7 +522,7 @@ double residual_of(double ssr, int n, int m, double scale) {
 /// One vertex's scratch in a batch.
 struct LaneScratch {
   std::vector<int> ring;  ///< v and the vertices within `rings` edges, sorted
-  std::vector<Point> points;
+  Points points;
   Eigen::Vector3d n;   ///< the normal of the next fit's frame
   bool alive = false;  ///< every fit so far succeeded
 };
