@@ -513,27 +513,38 @@ std::vector<char> crease_vertices(const Context& c) {
                           d = V.row(F(f, 2)).transpose();
     return Eigen::Vector3d((b - a).cross(d - a).normalized());
   };
+  // A corner of f other than v is one of g's.
   const auto shares_edge_at = [&](int f, int g, int v) {
-    int shared = 0;
+    const int g0 = F(g, 0), g1 = F(g, 1), g2 = F(g, 2);
     for (int x = 0; x < 3; ++x) {
-      for (int y = 0; y < 3; ++y) shared += F(f, x) == F(g, y) && F(f, x) != v;
+      const int corner = F(f, x);
+      if (corner != v && (corner == g0 || corner == g1 || corner == g2)) return true;
     }
-    return shared > 0;
+    return false;
   };
   std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
-  detail::parallel_for(c.mesh.vertex_count(), c.threads, [&](std::int64_t i) {
-    const int v = static_cast<int>(i);
-    for (int a = incidence.begin(v); a < incidence.end(v) && !crease[i]; ++a) {
-      const int f = incidence.faces[static_cast<std::size_t>(a)];
-      for (int b = a + 1; b < incidence.end(v); ++b) {
-        const int g = incidence.faces[static_cast<std::size_t>(b)];
-        if (shares_edge_at(f, g, v) && normal_of(f).dot(normal_of(g)) < cos_limit) {
-          crease[static_cast<std::size_t>(i)] = 1;
-          break;
+  detail::parallel_for_blocks(
+      c.mesh.vertex_count(), 1024, c.threads, [&](std::int64_t begin, std::int64_t end) {
+        // The normals of a vertex's faces, each computed once (a face meets two others at v).
+        std::vector<Eigen::Vector3d> normal;
+        for (auto i = begin; i < end; ++i) {
+          const int v = static_cast<int>(i);
+          const int* faces = incidence.faces.data() + incidence.begin(v);
+          const int count = incidence.size(v);
+          normal.clear();
+          for (int a = 0; a < count; ++a) normal.push_back(normal_of(faces[a]));
+          for (int a = 0; a < count && !crease[static_cast<std::size_t>(i)]; ++a) {
+            for (int b = a + 1; b < count; ++b) {
+              if (shares_edge_at(faces[a], faces[b], v) &&
+                  normal[static_cast<std::size_t>(a)].dot(normal[static_cast<std::size_t>(b)]) <
+                      cos_limit) {
+                crease[static_cast<std::size_t>(i)] = 1;
+                break;
+              }
+            }
+          }
         }
-      }
-    }
-  });
+      });
   return crease;
 }
 
