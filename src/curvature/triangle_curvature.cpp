@@ -338,15 +338,20 @@ FaceBlock solve_face_block_for(detail::SimdIsa isa) {
 
 /// The minimal rotation taking unit a to unit b (Rodrigues; a.b > -1 holds since both normals
 /// lie in each other's hemisphere here): its axis a x b and cosine a.b, computed once for the
-/// two face axes it turns.
+/// two face axes it turns. In plain scalars (kernels/vec3.h, Eigen's order of operations: the
+/// bits of the Eigen code it replaced), which pack into no SSE pairs.
 struct Rotation {
-  Eigen::Vector3d axis;
+  Vec3<double> axis;
   double c;
 
-  Rotation(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : axis(a.cross(b)), c(a.dot(b)) {}
-  /// The rotation applied to w.
-  [[nodiscard]] Eigen::Vector3d operator()(const Eigen::Vector3d& w) const {
-    return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+  Rotation(const Vec3<double>& a, const Vec3<double>& b)
+      : axis(kernels::cross(a, b)), c(kernels::dot(a, b)) {}
+  /// The rotation applied to w: w + axis x w + axis x (axis x w) / (1 + c).
+  [[nodiscard]] Vec3<double> operator()(const Vec3<double>& w) const {
+    const Vec3<double> once = kernels::cross(axis, w), twice = kernels::cross(axis, once);
+    const double d = 1.0 + c;
+    return {(w.x + once.x) + twice.x / d, (w.y + once.y) + twice.y / d,
+            (w.z + once.z) + twice.z / d};
   }
 };
 
@@ -354,14 +359,14 @@ struct Rotation {
 /// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
 /// stays kI exactly, as on a sphere).
 Eigen::Matrix2d operator_in_frame(const FaceRecord& face, const TangentFrame& to) {
-  using Axis = Eigen::Map<const Eigen::Vector3d>;
+  const auto vec = [](const double* v) { return Vec3<double>{v[0], v[1], v[2]}; };
   Eigen::Matrix2d sym;
   sym << face.s00, face.s01, face.s01, face.s11;
-  const Rotation rotate(Axis(face.n), to.n);
-  const Eigen::Vector3d x = rotate(Axis(face.x));
-  const Eigen::Vector3d y = rotate(Axis(face.y));
+  const Rotation rotate(vec(face.n), kernels::vec3_of(to.n));
+  const Vec3<double> x = rotate(vec(face.x)), y = rotate(vec(face.y));
+  const Vec3<double> to_x = kernels::vec3_of(to.x), to_y = kernels::vec3_of(to.y);
   Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
-  q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
+  q << kernels::dot(to_x, x), kernels::dot(to_x, y), kernels::dot(to_y, x), kernels::dot(to_y, y);
   return q * sym * q.transpose();
 }
 
