@@ -1,4 +1,5 @@
-// The lane kernels of the closed-form fit, of the per-triangle solve and of the jets
+// The lane kernels of the closed-form fit, of the per-triangle solve, of the jets and of the
+// area- and Max-weighted vertex normals
 // (src/core/simd_lanes.h):
 // the same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
@@ -22,6 +23,8 @@
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "mesh/normals_detail.h"
+#include "mesh/topology.h"
 #include "normals/jets_detail.h"
 #include "test_meshes.h"
 
@@ -318,6 +321,43 @@ TEST(SimdKernels, JetLanesEqualTheScalarPathVertexByVertex) {
         EXPECT_EQ(at.degree[row], scalar.degree[some[k]]);
         EXPECT_TRUE(identical(RowMatrixX3d(at.N.row(row)), RowMatrixX3d(scalar.N.row(some[k]))))
             << "vertex " << some[k];
+      }
+    }
+  }
+}
+
+/// The awkward torus with a face of three collinear vertices (zero area), a face that repeats an
+/// index, a face given twice with opposite orientations (its terms cancel at its corners), a
+/// vertex at NaN and a vertex in no face: every kind of corner the normals' lanes add as +0.
+Mesh awkward_faces() {
+  const Mesh m = awkward_mesh();
+  const auto n = static_cast<int>(m.V.rows()), f = static_cast<int>(m.F.rows());
+  Mesh out;
+  out.V.resize(n + 4, 3);
+  out.V.topRows(n) = m.V;
+  out.V.bottomRows(4) << 10.0, 0.0, 0.0, 11.0, 0.0, 0.0, 12.0, 0.0, 0.0, 0.0, 0.0, 50.0;
+  out.V(5, 0) = std::nan("");
+  out.F.resize(f + 4, 3);
+  out.F.topRows(f) = m.F;
+  out.F.bottomRows(4) << n, n + 1, n + 2, 7, 7, 8, 9, 10, 11, 9, 11, 10;
+  return out;
+}
+
+TEST(SimdKernels, AreaAndMaxNormalsInLanesEqualTheScalarLoopVertexByVertex) {
+  const Mesh m = awkward_faces();
+  for (NormalWeighting weighting : {NormalWeighting::area, NormalWeighting::max}) {
+    const detail::VertexFaces inc = detail::vertex_face_incidence(m.V.rows(), m.F, 1);
+    const RowMatrixX3d scalar =
+        detail::vertex_normals_from(m.V, m.F, inc, weighting, 1, std::nullopt);
+    EXPECT_TRUE(scalar.row(m.V.rows() - 1).array().isNaN().all()) << "the vertex in no face";
+    EXPECT_TRUE(scalar.row(5).array().isNaN().all()) << "the vertex at NaN";
+    EXPECT_GT(scalar.array().isFinite().rowwise().all().count(), m.V.rows() - 20);
+    for (SimdIsa isa : available_isas()) {
+      for (int threads : {1, 2, 3}) {
+        EXPECT_TRUE(
+            identical(detail::vertex_normals_from(m.V, m.F, inc, weighting, threads, isa), scalar))
+            << "weighting " << static_cast<int>(weighting) << " isa " << static_cast<int>(isa)
+            << " threads " << threads;
       }
     }
   }

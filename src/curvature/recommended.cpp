@@ -513,27 +513,46 @@ std::vector<char> crease_vertices(const Context& c) {
                           d = V.row(F(f, 2)).transpose();
     return Eigen::Vector3d((b - a).cross(d - a).normalized());
   };
-  const auto shares_edge_at = [&](int f, int g, int v) {
-    int shared = 0;
-    for (int x = 0; x < 3; ++x) {
-      for (int y = 0; y < 3; ++y) shared += F(f, x) == F(g, y) && F(f, x) != v;
+  // A face at v: its normal and its corners other than v (the one there is twice, or a value no
+  // corner has where there is none): two faces share an edge at v exactly when those meet.
+  struct FaceAtVertex {
+    Eigen::Vector3d normal;
+    int other[2];
+  };
+  const auto at_vertex = [&](int f, int v) {
+    FaceAtVertex out{normal_of(f), {-1 - f, -1 - f}};
+    int found = 0;
+    for (int x = 0; x < 3 && found < 2; ++x) {
+      if (F(f, x) != v) out.other[found++] = F(f, x);
     }
-    return shared > 0;
+    if (found == 1) out.other[1] = out.other[0];
+    return out;
+  };
+  const auto share_edge = [](const FaceAtVertex& a, const FaceAtVertex& b) {
+    return a.other[0] == b.other[0] || a.other[0] == b.other[1] || a.other[1] == b.other[0] ||
+           a.other[1] == b.other[1];
   };
   std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
-  detail::parallel_for(c.mesh.vertex_count(), c.threads, [&](std::int64_t i) {
-    const int v = static_cast<int>(i);
-    for (int a = incidence.begin(v); a < incidence.end(v) && !crease[i]; ++a) {
-      const int f = incidence.faces[static_cast<std::size_t>(a)];
-      for (int b = a + 1; b < incidence.end(v); ++b) {
-        const int g = incidence.faces[static_cast<std::size_t>(b)];
-        if (shares_edge_at(f, g, v) && normal_of(f).dot(normal_of(g)) < cos_limit) {
-          crease[static_cast<std::size_t>(i)] = 1;
-          break;
+  detail::parallel_for_blocks(
+      c.mesh.vertex_count(), 1024, c.threads, [&](std::int64_t begin, std::int64_t end) {
+        // Each face's normal and corners once per vertex (a face meets two others at v).
+        std::vector<FaceAtVertex> faces;
+        for (auto i = begin; i < end; ++i) {
+          const int v = static_cast<int>(i);
+          faces.clear();
+          for (int a = incidence.begin(v); a < incidence.end(v); ++a)
+            faces.push_back(at_vertex(incidence.faces[static_cast<std::size_t>(a)], v));
+          for (std::size_t a = 0; a < faces.size() && !crease[static_cast<std::size_t>(i)]; ++a) {
+            for (std::size_t b = a + 1; b < faces.size(); ++b) {
+              if (share_edge(faces[a], faces[b]) &&
+                  faces[a].normal.dot(faces[b].normal) < cos_limit) {
+                crease[static_cast<std::size_t>(i)] = 1;
+                break;
+              }
+            }
+          }
         }
-      }
-    }
-  });
+      });
   return crease;
 }
 

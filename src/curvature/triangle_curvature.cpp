@@ -76,6 +76,17 @@ using kernels::is_finite;
 using kernels::Quotient;
 using kernels::Vec3;
 
+/// What the per-vertex averaging reads of a solved face, written once per face by the face
+/// kernel instead of being recomputed at each of the face's three corners: the face's frame (its
+/// normal and the axes kernels::frame_of gives it, the bits frame_of gives there), its
+/// symmetrised shape operator [s00 s01; s01 s11] and its area. Unspecified where the face is
+/// undefined (the averaging skips those).
+struct FaceRecord {
+  double n[3], x[3], y[3];
+  double s00, s01, s11;
+  double area;
+};
+
 /// What the face kernel reads.
 struct FaceInput {
   PositionsRef V;
@@ -84,6 +95,7 @@ struct FaceInput {
   FacesRef F;
   detail::ClassTolerances tol;
   const TriangleFields& want;
+  FaceRecord* records = nullptr;  ///< where set, row f of F's record is written there too
 };
 
 /// A 2x2 matrix per lane, as in the file's scalar formulas: columns are the edges 0->1, 0->2.
@@ -136,6 +148,31 @@ template <class L>
 FOCAL_LANE_INLINE void store_rows(RowMatrixX3d& m, std::int64_t first, int active, L x, L y, L z) {
   double* row = m.data() + 3 * first;
   for (int l = 0; l < active; ++l) row[3 * l] = x[l], row[3 * l + 1] = y[l], row[3 * l + 2] = z[l];
+}
+
+/// Half the length of (b - a) x (c - a) for the corners a, b, c: the operations of Eigen's
+/// `0.5 * (b - a).cross(c - a).norm()` (kernels/vec3.h keeps Eigen's order), which the averaging
+/// computed at each of the face's corners before, so the area keeps its bits.
+template <class L>
+FOCAL_LANE_INLINE L face_area_of(const L (&px)[3], const L (&py)[3], const L (&pz)[3]) {
+  const Vec3<L> a{px[0], py[0], pz[0]}, b{px[1], py[1], pz[1]}, c{px[2], py[2], pz[2]};
+  return 0.5 * kernels::norm(kernels::cross(b - a, c - a));
+}
+
+/// The records (FaceRecord) of faces [first, first + active) from their frame, shape operator M
+/// and area.
+template <class L>
+FOCAL_LANE_INLINE void store_records(FaceRecord* records, int active,
+                                     const kernels::Frame<L>& frame, const Lanes2x2<L>& M, L area) {
+  const L s01 = 0.5 * (M.m01 + M.m10);
+  for (int l = 0; l < active; ++l) {
+    FaceRecord& r = records[l];
+    r.n[0] = frame.n.x[l], r.n[1] = frame.n.y[l], r.n[2] = frame.n.z[l];
+    r.x[0] = frame.x.x[l], r.x[1] = frame.x.y[l], r.x[2] = frame.x.z[l];
+    r.y[0] = frame.y.x[l], r.y[1] = frame.y.y[l], r.y[2] = frame.y.z[l];
+    r.s00 = M.m00[l], r.s01 = s01[l], r.s11 = M.m11[l];
+    r.area = area[l];
+  }
 }
 
 /// Solves faces [first, first + active) and writes their asked fields.
@@ -225,6 +262,9 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
     store_scalars(r.lambda1, first, active, or_nan(lambda1));
     store_scalars(r.lambda2, first, active, or_nan(lambda2));
   }
+  if (in.records) {
+    store_records(in.records + first, active, frame, times_inverse(G, X), face_area_of(px, py, pz));
+  }
   if (want.directions || want.slits || want.shape_operator) {
     const Lanes2x2<L> M = times_inverse(G, X);  // M on the shifted X
     if (want.shape_operator) {
@@ -298,37 +338,36 @@ FaceBlock solve_face_block_for(detail::SimdIsa isa) {
 
 /// The minimal rotation taking unit a to unit b (Rodrigues; a.b > -1 holds since both normals
 /// lie in each other's hemisphere here): its axis a x b and cosine a.b, computed once for the
-/// two face axes it turns.
+/// two face axes it turns. In plain scalars (kernels/vec3.h, Eigen's order of operations: the
+/// bits of the Eigen code it replaced), which pack into no SSE pairs.
 struct Rotation {
-  Eigen::Vector3d axis;
+  Vec3<double> axis;
   double c;
 
-  Rotation(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : axis(a.cross(b)), c(a.dot(b)) {}
-  /// The rotation applied to w.
-  [[nodiscard]] Eigen::Vector3d operator()(const Eigen::Vector3d& w) const {
-    return w + axis.cross(w) + axis.cross(axis.cross(w)) / (1.0 + c);
+  Rotation(const Vec3<double>& a, const Vec3<double>& b)
+      : axis(kernels::cross(a, b)), c(kernels::dot(a, b)) {}
+  /// The rotation applied to w: w + axis x w + axis x (axis x w) / (1 + c).
+  [[nodiscard]] Vec3<double> operator()(const Vec3<double>& w) const {
+    const Vec3<double> once = kernels::cross(axis, w), twice = kernels::cross(axis, once);
+    const double d = 1.0 + c;
+    return {(w.x + once.x) + twice.x / d, (w.y + once.y) + twice.y / d,
+            (w.z + once.z) + twice.z / d};
   }
 };
 
 /// The face's symmetrised shape operator in a vertex's tangent frame: the face frame is rotated
 /// onto the vertex's tangent plane (a rotation, not a projection, so that a face operator kI
 /// stays kI exactly, as on a sphere).
-Eigen::Matrix2d operator_in_frame(const TriangleCurvatureResult& t, int f, const TangentFrame& to) {
-  const TangentFrame from = detail::frame_of(t.face_normal.row(f).transpose());
-  const auto& m = t.shape_operator.row(f);
+Eigen::Matrix2d operator_in_frame(const FaceRecord& face, const TangentFrame& to) {
+  const auto vec = [](const double* v) { return Vec3<double>{v[0], v[1], v[2]}; };
   Eigen::Matrix2d sym;
-  sym << m[0], 0.5 * (m[1] + m[2]), 0.5 * (m[1] + m[2]), m[3];
-  const Rotation rotate(from.n, to.n);
-  const Eigen::Vector3d x = rotate(from.x);
-  const Eigen::Vector3d y = rotate(from.y);
+  sym << face.s00, face.s01, face.s01, face.s11;
+  const Rotation rotate(vec(face.n), kernels::vec3_of(to.n));
+  const Vec3<double> x = rotate(vec(face.x)), y = rotate(vec(face.y));
+  const Vec3<double> to_x = kernels::vec3_of(to.x), to_y = kernels::vec3_of(to.y);
   Eigen::Matrix2d q;  // orthogonal change of basis from the rotated face axes to (to.x, to.y)
-  q << to.x.dot(x), to.x.dot(y), to.y.dot(x), to.y.dot(y);
+  q << kernels::dot(to_x, x), kernels::dot(to_x, y), kernels::dot(to_y, x), kernels::dot(to_y, y);
   return q * sym * q.transpose();
-}
-
-double face_area(PositionsRef V, FacesRef F, int f) {
-  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-  return 0.5 * (b - a).cross(c - a).norm();
 }
 
 }  // namespace
@@ -402,16 +441,18 @@ struct VertexAverage {
   bool defined = false;
 };
 
-/// The solved faces of a block of vertices: face f of the mesh is row row[f] of `faces`.
+/// The solved faces of a block of vertices: face f of the mesh is row row[f] of `faces` and of
+/// `records`.
 struct SolvedFaces {
   TriangleCurvatureResult faces;
+  const std::vector<FaceRecord, detail::DefaultInitAllocator<FaceRecord>>& records;
   const std::vector<int>& row;
 };
 
 /// Area-weighted mean of the operators of vertex i's usable faces, and their spread about it.
-VertexAverage average_at_vertex(PositionsRef V, FacesRef F, const SolvedFaces& solved,
-                                const detail::VertexFaces& inc, const RowMatrixX3d& unit,
-                                Eigen::Index i, std::vector<FacePart>& parts) {
+VertexAverage average_at_vertex(const SolvedFaces& solved, const detail::VertexFaces& inc,
+                                const RowMatrixX3d& unit, Eigen::Index i,
+                                std::vector<FacePart>& parts) {
   VertexAverage out;
   out.frame = detail::frame_of(unit.row(i).transpose());
   const TangentFrame& frame = out.frame;
@@ -422,11 +463,12 @@ VertexAverage average_at_vertex(PositionsRef V, FacesRef F, const SolvedFaces& s
   for (int k = inc.begin(i); k < inc.end(i); ++k) {
     const int f = inc.faces[static_cast<std::size_t>(k)];
     const int s = solved.row[static_cast<std::size_t>(f)];
+    const FaceRecord& face = solved.records[static_cast<std::size_t>(s)];
     if (faces.point_class[s] == static_cast<std::uint8_t>(PointClass::undefined) ||
-        !(faces.face_normal.row(s).dot(frame.n) > 0.0)) {
+        !(Eigen::Map<const Eigen::Vector3d>(face.n).dot(frame.n) > 0.0)) {
       continue;
     }
-    parts.push_back({face_area(V, F, f), operator_in_frame(faces, s, frame)});
+    parts.push_back({face.area, operator_in_frame(face, frame)});
     mean += parts.back().area * parts.back().op;
     area += parts.back().area;
   }
@@ -452,10 +494,11 @@ void store_average(const VertexAverage& a, const detail::ClassTolerances& tol, E
   detail::store_vertex(r, i, a.frame, a.principal, a.spread, tol);
 }
 
-/// Vertices whose faces are solved at a time: their face operators, normals and classes (57 B a
-/// face, ~7 MB a block) instead of the whole mesh's (114 MB at 2M faces, the peak of the
-/// recommended estimator's run).
-constexpr std::int64_t kAverageBlock = std::int64_t{1} << 16;
+/// Vertices whose faces are solved at a time: their records and classes (105 B a face, ~7 MB a
+/// block) instead of the whole mesh's (210 MB at 2M faces; the face operators, normals and
+/// classes alone made the peak of the recommended estimator's run). Half the block of the 57 B
+/// a face before the records: the same memory in the pass.
+constexpr std::int64_t kAverageBlock = std::int64_t{1} << 15;
 
 /// The faces of vertices [begin, end) that have a valid normal, each once: their indices and
 /// corners, row[f] set to f's position in them (to be reset to -1 by the caller).
@@ -485,10 +528,10 @@ BlockFaces faces_of_block(FacesRef F, const detail::VertexFaces& inc, const std:
 /// in parallel blocks (each row visited by one thread).
 template <class Body>
 void for_each_average(const PreparedMesh& mesh, const CurvatureOptions& options, Body&& body) {
-  // Only what the averaging reads: the face operators, their normals and classes.
+  // Only what the averaging reads: the faces' records and classes.
   TriangleFields needed;
   needed.coefficients = needed.curvatures = needed.focal_depths = false;
-  needed.directions = needed.slits = false;
+  needed.directions = needed.slits = needed.face_normal = needed.shape_operator = false;
   if (!mesh.has_normals()) throw InvalidInput("triangle curvature: the mesh has no normals");
   const PositionsRef& V = mesh.V();
   const FacesRef& F = mesh.F();
@@ -500,19 +543,22 @@ void for_each_average(const PreparedMesh& mesh, const CurvatureOptions& options,
   const detail::VertexFaces& inc = *incidence;
   const detail::ClassTolerances tol = detail::class_tolerances(options, mesh.mean_edge_length());
   std::vector<int> row(static_cast<std::size_t>(F.rows()), -1);
+  // Written in full by the face kernel (each row by the thread that solves its face).
+  std::vector<FaceRecord, detail::DefaultInitAllocator<FaceRecord>> records;
   for (std::int64_t first = 0; first < V.rows(); first += kAverageBlock) {
     const std::int64_t last = std::min<std::int64_t>(V.rows(), first + kAverageBlock);
     const BlockFaces block = faces_of_block(F, inc, ok, first, last, row);
-    const SolvedFaces solved{
-        solve_faces({V, unit, ok, block.F, tol, needed}, detail::SimdIsa::best, threads), row};
+    records.resize(static_cast<std::size_t>(block.F.rows()));
+    const SolvedFaces solved{solve_faces({V, unit, ok, block.F, tol, needed, records.data()},
+                                         detail::SimdIsa::best, threads),
+                             records, row};
     // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
     detail::parallel_for_blocks(
         last - first, 256, threads, [&](std::int64_t begin, std::int64_t end) {
           std::vector<FacePart> parts;
           for (auto i = first + begin; i < first + end; ++i) {
             if (ok[static_cast<std::size_t>(i)]) {
-              body(i, std::optional<VertexAverage>(
-                          average_at_vertex(V, F, solved, inc, unit, i, parts)));
+              body(i, std::optional<VertexAverage>(average_at_vertex(solved, inc, unit, i, parts)));
             } else {
               body(i, std::optional<VertexAverage>());
             }

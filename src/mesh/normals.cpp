@@ -5,12 +5,15 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/simd_lanes.h"
 #include "focal/core/error.h"
+#include "kernels/vec3.h"
 #include "mesh/normals_detail.h"
 #include "mesh/prepared_detail.h"
 #include "mesh/statistics_detail.h"
@@ -97,9 +100,142 @@ Eigen::Vector3d gathered_normal(PositionsRef V, FacesRef F, const detail::Vertex
   return {sum.x / length, sum.y / length, sum.z / length};
 }
 
+// ---- Area- and Max-weighted normals of several vertices side by side, one vertex per lane
+// (core/simd_lanes.h): lane l adds its vertex's k-th face at step k, in the scalar loop's order
+// and with its operations, so each lane has gathered_normal's bits. A lane with no k-th face, or
+// whose k-th face repeats an index, takes its own vertex as both other corners: a degenerate
+// corner, which adds +0, and +0 leaves the sums' bits (they start at +0 and never become -0).
+// The angle weighting stays scalar (no atan2 in lanes).
+
+/// A 3-vector of lanes (this file's Vec3 is the scalar one).
+template <class L>
+using Lanes3 = kernels::Vec3<L>;
+
+/// The corners following v counter-clockwise in face f, or v twice where f repeats an index.
+inline void following_corners(FacesRef F, int f, int v, int& q, int& r) {
+  const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+  if (a == b || b == c || a == c) {
+    q = r = v;
+    return;
+  }
+  q = a == v ? b : (b == v ? c : a);
+  r = a == v ? c : (b == v ? a : b);
+}
+
+template <class L>
+FOCAL_LANE_INLINE Lanes3<L> rows_of(PositionsRef V, const int (&i)[detail::lane_count<L>]) {
+  return {detail::lanes_of<L>([&](int l) { return V(i[l], 0); }),
+          detail::lanes_of<L>([&](int l) { return V(i[l], 1); }),
+          detail::lanes_of<L>([&](int l) { return V(i[l], 2); })};
+}
+
+/// corner_contribution per lane, added to sum and total (+0 where it is degenerate).
+template <NormalWeighting weighting, class L>
+FOCAL_LANE_INLINE void add_corner(const Lanes3<L>& p, const Lanes3<L>& q, const Lanes3<L>& r,
+                                  Lanes3<L>& sum, L& total) {
+  using kernels::dot;
+  const Lanes3<L> e1 = q - p, e2 = r - p;
+  const Lanes3<L> n = kernels::cross(e1, e2);
+  const L n_norm = kernels::sqrt_of(dot(n, n));
+  const L e1_sq = dot(e1, e1), e2_sq = dot(e2, e2);
+  const Lanes3<L> e3 = r - q;
+  // std::max({a, b, c}) with its comparisons (max_of), so a NaN is kept or dropped alike.
+  const L longest = kernels::max_of(kernels::max_of(e1_sq, e2_sq), dot(e3, e3));
+  const auto kept = n_norm > detail::kDegenerateArea * longest;
+  Lanes3<L> term = n;
+  L length = n_norm;
+  if constexpr (weighting == NormalWeighting::max) {
+    const L scale = 1.0 / (e1_sq * e2_sq);
+    term = scale * n, length = scale * n_norm;
+  }
+  const L zero{};
+  sum = {sum.x + (kept ? term.x : zero), sum.y + (kept ? term.y : zero),
+         sum.z + (kept ? term.z : zero)};
+  total += kept ? length : zero;
+}
+
+/// gathered_normal of vertices [first, first + active) into their rows of N.
+template <NormalWeighting weighting, class L>
+FOCAL_LANE_INLINE void gather_normal_group(PositionsRef V, FacesRef F,
+                                           const detail::VertexFaces& inc, std::int64_t first,
+                                           int active, RowMatrixX3d& N) {
+  constexpr int W = detail::lane_count<L>;
+  int v[W], count[W], most = 0;
+  for (int l = 0; l < W; ++l) {
+    v[l] = static_cast<int>(first + std::min(l, active - 1));
+    count[l] = inc.size(v[l]);
+    most = std::max(most, count[l]);
+  }
+  const Lanes3<L> p = rows_of<L>(V, v);
+  Lanes3<L> sum{L{}, L{}, L{}};
+  L total{};
+  for (int k = 0; k < most; ++k) {
+    int q[W], r[W];
+    for (int l = 0; l < W; ++l) {
+      q[l] = r[l] = v[l];
+      if (k < count[l]) {
+        following_corners(F, inc.faces[static_cast<std::size_t>(inc.begin(v[l]) + k)], v[l], q[l],
+                          r[l]);
+      }
+    }
+    add_corner<weighting>(p, rows_of<L>(V, q), rows_of<L>(V, r), sum, total);
+  }
+  const L length = kernels::sqrt_of(kernels::dot(sum, sum));
+  const auto exists = length > kVanishingSum * total;
+  const L nan = detail::broadcast<L>(kNaN);
+  const L x = exists ? sum.x / length : nan, y = exists ? sum.y / length : nan;
+  const L z = exists ? sum.z / length : nan;
+  for (int l = 0; l < active; ++l)
+    N(first + l, 0) = x[l], N(first + l, 1) = y[l], N(first + l, 2) = z[l];
+}
+
+template <NormalWeighting weighting, class L>
+FOCAL_LANE_INLINE void gather_normal_block(PositionsRef V, FacesRef F,
+                                           const detail::VertexFaces& inc, std::int64_t begin,
+                                           std::int64_t end, RowMatrixX3d& N) {
+  constexpr int W = detail::lane_count<L>;
+  for (std::int64_t first = begin; first < end; first += W) {
+    gather_normal_group<weighting, L>(V, F, inc, first,
+                                      static_cast<int>(std::min<std::int64_t>(W, end - first)), N);
+  }
+}
+
+template <NormalWeighting weighting>
+FOCAL_TARGET_AVX512 void gather_normal_block_avx512(PositionsRef V, FacesRef F,
+                                                    const detail::VertexFaces& inc,
+                                                    std::int64_t begin, std::int64_t end,
+                                                    RowMatrixX3d& N) {
+  gather_normal_block<weighting, detail::Lanes8>(V, F, inc, begin, end, N);
+}
+template <NormalWeighting weighting>
+FOCAL_TARGET_AVX2 void gather_normal_block_avx2(PositionsRef V, FacesRef F,
+                                                const detail::VertexFaces& inc, std::int64_t begin,
+                                                std::int64_t end, RowMatrixX3d& N) {
+  gather_normal_block<weighting, detail::Lanes4>(V, F, inc, begin, end, N);
+}
+template <NormalWeighting weighting>
+void gather_normal_block_baseline(PositionsRef V, FacesRef F, const detail::VertexFaces& inc,
+                                  std::int64_t begin, std::int64_t end, RowMatrixX3d& N) {
+  gather_normal_block<weighting, detail::Lanes2>(V, F, inc, begin, end, N);
+}
+
+/// The normals of every vertex: in the lanes of `isa` where the weighting has a lane kernel,
+/// one vertex at a time otherwise or without `isa` (the reference the lanes are tested against).
 template <NormalWeighting weighting>
 void gather_normals(PositionsRef V, FacesRef F, const detail::VertexFaces& inc, int threads,
-                    RowMatrixX3d& N) {
+                    std::optional<detail::SimdIsa> isa, RowMatrixX3d& N) {
+  if constexpr (weighting != NormalWeighting::angle) {
+    if (isa) {
+      const auto block = detail::kernel_for(*isa, gather_normal_block_avx512<weighting>,
+                                            gather_normal_block_avx2<weighting>,
+                                            gather_normal_block_baseline<weighting>);
+      // Each vertex's row is computed alone: blocks and threads change no bit.
+      detail::parallel_for_blocks(
+          V.rows(), 1024, threads,
+          [&](std::int64_t begin, std::int64_t end) { block(V, F, inc, begin, end, N); });
+      return;
+    }
+  }
   detail::parallel_for(V.rows(), threads, [&](std::int64_t v) {
     N.row(v) = gathered_normal<weighting>(V, F, inc, v).transpose();
   });
@@ -121,17 +257,18 @@ RowMatrixX3d vertex_normals(const PreparedMesh& mesh, NormalWeighting weighting)
 namespace detail {
 
 RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting, int threads) {
+                                 NormalWeighting weighting, int threads,
+                                 std::optional<SimdIsa> isa) {
   RowMatrixX3d N(V.rows(), 3);
   switch (weighting) {
     case NormalWeighting::area:
-      gather_normals<NormalWeighting::area>(V, F, inc, threads, N);
+      gather_normals<NormalWeighting::area>(V, F, inc, threads, isa, N);
       break;
     case NormalWeighting::angle:
-      gather_normals<NormalWeighting::angle>(V, F, inc, threads, N);
+      gather_normals<NormalWeighting::angle>(V, F, inc, threads, isa, N);
       break;
     case NormalWeighting::max:
-      gather_normals<NormalWeighting::max>(V, F, inc, threads, N);
+      gather_normals<NormalWeighting::max>(V, F, inc, threads, isa, N);
       break;
   }
   return N;

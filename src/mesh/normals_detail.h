@@ -2,6 +2,9 @@
 // Internal: the parts of normals.cpp that check.cpp and statistics.cpp reuse with a connectivity
 // they have already computed.
 
+#include <optional>
+
+#include "core/simd_lanes.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/normals.h"
 #include "mesh/statistics_detail.h"
@@ -13,8 +16,11 @@ namespace focal::detail {
 OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t,
                                           int threads);
 
-/// vertex_normals from an incidence already computed for F.
+/// vertex_normals from an incidence already computed for F. The area and Max weightings run
+/// several vertices side by side in the lanes of `isa` (the same bits for every instruction set);
+/// std::nullopt: one vertex at a time, the reference the lanes are tested against.
 RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& inc,
-                                 NormalWeighting weighting, int threads);
+                                 NormalWeighting weighting, int threads,
+                                 std::optional<SimdIsa> isa = SimdIsa::best);
 
 }  // namespace focal::detail

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -86,6 +87,24 @@ struct Point {
 /// sums per entry (and bits) as one at a time.
 using Pair = double __attribute__((vector_size(2 * sizeof(double))));
 
+/// Where the marked vertices of `ring` lie within a few words of marks of each other (on a mesh
+/// whose nearby vertices have nearby indices), rewrites `ring` in ascending order by reading
+/// those words, clearing them as it goes, and returns true: the sorted ring without a sort.
+/// Otherwise leaves both as they are and returns false.
+bool read_marks_in_order(std::vector<int>& ring, std::uint64_t* bits) {
+  const auto [lowest, highest] = std::minmax_element(ring.begin(), ring.end());
+  const auto first = static_cast<std::size_t>(*lowest) / 64;
+  const auto last = static_cast<std::size_t>(*highest) / 64;
+  if (last - first >= 4 * ring.size()) return false;
+  int* out = ring.data();
+  for (std::size_t k = first; k <= last; ++k) {
+    for (std::uint64_t word = bits[k]; word != 0; word &= word - 1)
+      *out++ = static_cast<int>(64 * k) + std::countr_zero(word);
+    bits[k] = 0;
+  }
+  return true;
+}
+
 /// The vertices within `rings` edges of v (v included), sorted, into `ring`: breadth-first over
 /// the 1-ring with marks (`in_ring`: one bit per vertex, allocated on first use, #V / 8 bytes: it
 /// stays in cache; set while the vertex is in the neighbourhood being gathered, cleared after
@@ -105,28 +124,36 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::u
   ring.assign(1, v);
   test_and_set(v);
   // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
+  // Checked once per vertex whose neighbours were added (the ring may pass the cap by those), not
+  // once per neighbour: past it the ring is dropped either way.
   const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
   std::size_t begin = 0;
   for (int depth = 0; depth < rings && begin < ring.size(); ++depth) {
     const std::size_t end = ring.size();
     for (std::size_t k = begin; k < end && ring.size() <= cap; ++k) {
       const int u = ring[k];
-      for (const int* w = one.begin(u); w != one.end(u) && ring.size() <= cap; ++w) {
+      for (const int* w = one.begin(u); w != one.end(u); ++w) {
         if (!test_and_set(*w)) ring.push_back(*w);
       }
     }
     begin = end;
   }
+  if (ring.size() <= cap && read_marks_in_order(ring, bits)) return;
   for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
   if (ring.size() > cap) ring.resize(1);
   detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
 }
 
+/// A vertex's points: resize() leaves new entries unwritten (gather_points writes them).
+using Points = std::vector<Point, detail::DefaultInitAllocator<Point>>;
+
 /// The vertex itself (zero) and its ring in the frame, scaled by the largest offset, into
 /// `points`; non-finite neighbours are skipped. Returns the scale (0 when no usable neighbour).
 double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
-                     const std::vector<int>& ring, std::vector<Point>& points) {
-  points.assign(1, Point{0.0, 0.0, 0.0});
+                     const std::vector<int>& ring, Points& points) {
+  points.resize(ring.size() + 1);  // room for every point: written through a pointer, no checks
+  Point* out = points.data();
+  *out++ = {0.0, 0.0, 0.0};
   // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
   // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
   // GCC paired them by itself or not, depending on how the frame was built.
@@ -137,11 +164,13 @@ double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
   for (const int j : ring) {
     if (j == i) continue;
     const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
-    if (!std::isfinite(qx) || !std::isfinite(qy) || !std::isfinite(qz)) continue;
+    // All three finite (x - x is 0 for a finite x, NaN otherwise): one test instead of three.
+    if (!((qx - qx) + (qy - qy) + (qz - qz) == 0.0)) continue;
     const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
-    points.push_back({tangential[0], tangential[1], nx * qx + ny * qy + nz * qz});
+    *out++ = {tangential[0], tangential[1], nx * qx + ny * qy + nz * qz};
     scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
   }
+  points.resize(static_cast<std::size_t>(out - points.data()));
   const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
   if (scale > 0.0) {
     const double inv = 1.0 / scale;
@@ -177,7 +206,9 @@ constexpr int kMaxLanes = 8;
 /// numbered by degree). 28 moments per point for a cubic instead of 55 products, and a failed
 /// cubic falls back to lower degrees without another pass over the points.
 struct JetBatch {
-  const Point* points[kMaxLanes] = {};  ///< count[l] points of lane l (0: an idle lane)
+  /// points_max points per lane: lane l's count[l] points (0: an idle lane), then (0, 0, 0), so
+  /// that the kernel loads every lane's point p without asking whether it has one.
+  const Point* points[kMaxLanes] = {};
   int count[kMaxLanes] = {};
   int points_max = 0;  ///< the largest count
   /// Per point p, terms_stride(D) lane vectors from terms + p * terms_stride(D) * W: the
@@ -231,14 +262,16 @@ template <class L, int D>
 FOCAL_LANE_INLINE void accumulate_moments(JetBatch& b) {
   constexpr int W = width<L>, kProducts = coefficient_count(2 * D), kTerms = coefficient_count(D);
   L xy[kProducts] = {}, z[kTerms] = {};
+  const L count = lanes_from<L>([&](int l) { return static_cast<double>(b.count[l]); });
+  const L one = detail::broadcast<L>(1.0), zero{};
   double* out = b.terms;
   for (int p = 0; p < b.points_max; ++p) {
     const auto field = [&](double Point::*f) FOCAL_LANE_LAMBDA {
-      return lanes_from<L>([&](int l) { return p < b.count[l] ? b.points[l][p].*f : 0.0; });
+      return lanes_from<L>([&](int l) { return b.points[l][p].*f; });
     };
     const L x = field(&Point::x), y = field(&Point::y), height = field(&Point::z);
     L xp[2 * D + 1], yp[2 * D + 1];
-    xp[0] = lanes_from<L>([&](int l) { return p < b.count[l] ? 1.0 : 0.0; });
+    xp[0] = detail::broadcast<L>(static_cast<double>(p)) < count ? one : zero;
     yp[0] = detail::broadcast<L>(1.0);
 #pragma GCC unroll 16
     for (int k = 1; k <= 2 * D; ++k) xp[k] = xp[k - 1] * x, yp[k] = yp[k - 1] * y;
@@ -328,6 +361,58 @@ FOCAL_LANE_INLINE auto solve_ldlt(L (&A)[m][m], const L (&r)[m], L (&y)[m]) {
   return ok;
 }
 
+/// Whether one lane's diagonal magnitudes (as pivot_order reads them) strictly decrease along
+/// `perm`: pivot_order's order is then `perm` (with distinct magnitudes it is the one descending
+/// order), found with m - 1 comparisons instead of its m (m - 1) / 2 and swaps.
+template <int m>
+bool decreasing_along(const double* xy, int stride, const int* perm) {
+  const auto magnitude = [&](int i) { return std::abs(xy[kProductMoment.index[i][i] * stride]); };
+  double previous = magnitude(perm[0]);
+  for (int k = 1; k < m; ++k) {
+    const double next = magnitude(perm[k]);
+    if (!(previous > next)) return false;  // a tie or a NaN: pivot_order decides
+    previous = next;
+  }
+  return true;
+}
+
+/// True where every lane's pivot order is lane 0's: neighbouring vertices mostly share theirs
+/// (their moments differ little), and their systems are then gathered with one load per entry.
+template <int W, int m>
+FOCAL_LANE_INLINE bool same_pivot_order(const int (&perm)[W][m]) {
+  bool same = true;
+  for (int l = 1; l < W; ++l) {
+    for (int i = 0; i < m; ++i) same &= perm[l][i] == perm[0][i];
+  }
+  return same;
+}
+
+/// Every lane's permuted system A (on and below the diagonal) and right-hand side r from its
+/// moments, lane by lane in its own order perm[l], or with one load of all lanes per entry where
+/// the orders are `shared` (the same values either way).
+template <class L, int m>
+FOCAL_LANE_INLINE void gather_system(const double* xy, const double* rhs,
+                                     const int (&perm)[width<L>][m], bool shared, L (&A)[m][m],
+                                     L (&r)[m]) {
+  constexpr int W = width<L>;
+  if (shared) {
+    const int* p = perm[0];
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; j <= i; ++j)
+        A[i][j] = detail::load_lanes<L>(xy + kProductMoment.index[p[i]][p[j]] * W);
+      r[i] = detail::load_lanes<L>(rhs + p[i] * W);
+    }
+    return;
+  }
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      A[i][j] = lanes_from<L>(
+          [&](int l) { return xy[kProductMoment.index[perm[l][i]][perm[l][j]] * W + l]; });
+    }
+    r[i] = lanes_from<L>([&](int l) { return rhs[perm[l][i] * W + l]; });
+  }
+}
+
 /// Solves every lane's m x m normal equations A c = rhs, A[j][k] = xy[kProductMoment[j][k]], by
 /// LDL^T in its own pivot order (pivot_order): the matrix and right-hand side are gathered per
 /// lane in that order, then factored in lanes. Fixed size and unrolled: Eigen's LDLT runs
@@ -336,18 +421,24 @@ template <class L, int m>
 FOCAL_LANE_INLINE auto solve_normal_equations(const double* xy, const double* rhs, double* c) {
   constexpr int W = width<L>;
   int perm[W][m];
-  for (int l = 0; l < W; ++l) pivot_order<m>(xy + l, W, perm[l]);
-  L A[m][m], r[m], y[m];
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j <= i; ++j) {
-      A[i][j] = lanes_from<L>(
-          [&](int l) { return xy[kProductMoment.index[perm[l][i]][perm[l][j]] * W + l]; });
+  pivot_order<m>(xy, W, perm[0]);
+  for (int l = 1; l < W; ++l) {
+    if (decreasing_along<m>(xy + l, W, perm[0])) {
+      std::copy(perm[0], perm[0] + m, perm[l]);
+    } else {
+      pivot_order<m>(xy + l, W, perm[l]);
     }
-    r[i] = lanes_from<L>([&](int l) { return rhs[perm[l][i] * W + l]; });
   }
+  const bool shared = same_pivot_order<W, m>(perm);
+  L A[m][m], r[m], y[m];
+  gather_system<L, m>(xy, rhs, perm, shared, A, r);
   const auto ok = solve_ldlt<L, m>(A, r, y);
-  for (int l = 0; l < W; ++l) {
-    for (int i = 0; i < m; ++i) c[perm[l][i] * W + l] = lane_of(y[i], l);
+  if (shared) {
+    for (int i = 0; i < m; ++i) detail::store_lanes(c + perm[0][i] * W, y[i]);
+  } else {
+    for (int l = 0; l < W; ++l) {
+      for (int i = 0; i < m; ++i) c[perm[l][i] * W + l] = lane_of(y[i], l);
+    }
   }
   return ok;
 }
@@ -455,7 +546,7 @@ double residual_of(double ssr, int n, int m, double scale) {
 /// One vertex's scratch in a batch.
 struct LaneScratch {
   std::vector<int> ring;  ///< v and the vertices within `rings` edges, sorted
-  std::vector<Point> points;
+  Points points;
   Eigen::Vector3d n;   ///< the normal of the next fit's frame
   bool alive = false;  ///< every fit so far succeeded
 };
@@ -464,6 +555,7 @@ struct LaneScratch {
 struct JetScratch {
   std::vector<std::uint64_t> in_ring;  ///< gather_ring's marks
   LaneScratch lanes[kMaxLanes];
+  std::vector<Point> zeros;  ///< an idle lane's points
   std::vector<double> terms;
   JetBatch batch;
   std::vector<double> scalar_terms;  ///< the scalar path's, for a lane that failed degree D
@@ -473,10 +565,9 @@ struct JetScratch {
 /// The fit of the highest degree < D that succeeds, one lane alone, where degree D failed in
 /// its batch: the scalar path (moments and degree D again, the same bits, then lower degrees).
 template <int D>
-bool fit_lower_degrees(const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+bool fit_lower_degrees(const Point* points, int n, JetScratch& s, LocalJet& jet) {
   JetBatch& b = s.scalar;
-  const auto n = static_cast<int>(points.size());
-  b.points[0] = points.data();
+  b.points[0] = points;
   b.count[0] = b.points_max = n;
   s.scalar_terms.resize(static_cast<std::size_t>(n) * terms_stride(D));
   b.terms = s.scalar_terms.data();
@@ -500,16 +591,16 @@ bool fit_lower_degrees(const std::vector<Point>& points, JetScratch& s, LocalJet
   return false;
 }
 
-bool fit_lower_degrees(int degree, const std::vector<Point>& points, JetScratch& s, LocalJet& jet) {
+bool fit_lower_degrees(int degree, const Point* points, int n, JetScratch& s, LocalJet& jet) {
   switch (degree) {
     case 4:
-      return fit_lower_degrees<4>(points, s, jet);
+      return fit_lower_degrees<4>(points, n, s, jet);
     case 3:
-      return fit_lower_degrees<3>(points, s, jet);
+      return fit_lower_degrees<3>(points, n, s, jet);
     case 2:
-      return fit_lower_degrees<2>(points, s, jet);
+      return fit_lower_degrees<2>(points, n, s, jet);
     default:
-      return fit_lower_degrees<1>(points, s, jet);
+      return fit_lower_degrees<1>(points, n, s, jet);
   }
 }
 
@@ -529,6 +620,22 @@ struct JetInput {
   int width;  ///< the kernel's lanes
 };
 
+/// b.points of every lane, padded with (0, 0, 0) to b.points_max (JetBatch::points); an idle
+/// lane's are all zero.
+void pad_points(int width, JetScratch& s, JetBatch& b) {
+  const auto n = static_cast<std::size_t>(b.points_max);
+  if (s.zeros.size() < n) s.zeros.resize(n, Point{0.0, 0.0, 0.0});
+  for (int l = 0; l < width; ++l) {
+    LaneScratch& lane = s.lanes[l];
+    if (b.count[l] == 0) {
+      b.points[l] = s.zeros.data();
+      continue;
+    }
+    lane.points.resize(n, Point{0.0, 0.0, 0.0});
+    b.points[l] = lane.points.data();
+  }
+}
+
 /// Each lane's degree-D fit from the kernel where it succeeded, the scalar path's lower degrees
 /// where not; a lane with no fit is no longer alive.
 void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
@@ -536,10 +643,10 @@ void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
   b.points_max = 0;
   for (int l = 0; l < in.width; ++l) {
     const LaneScratch& lane = s.lanes[l];
-    b.points[l] = lane.points.data();
     b.count[l] = lane.alive ? static_cast<int>(lane.points.size()) : 0;
     b.points_max = std::max(b.points_max, b.count[l]);
   }
+  pad_points(in.width, s, b);
   const int D = in.o.degree, m = coefficient_count(D);
   s.terms.resize(static_cast<std::size_t>(b.points_max) * terms_stride(D) * in.width);
   b.terms = s.terms.data();
@@ -549,7 +656,7 @@ void fit_heights(const JetInput& in, JetScratch& s, LocalJet* jets) {
     if (!lane.alive) continue;
     LocalJet& jet = jets[l];
     if (!b.solved[l]) {
-      lane.alive = fit_lower_degrees(D, lane.points, s, jet);
+      lane.alive = fit_lower_degrees(D, lane.points.data(), b.count[l], s, jet);
       continue;
     }
     for (int k = 0; k < m; ++k) jet.c[k] = b.c[k * in.width + l];
@@ -581,6 +688,7 @@ void fit_batch(const JetInput& in, const int* v, int count, JetScratch& s, Local
       lane.alive = jets[l].scale > 0.0;
     }
     fit_heights(in, s, jets);
+    if (it + 1 == in.o.iterations) break;  // the last fit's normal is the caller's to compute
     for (int l = 0; l < in.width; ++l) {
       if (s.lanes[l].alive) s.lanes[l].n = jet_normal(jets[l]);
     }
