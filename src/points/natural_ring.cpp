@@ -20,8 +20,25 @@ constexpr int kBox = -1;
 /// half-plane x . p <= |p|^2 / 2 (the side of the origin of the bisector of the origin and p);
 /// the new edge is labelled `j`. Sutherland-Hodgman on one plane, each vertex's side evaluated
 /// once: the early-out and the cut share them.
+/// Whether the bisector of the origin and p surely misses the cell, by its farthest vertex
+/// alone: |v| |p| < |p|^2 / 2 for every vertex v, with a margin (1e-6, far above the rounding of
+/// the sides) so that clip's own test, vertex by vertex, would find every side <= 0 too. Most
+/// points of a neighbourhood close no edge of the cell once the nearest have cut it.
+bool surely_misses(const RingScratch& s, double p2) {
+  return 4.0 * s.farthest2 * (1.0 + 1e-6) < p2;
+}
+
+/// The largest squared distance of the cell's vertices from the origin.
+double farthest2_of(const std::vector<Eigen::Vector2d>& vertex) {
+  double out = 0.0;
+  for (const Eigen::Vector2d& v : vertex) out = std::max(out, v.squaredNorm());
+  return out;
+}
+
 void clip(RingScratch& s, const Eigen::Vector2d& p, int j) {
-  const double offset = 0.5 * p.squaredNorm();
+  const double p2 = p.squaredNorm();
+  if (surely_misses(s, p2)) return;
+  const double offset = 0.5 * p2;
   const std::size_t m = s.vertex.size();
   s.side.resize(m);
   bool cuts = false;
@@ -51,6 +68,7 @@ void clip(RingScratch& s, const Eigen::Vector2d& p, int j) {
   }
   std::swap(s.vertex, s.clipped_vertex);
   std::swap(s.label, s.clipped_label);
+  s.farthest2 = farthest2_of(s.vertex);
 }
 
 /// The triangles of `centre`'s fan among p (its natural neighbours about it), appended to
@@ -100,6 +118,7 @@ void natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p, RingScr
   const double r = 4.0 * reach;
   scratch.vertex.assign({{-r, -r}, {r, -r}, {r, r}, {-r, r}});
   scratch.label.assign({kBox, kBox, kBox, kBox});
+  scratch.farthest2 = farthest2_of(scratch.vertex);
   for (std::size_t j = 0; j < p.size(); ++j) {
     if (p[j].norm() > 1e-12 * reach) clip(scratch, p[j], static_cast<int>(j));
   }

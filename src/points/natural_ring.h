@@ -35,6 +35,7 @@ struct RingScratch {
   std::vector<Eigen::Vector2d> vertex, clipped_vertex;  ///< the cell, and its next clipping
   std::vector<int> label, clipped_label;                ///< each vertex's outgoing edge's point
   std::vector<double> side;                             ///< the vertices' side of one bisector
+  double farthest2 = 0.0;  ///< the largest squared distance of a cell vertex from the origin
   std::vector<int> contacts;                            ///< the labels of edges of length > 0
   std::vector<Eigen::Vector2d> about;                   ///< planar_fans: p about one centre
   PlanarRing ring;                                      ///< planar_fans: one centre's ring
