@@ -206,26 +206,76 @@ void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, 
   }
 }
 
-JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                              const CloudNormalOptions& options) {
+namespace {
+
+void check_jet_options(PositionsRef V, const Neighbourhoods& neighbours,
+                       const CloudNormalOptions& options) {
   check_sizes(V, neighbours, "cloud_normals");
   if (options.jet_degree < 1 || options.jet_degree > 4) {
     throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
                        std::to_string(options.jet_degree));
   }
   if (options.threads < 0) throw InvalidInput("cloud_normals: threads must be >= 0");
-  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
-  if (options.viewpoint) {
-    orient_towards_viewpoint(V, *options.viewpoint, N);
-  } else {
-    orient_normals_mst(V, neighbours, N);
-  }
+}
+
+/// Whether cloud_jets_sided turns point i's PCA normal `n` over: towards its row of `side`.
+bool turned_to_side(const Eigen::RowVector3d& n, NormalsRef side, Eigen::Index i) {
+  return n.dot(side.row(i)) < 0.0;
+}
+
+/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N.
+JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
+                           const CloudNormalOptions& options, RowMatrixX3d N) {
   if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
   const JetOptions jet{
       .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
   return detail::jet_normals_from(V, neighbours, N, jet);
+}
+
+}  // namespace
+
+JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                              const CloudNormalOptions& options) {
+  check_jet_options(V, neighbours, options);
+  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  if (options.viewpoint) {
+    orient_towards_viewpoint(V, *options.viewpoint, N);
+  } else {
+    orient_normals_mst(V, neighbours, N);
+  }
+  return jets_from_start(V, neighbours, options, std::move(N));
+}
+
+JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
+                                    const CloudNormalOptions& options, NormalsRef side) {
+  if (options.viewpoint) return cloud_jets(V, neighbours, options);
+  check_jet_options(V, neighbours, options);
+  if (side.rows() != V.rows()) throw InvalidInput("cloud_jets_sided: side does not have #V rows");
+  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+    if (turned_to_side(N.row(i), side, i)) N.row(i) *= -1.0;
+  });
+  return jets_from_start(V, neighbours, options, std::move(N));
+}
+
+void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                               const CloudNormalOptions& options, NormalsRef side,
+                               JetNormals& jets) {
+  if (options.viewpoint) return;  // cloud_jets_sided was cloud_jets
+  // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
+  const RowMatrixX3d pca = pca_normals(V, neighbours, options.threads);
+  RowMatrixX3d mst = pca;
+  orient_normals_mst(V, neighbours, mst);
+  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+    // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
+    const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();
+    // Only finite jets: an undefined one is the same NaN row whatever its start's sign.
+    if (by_mst != turned_to_side(pca.row(i), side, i) && jets.N.row(i).allFinite()) {
+      jets.N.row(i) *= -1.0;
+    }
+  });
 }
 
 RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,
