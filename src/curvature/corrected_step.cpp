@@ -99,6 +99,10 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
   s.seen[0] = 1;
   s.fan.resize(s.plane.size());
   s.has_fan.assign(s.plane.size(), 0);
+  // The point's own fan from its ring: planar_fan about it (at the origin) would clip its cell
+  // again: one of the 6 or so cells a point's ball needed (100K torus).
+  fan_of_ring(s.ring, 0, s.fan[0]);
+  s.has_fan[0] = 1;
   std::size_t ring_end = 1;
   int rings = 0;
   for (std::size_t k = 0; k < s.reached.size(); ++k) {

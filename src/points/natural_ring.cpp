@@ -16,10 +16,6 @@ namespace {
 /// The box label: an edge of the starting square, not of any point's half-plane.
 constexpr int kBox = -1;
 
-/// Cuts the cell held in `s` (s.vertex, and s.label: vertex k's edge to k + 1) by the
-/// half-plane x . p <= |p|^2 / 2 (the side of the origin of the bisector of the origin and p);
-/// the new edge is labelled `j`. Sutherland-Hodgman on one plane, each vertex's side evaluated
-/// once: the early-out and the cut share them.
 /// Whether the bisector of the origin and p surely misses the cell, by its farthest vertex
 /// alone: |v| |p| < |p|^2 / 2 for every vertex v, with a margin (1e-6, far above the rounding of
 /// the sides) so that clip's own test, vertex by vertex, would find every side <= 0 too. Most
@@ -35,6 +31,10 @@ double farthest2_of(const std::vector<Eigen::Vector2d>& vertex) {
   return out;
 }
 
+/// Cuts the cell held in `s` (s.vertex, and s.label: vertex k's edge to k + 1) by the
+/// half-plane x . p <= |p|^2 / 2 (the side of the origin of the bisector of the origin and p);
+/// the new edge is labelled `j`. Sutherland-Hodgman on one plane, each vertex's side evaluated
+/// once: the early-out and the cut share them.
 void clip(RingScratch& s, const Eigen::Vector2d& p, int j) {
   const double p2 = p.squaredNorm();
   if (surely_misses(s, p2)) return;
@@ -53,22 +53,33 @@ void clip(RingScratch& s, const Eigen::Vector2d& p, int j) {
   for (std::size_t e = 0; e < m; ++e) {
     const std::size_t next = e + 1 == m ? 0 : e + 1;
     const Eigen::Vector2d& a = s.vertex[e];
-    const Eigen::Vector2d& b = s.vertex[next];
     const double fa = s.side[e], fb = s.side[next];
     if (fa <= 0.0) {
       s.clipped_vertex.push_back(a);
       s.clipped_label.push_back(s.label[e]);
     }
     if ((fa <= 0.0) != (fb <= 0.0)) {
-      const Eigen::Vector2d c = a + (fa / (fa - fb)) * (b - a);
-      s.clipped_vertex.push_back(c);
-      // Leaving the half-plane, the edge from c runs along the bisector; entering it, along e.
+      s.clipped_vertex.push_back(a + (fa / (fa - fb)) * (s.vertex[next] - a));
+      // Leaving the half-plane, the edge from the new vertex runs along the bisector; entering
+      // it, along e.
       s.clipped_label.push_back(fa <= 0.0 ? j : s.label[e]);
     }
   }
   std::swap(s.vertex, s.clipped_vertex);
   std::swap(s.label, s.clipped_label);
   s.farthest2 = farthest2_of(s.vertex);
+}
+
+/// The triangles (centre, a, b) of consecutive adjacent ring points a, b, appended to `out`,
+/// each starting at its smallest corner.
+void append_triangles(const PlanarRing& ring, int centre, std::vector<std::array<int, 3>>& out) {
+  const std::size_t m = ring.ring.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!ring.adjacent_to_next[k]) continue;
+    std::array<int, 3> t{centre, ring.ring[k], ring.ring[(k + 1) % m]};
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    out.push_back(t);
+  }
 }
 
 /// The triangles of `centre`'s fan among p (its natural neighbours about it), appended to
@@ -81,13 +92,7 @@ void append_fan(const std::vector<Eigen::Vector2d>& p, int centre, RingScratch& 
   // The ring lives in scratch too: moved out for the call, so that its buffers are reused.
   PlanarRing ring = std::move(scratch.ring);
   natural_neighbours_of_origin(scratch.about, scratch, ring);
-  const std::size_t m = ring.ring.size();
-  for (std::size_t k = 0; k < m; ++k) {
-    if (!ring.adjacent_to_next[k]) continue;
-    std::array<int, 3> t{centre, ring.ring[k], ring.ring[(k + 1) % m]};
-    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-    out.push_back(t);
-  }
+  append_triangles(ring, centre, out);
   scratch.ring = std::move(ring);
 }
 
@@ -159,6 +164,12 @@ void planar_fan(const std::vector<Eigen::Vector2d>& p, int centre, RingScratch& 
                 std::vector<std::array<int, 3>>& out) {
   out.clear();
   append_fan(p, centre, scratch, out);
+  sort_unique(out);
+}
+
+void fan_of_ring(const PlanarRing& ring, int centre, std::vector<std::array<int, 3>>& out) {
+  out.clear();
+  append_triangles(ring, centre, out);
   sort_unique(out);
 }
 
