@@ -35,8 +35,8 @@ void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* w
 
 /// The neighbour graph made symmetric (j in i's list or i in j's), as CSR, each edge once per
 /// direction, lists sorted. Built in place in one flat array (a vector per point cost 200 bytes
-/// per point more at 1M points).
-Neighbourhoods symmetric(const Neighbourhoods& nb) {
+/// per point more at 1M points); the lists sorted on `threads`.
+Neighbourhoods symmetric(const Neighbourhoods& nb, int threads) {
   const int n = nb.vertex_count();
   std::vector<std::int64_t> start(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i) {
@@ -54,13 +54,19 @@ Neighbourhoods symmetric(const Neighbourhoods& nb) {
   Neighbourhoods out;
   out.offsets.resize(n + 1);
   out.offsets[0] = 0;
-  std::int64_t kept = 0;
-  for (int i = 0; i < n; ++i) {
+  // Each list sorted and made unique where it lies (the lists are disjoint: in parallel), its
+  // length kept in offsets[i + 1] until the lists are packed.
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
     const auto first = both.begin() + start[i], last = both.begin() + start[i + 1];
     std::sort(first, last);
-    const auto end = std::unique(first, last);
-    std::copy(first, end, both.begin() + kept);  // leftwards: the destination starts before first
-    kept += end - first;
+    out.offsets[i + 1] = static_cast<int>(std::unique(first, last) - first);
+  });
+  std::int64_t kept = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto first = both.begin() + start[i];
+    // Leftwards: the destination starts at or before first.
+    std::copy(first, first + out.offsets[i + 1], both.begin() + kept);
+    kept += out.offsets[i + 1];
     out.offsets[i + 1] = static_cast<int>(kept);
   }
   out.indices = Eigen::Map<const Eigen::VectorXi>(both.data(), static_cast<Eigen::Index>(kept));
@@ -207,9 +213,14 @@ RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours, int t
 }
 
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
+  return detail::orient_normals_mst(V, neighbours, N, 1);
+}
+
+int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                               int threads) {
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
-  const Neighbourhoods graph = symmetric(neighbours);
+  const Neighbourhoods graph = symmetric(neighbours, threads);
   const auto n = static_cast<int>(V.rows());
   std::vector<char> usable(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) usable[i] = N.row(i).allFinite() && V.row(i).allFinite();
@@ -303,7 +314,7 @@ JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
   if (options.viewpoint) {
     orient_towards_viewpoint(V, *options.viewpoint, N);
   } else {
-    orient_normals_mst(V, neighbours, N);
+    detail::orient_normals_mst(V, neighbours, N, options.threads);
   }
   return jets_from_start(V, neighbours, options, std::move(N));
 }
@@ -327,7 +338,7 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
   // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
   const RowMatrixX3d pca = pca_normals(V, neighbours, options.threads);
   RowMatrixX3d mst = pca;
-  orient_normals_mst(V, neighbours, mst);
+  detail::orient_normals_mst(V, neighbours, mst, options.threads);
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
     const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();

@@ -9,6 +9,10 @@
 
 namespace focal::detail {
 
+/// orient_normals_mst, its neighbour graph built on `threads` (the tree itself is serial).
+int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                       int threads);
+
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
 /// \throw as cloud_normals.
 JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
