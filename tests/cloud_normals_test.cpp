@@ -4,11 +4,13 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
 #include "focal/surfaces/cloud_samples.h"
+#include "normals/cloud_normals_detail.h"
 #include "test_clouds.h"
 
 namespace focal {
@@ -138,6 +140,36 @@ TEST(CloudNormals, RejectInvalidInput) {
   EXPECT_THROW((void)cloud_normals(s.mesh.V, nb, {.jet_degree = 5}), InvalidInput);
   RowMatrixX3d short_normals = RowMatrixX3d::Zero(3, 3);
   EXPECT_THROW((void)orient_normals_mst(s.mesh.V, nb, short_normals), InvalidInput);
+}
+
+// The plan's jets started on the side of given normals (no MST), then oriented as the MST
+// orients them: the same residuals and normals as cloud_jets, bit for bit, for given normals
+// that agree, that are random (every start sign a coin toss) and for both jet degrees.
+TEST(CloudJetsSided, SameBitsAsTheMstJets) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (SurfaceKind kind : {SurfaceKind::torus, SurfaceKind::saddle}) {
+    const AnalyticSurface s = test::cloud_of(kind, 3000, 2);
+    const Neighbourhoods nb = nearest_neighbours(s.mesh.V, 16);
+    RowMatrixX3d random(s.mesh.V.rows(), 3);
+    for (Eigen::Index i = 0; i < random.rows(); ++i) random.row(i) << u(rng), u(rng), u(rng);
+    for (const RowMatrixX3d& side : {s.mesh.N, random}) {
+      for (int degree : {2, 3}) {
+        CloudNormalOptions options;
+        options.jet_degree = degree;
+        const JetNormals mst = detail::cloud_jets(s.mesh.V, nb, options);
+        JetNormals sided = detail::cloud_jets_sided(s.mesh.V, nb, options, side);
+        EXPECT_EQ(std::memcmp(sided.residual.data(), mst.residual.data(),
+                              sizeof(double) * static_cast<std::size_t>(mst.residual.size())),
+                  0);
+        detail::orient_sided_jets(s.mesh.V, nb, options, side, sided);
+        EXPECT_EQ(std::memcmp(sided.N.data(), mst.N.data(),
+                              sizeof(double) * static_cast<std::size_t>(mst.N.size())),
+                  0)
+            << surface_name(kind) << " degree " << degree;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -152,6 +152,25 @@ TEST(NaturalRing, PlanarFansListEachTriangleOnce) {
   EXPECT_EQ(std::adjacent_find(two.begin(), two.end()), two.end());
 }
 
+// The scratch forms give planar_fans' triangles, reusing one scratch for every centre: planar_fan
+// about each centre, and fan_of_ring from the ring about a centre at the origin.
+TEST(NaturalRing, ScratchFormsMatchPlanarFans) {
+  std::vector<Vector2d> p{{0.0, 0.0}};
+  for (int k = 0; k < 16; ++k)
+    p.emplace_back(std::cos(2.4 * k) * (1.0 + 0.1 * k), std::sin(2.4 * k));
+  RingScratch scratch;
+  std::vector<std::array<int, 3>> fan;
+  for (int c = 0; c < static_cast<int>(p.size()); ++c) {
+    planar_fan(p, c, scratch, fan);
+    EXPECT_EQ(fan, planar_fans(p, {c})) << c;
+  }
+  PlanarRing ring;
+  natural_neighbours_of_origin(p, scratch, ring);
+  fan_of_ring(ring, 0, fan);
+  EXPECT_EQ(fan, planar_fans(p, {0}));
+  EXPECT_FALSE(fan.empty());
+}
+
 /// A hexagonal lattice of unit spacing in the plane z = 0, within `radius` of the origin.
 RowMatrixX3d planar_hexagonal_lattice(double radius) {
   std::vector<Eigen::Vector3d> rows;

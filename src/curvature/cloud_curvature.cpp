@@ -215,18 +215,25 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
   CloudNormalOptions normals = normal_options(options);
-  JetNormals jets = detail::cloud_jets(V, out.neighbours, normals);
+  // With the file's normals, the jets start on their side: the noise and the agreement below
+  // need no orientation, and the MST (serial) runs only if the file's normals are not used.
+  const auto fit_jets = [&] {
+    return N ? detail::cloud_jets_sided(V, out.neighbours, normals, *N)
+             : detail::cloud_jets(V, out.neighbours, normals);
+  };
+  JetNormals jets = fit_jets();
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
   if (out.noise > kNoisyPositions) {
     out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
     out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
     normals.jet_degree = 2;
-    jets = detail::cloud_jets(V, out.neighbours, normals);
+    jets = fit_jets();
   }
   // Without jets (CloudNormalMethod::pca) there is no noise to judge by: the file's are kept.
   // 1e-9 rad: exact normals of an exactly fitted cloud (noise 0) still agree.
   out.file_normals_used = N && (!std::isfinite(out.noise) ||
                                 median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
+  if (N && !out.file_normals_used) detail::orient_sided_jets(V, out.neighbours, normals, *N, jets);
   out.normals_estimated = !out.file_normals_used;
   out.N = std::move(jets.N);
   if (out.k == default_cloud_neighbours && !out.file_normals_used) {

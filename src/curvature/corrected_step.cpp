@@ -59,11 +59,13 @@ struct LocalScratch {
   std::vector<char> has_fan;
   std::vector<std::array<int, 3>> local_faces;
   std::vector<std::array<int, 3>> faces;
+  PlanarRing ring;    ///< the point's natural neighbours
+  RingScratch cells;  ///< the Voronoi cells' working memory
 
   const std::vector<std::array<int, 3>>& fan_of(int c) {
     const auto v = static_cast<std::size_t>(c);
     if (!has_fan[v]) {
-      fan[v] = planar_fans(plane, {c});
+      planar_fan(plane, c, cells, fan[v]);  // into the fan's own vector, kept from point to point
       has_fan[v] = 1;
     }
     return fan[v];
@@ -86,17 +88,21 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
   const auto distance = [&](int local) {
     return (V.row(s.index[static_cast<std::size_t>(local)]) - V.row(i)).norm();
   };
-  const PlanarRing ring = natural_neighbours_of_origin(s.plane);
-  if (ring.ring.empty()) return;
+  natural_neighbours_of_origin(s.plane, s.cells, s.ring);
+  if (s.ring.ring.empty()) return;
   double sum = 0.0;
-  for (const int q : ring.ring) sum += distance(q);
-  const double r = kCorrectedBall * sum / static_cast<double>(ring.ring.size());
+  for (const int q : s.ring.ring) sum += distance(q);
+  const double r = kCorrectedBall * sum / static_cast<double>(s.ring.ring.size());
   // The points within the ball reached along the local triangulation's edges, as ball::gather.
   s.reached.assign(1, 0);
   s.seen.assign(s.plane.size(), 0);
   s.seen[0] = 1;
   s.fan.resize(s.plane.size());
   s.has_fan.assign(s.plane.size(), 0);
+  // The point's own fan from its ring: planar_fan about it (at the origin) would clip its cell
+  // again: one of the 6 or so cells a point's ball needed (100K torus).
+  fan_of_ring(s.ring, 0, s.fan[0]);
+  s.has_fan[0] = 1;
   std::size_t ring_end = 1;
   int rings = 0;
   for (std::size_t k = 0; k < s.reached.size(); ++k) {

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
-#include <queue>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,8 +35,8 @@ void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* w
 
 /// The neighbour graph made symmetric (j in i's list or i in j's), as CSR, each edge once per
 /// direction, lists sorted. Built in place in one flat array (a vector per point cost 200 bytes
-/// per point more at 1M points).
-Neighbourhoods symmetric(const Neighbourhoods& nb) {
+/// per point more at 1M points); the lists sorted on `threads`.
+Neighbourhoods symmetric(const Neighbourhoods& nb, int threads) {
   const int n = nb.vertex_count();
   std::vector<std::int64_t> start(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i) {
@@ -55,18 +54,97 @@ Neighbourhoods symmetric(const Neighbourhoods& nb) {
   Neighbourhoods out;
   out.offsets.resize(n + 1);
   out.offsets[0] = 0;
-  std::int64_t kept = 0;
-  for (int i = 0; i < n; ++i) {
+  // Each list sorted and made unique where it lies (the lists are disjoint: in parallel), its
+  // length kept in offsets[i + 1] until the lists are packed.
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
     const auto first = both.begin() + start[i], last = both.begin() + start[i + 1];
     std::sort(first, last);
-    const auto end = std::unique(first, last);
-    std::copy(first, end, both.begin() + kept);  // leftwards: the destination starts before first
-    kept += end - first;
+    out.offsets[i + 1] = static_cast<int>(std::unique(first, last) - first);
+  });
+  std::int64_t kept = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto first = both.begin() + start[i];
+    // Leftwards: the destination starts at or before first.
+    std::copy(first, first + out.offsets[i + 1], both.begin() + kept);
+    kept += out.offsets[i + 1];
     out.offsets[i + 1] = static_cast<int>(kept);
   }
   out.indices = Eigen::Map<const Eigen::VectorXi>(both.data(), static_cast<Eigen::Index>(kept));
   return out;
 }
+
+/// Prim's frontier: the points offered an edge to the tree and not in it yet, smallest
+/// (weight, point) first, with the best (weight, parent) offered to each. An indexed binary heap
+/// with decrease-key: each point is in it once, where a heap of every offer pops the same
+/// points in the same order (an offer of a point is popped first only if it is that point's
+/// best, and two points never tie on (weight, point)) but holds 24 B per offer and pops the
+/// stale ones too.
+class Frontier {
+ public:
+  explicit Frontier(int n)
+      : best_(static_cast<std::size_t>(n), {std::numeric_limits<double>::infinity(), -1}),
+        slot_(static_cast<std::size_t>(n), -1) {}
+
+  bool empty() const { return heap_.empty(); }
+
+  /// Offers point i the edge to `parent` of this weight; kept if better than its best so far
+  /// ((weight, parent) order, as offers were compared before).
+  void offer(int i, double weight, int parent) {
+    const std::pair<double, int> o(weight, parent);
+    if (!(o < best_[static_cast<std::size_t>(i)])) return;
+    best_[static_cast<std::size_t>(i)] = o;
+    if (slot_[static_cast<std::size_t>(i)] < 0) {
+      slot_[static_cast<std::size_t>(i)] = static_cast<int>(heap_.size());
+      heap_.push_back(i);
+    }
+    rise(static_cast<std::size_t>(slot_[static_cast<std::size_t>(i)]));
+  }
+
+  /// The next point and its parent, out of the frontier.
+  std::pair<int, int> pop() {
+    const int top = heap_.front();
+    move_to(0, heap_.back());
+    heap_.pop_back();
+    if (!heap_.empty()) sink(0);
+    slot_[static_cast<std::size_t>(top)] = -1;
+    return {top, best_[static_cast<std::size_t>(top)].second};
+  }
+
+ private:
+  bool before(int a, int b) const {
+    const double wa = best_[static_cast<std::size_t>(a)].first;
+    const double wb = best_[static_cast<std::size_t>(b)].first;
+    return wa < wb || (wa == wb && a < b);
+  }
+  void move_to(std::size_t k, int i) {
+    heap_[k] = i;
+    slot_[static_cast<std::size_t>(i)] = static_cast<int>(k);
+  }
+  void rise(std::size_t k) {
+    const int i = heap_[k];
+    while (k > 0 && before(i, heap_[(k - 1) / 2])) {
+      move_to(k, heap_[(k - 1) / 2]);
+      k = (k - 1) / 2;
+    }
+    move_to(k, i);
+  }
+  void sink(std::size_t k) {
+    const int i = heap_[k];
+    for (;;) {
+      std::size_t c = 2 * k + 1;
+      if (c >= heap_.size()) break;
+      if (c + 1 < heap_.size() && before(heap_[c + 1], heap_[c])) ++c;
+      if (!before(heap_[c], i)) break;
+      move_to(k, heap_[c]);
+      k = c;
+    }
+    move_to(k, i);
+  }
+
+  std::vector<std::pair<double, int>> best_;  ///< per point: its best offer (weight, parent)
+  std::vector<int> slot_;                     ///< per point: its place in heap_, -1 if none
+  std::vector<int> heap_;
+};
 
 /// The extreme points' vote on a component's side (see orient_normals_mst): for each of the six
 /// axis directions d, the `count` points of `members` farthest along d (ties by index) add
@@ -135,9 +213,14 @@ RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours, int t
 }
 
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
+  return detail::orient_normals_mst(V, neighbours, N, 1);
+}
+
+int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                               int threads) {
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
-  const Neighbourhoods graph = symmetric(neighbours);
+  const Neighbourhoods graph = symmetric(neighbours, threads);
   const auto n = static_cast<int>(V.rows());
   std::vector<char> usable(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) usable[i] = N.row(i).allFinite() && V.row(i).allFinite();
@@ -147,34 +230,22 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return V(a, 2) > V(b, 2); });
   std::vector<char> done(static_cast<std::size_t>(n), 0);
-  using Edge = std::tuple<double, int, int>;  // weight, point, parent: ties by point index
-  std::priority_queue<Edge, std::vector<Edge>, std::greater<>> heap;
-  // The best (weight, parent) offered to each point so far: an edge that is not better is never
-  // the first of its point to leave the heap, so it is not pushed (Prim's decrease-key, lazily).
-  // The tree, and so the orientation, is that of pushing every edge (the same normals, checked
-  // on a 1M-point torus, where the orientation took 4.2 s -> 3.2 s of CPU).
-  std::vector<std::pair<double, int>> best(static_cast<std::size_t>(n),
-                                           {std::numeric_limits<double>::infinity(), -1});
+  Frontier frontier(n);
   int components = 0;
   std::vector<int> component(static_cast<std::size_t>(n), -1);
   for (const int seed : order) {
     if (done[static_cast<std::size_t>(seed)] || !usable[seed]) continue;
     const int label = components++;
     if (N(seed, 2) < 0.0) N.row(seed) *= -1.0;
-    heap.emplace(0.0, seed, seed);
-    while (!heap.empty()) {
-      const auto [weight, i, parent] = heap.top();
-      heap.pop();
-      if (done[static_cast<std::size_t>(i)]) continue;
+    frontier.offer(seed, 0.0, seed);
+    while (!frontier.empty()) {
+      const auto [i, parent] = frontier.pop();
       done[static_cast<std::size_t>(i)] = 1;
       component[static_cast<std::size_t>(i)] = label;
       if (N.row(i).dot(N.row(parent)) < 0.0) N.row(i) *= -1.0;
       for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
         if (done[static_cast<std::size_t>(*j)] || !usable[*j]) continue;
-        const std::pair<double, int> offer(1.0 - std::abs(N.row(i).dot(N.row(*j))), i);
-        if (!(offer < best[*j])) continue;
-        best[*j] = offer;
-        heap.emplace(offer.first, *j, i);
+        frontier.offer(*j, 1.0 - std::abs(N.row(i).dot(N.row(*j))), i);
       }
     }
   }
@@ -206,26 +277,76 @@ void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, 
   }
 }
 
-JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                              const CloudNormalOptions& options) {
+namespace {
+
+void check_jet_options(PositionsRef V, const Neighbourhoods& neighbours,
+                       const CloudNormalOptions& options) {
   check_sizes(V, neighbours, "cloud_normals");
   if (options.jet_degree < 1 || options.jet_degree > 4) {
     throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
                        std::to_string(options.jet_degree));
   }
   if (options.threads < 0) throw InvalidInput("cloud_normals: threads must be >= 0");
-  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
-  if (options.viewpoint) {
-    orient_towards_viewpoint(V, *options.viewpoint, N);
-  } else {
-    orient_normals_mst(V, neighbours, N);
-  }
+}
+
+/// Whether cloud_jets_sided turns point i's PCA normal `n` over: towards its row of `side`.
+bool turned_to_side(const Eigen::RowVector3d& n, NormalsRef side, Eigen::Index i) {
+  return n.dot(side.row(i)) < 0.0;
+}
+
+/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N.
+JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
+                           const CloudNormalOptions& options, RowMatrixX3d N) {
   if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
   const JetOptions jet{
       .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
   return detail::jet_normals_from(V, neighbours, N, jet);
+}
+
+}  // namespace
+
+JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                              const CloudNormalOptions& options) {
+  check_jet_options(V, neighbours, options);
+  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  if (options.viewpoint) {
+    orient_towards_viewpoint(V, *options.viewpoint, N);
+  } else {
+    detail::orient_normals_mst(V, neighbours, N, options.threads);
+  }
+  return jets_from_start(V, neighbours, options, std::move(N));
+}
+
+JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
+                                    const CloudNormalOptions& options, NormalsRef side) {
+  if (options.viewpoint) return cloud_jets(V, neighbours, options);
+  check_jet_options(V, neighbours, options);
+  if (side.rows() != V.rows()) throw InvalidInput("cloud_jets_sided: side does not have #V rows");
+  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+    if (turned_to_side(N.row(i), side, i)) N.row(i) *= -1.0;
+  });
+  return jets_from_start(V, neighbours, options, std::move(N));
+}
+
+void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                               const CloudNormalOptions& options, NormalsRef side,
+                               JetNormals& jets) {
+  if (options.viewpoint) return;  // cloud_jets_sided was cloud_jets
+  // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
+  const RowMatrixX3d pca = pca_normals(V, neighbours, options.threads);
+  RowMatrixX3d mst = pca;
+  detail::orient_normals_mst(V, neighbours, mst, options.threads);
+  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+    // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
+    const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();
+    // Only finite jets: an undefined one is the same NaN row whatever its start's sign.
+    if (by_mst != turned_to_side(pca.row(i), side, i) && jets.N.row(i).allFinite()) {
+      jets.N.row(i) *= -1.0;
+    }
+  });
 }
 
 RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,

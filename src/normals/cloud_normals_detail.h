@@ -9,9 +9,27 @@
 
 namespace focal::detail {
 
+/// orient_normals_mst, its neighbour graph built on `threads` (the tree itself is serial).
+int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                       int threads);
+
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
 /// \throw as cloud_normals.
 JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
                       const CloudNormalOptions& options);
+
+/// cloud_jets with each starting (PCA) normal turned to the side of its row of `side` instead
+/// of oriented by orient_normals_mst (serial, the plan's one serial step), for a plan that may
+/// only need the jets' residuals and lines: a jet is fitted in the frame of its own start normal,
+/// and a start normal of the other sign gives the same residual and the opposite normal, bit for
+/// bit (docs/POINTS.md, "The default's cost"). With a viewpoint, cloud_jets itself.
+JetNormals cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
+                            const CloudNormalOptions& options, NormalsRef side);
+
+/// Turns the normals of cloud_jets_sided(V, neighbours, options, side) into those of
+/// cloud_jets(V, neighbours, options): runs the orientation it left out and flips the jets
+/// whose start normal it turned the other way.
+void orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
+                       const CloudNormalOptions& options, NormalsRef side, JetNormals& jets);
 
 }  // namespace focal::detail

@@ -29,12 +29,37 @@ struct PlanarRing {
 };
 PlanarRing natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p);
 
+/// The working memory of natural_neighbours_of_origin: one per thread, reused from point to
+/// point (fresh vectors per call cost about a third of the ring's time in malloc and free).
+struct RingScratch {
+  std::vector<Eigen::Vector2d> vertex, clipped_vertex;  ///< the cell, and its next clipping
+  std::vector<int> label, clipped_label;                ///< each vertex's outgoing edge's point
+  std::vector<double> side;                             ///< the vertices' side of one bisector
+  double farthest2 = 0.0;     ///< the largest squared distance of a cell vertex from the origin
+  std::vector<int> contacts;  ///< the labels of edges of length > 0
+  std::vector<Eigen::Vector2d> about;  ///< planar_fans: p about one centre
+  PlanarRing ring;                     ///< planar_fans: one centre's ring
+};
+
+/// natural_neighbours_of_origin into `out` (its vectors reused), working in `scratch`.
+void natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p, RingScratch& scratch,
+                                  PlanarRing& out);
+
 /// The triangles of the Delaunay triangulation of the 2D points `p` that have a corner among
 /// `centres` (indices into p): each centre's fan among the other points (its natural
 /// neighbours, natural_neighbours_of_origin about it), counter-clockwise, each triangle once
 /// (starting at its smallest corner, in ascending order).
 std::vector<std::array<int, 3>> planar_fans(const std::vector<Eigen::Vector2d>& p,
                                             const std::vector<int>& centres);
+
+/// planar_fans about the one centre `centre`, into `out` (its vector reused).
+void planar_fan(const std::vector<Eigen::Vector2d>& p, int centre, RingScratch& scratch,
+                std::vector<std::array<int, 3>>& out);
+
+/// planar_fan's triangles from the centre's ring when the caller has it already: `ring`, the
+/// natural neighbours of the origin among p - p[centre] (planar_fan about a centre at the origin
+/// finds exactly that ring again).
+void fan_of_ring(const PlanarRing& ring, int centre, std::vector<std::array<int, 3>>& out);
 
 /// Every point's fan: the triangles (i, a, b) of its local triangulation (its neighbours j with
 /// ok[j] and a normal in the hemisphere of N.row(i), projected onto the plane of N.row(i)) at i,
