@@ -59,9 +59,13 @@ class PointTree {
                          " exclusion flags for " + std::to_string(V.rows()) + " points");
     }
     points_.rows.reserve(static_cast<std::size_t>(V.rows()));
-    for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    // In a spatial order rather than by row: the build's partitions then move points that are
+    // near in memory too (on the randomly ordered 1M torus its splits took 2.4 times less CPU,
+    // the whole `--k 16` run 3-4% less). The lists do not depend on the tree's shape: they are
+    // the nearest by distance, ties broken by row.
+    for (const int i : detail::spatial_order(V, threads)) {
       const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
-      if (!out && V.row(i).allFinite()) points_.rows.push_back(static_cast<int>(i));
+      if (!out && V.row(i).allFinite()) points_.rows.push_back(i);
     }
     points_.xyz.resize(3 * points_.rows.size());
     for (std::size_t j = 0; j < points_.rows.size(); ++j) {
