@@ -141,11 +141,16 @@ void cloud_corrected_point(PositionsRef V, const RowMatrixX3d& N, const std::vec
 
 void cloud_corrected_measures(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
                               const Neighbourhoods& neighbours, const std::vector<char>& skip,
-                              const CurvatureOptions& options, double scale, CurvatureResult& fit) {
+                              const CurvatureOptions& options, double scale,
+                              const std::vector<int>& order, CurvatureResult& fit) {
+  if (!order.empty() && order.size() != static_cast<std::size_t>(V.rows())) {
+    throw InvalidInput("cloud_corrected_measures: the order does not have #V rows");
+  }
   const ClassTolerances tol = class_tolerances(options, scale);
   parallel_for_blocks(V.rows(), 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
     LocalScratch scratch;
-    for (std::int64_t i = begin; i < end; ++i) {
+    for (std::int64_t k = begin; k < end; ++k) {
+      const std::int64_t i = order.empty() ? k : order[static_cast<std::size_t>(k)];
       const auto v = static_cast<std::size_t>(i);
       if (!ok[v] || (!skip.empty() && skip[v]) || fit.residual[i] <= kExactFitResidual) continue;
       cloud_corrected_point(V, N, ok, neighbours, tol, static_cast<int>(i), scratch, fit);

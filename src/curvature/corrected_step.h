@@ -92,8 +92,11 @@ constexpr double kExactFitResidual = 1e-9;
 /// and its neighbours' positions and normals (tiles with a halo of one link give the same
 /// rows); writes row i of `fit` where the measures are defined (a positive area in the ball),
 /// leaves it otherwise. `scale`: the cloud's spacing, the scale of the class tolerances.
+/// `order`: the points in the order to visit them (a permutation of the rows, or empty: row
+/// order); each point reads and writes its own row of `fit` only, so any order gives the same.
 void cloud_corrected_measures(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
                               const Neighbourhoods& neighbours, const std::vector<char>& skip,
-                              const CurvatureOptions& options, double scale, CurvatureResult& fit);
+                              const CurvatureOptions& options, double scale,
+                              const std::vector<int>& order, CurvatureResult& fit);
 
 }  // namespace focal::detail
