@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "core/spatial_order.h"
 #include "points/neighbours_detail.h"
 
 namespace focal {
@@ -425,13 +426,13 @@ TEST(Neighbours, OutlierTestsMatchTheirDefinitionsInAnyOrder) {
 // The order the kd-tree takes its points in: a permutation (non-finite rows last, duplicates by
 // row), whose neighbours in the order are near in space: on a shuffled random cloud the mean
 // distance between consecutive points is a small fraction of that in row order.
-TEST(SpatialOrder, APermutationThatKeepsNeighboursTogether) {
+TEST(MortonOrder, APermutationThatKeepsNeighboursTogether) {
   RowMatrixX3d V = random_cloud(20000, 4);
   V.row(7).setConstant(NAN);
   V(11, 2) = INFINITY;
   V.row(100) = V.row(50);
   V.row(30) = V.row(50);
-  const std::vector<int> order = detail::spatial_order(V, 2);
+  const std::vector<int> order = detail::morton_order(V, 2);
   ASSERT_EQ(order.size(), static_cast<std::size_t>(V.rows()));
   std::vector<int> sorted = order;
   std::sort(sorted.begin(), sorted.end());
@@ -457,8 +458,8 @@ TEST(SpatialOrder, APermutationThatKeepsNeighboursTogether) {
   // Z-order curve, steps of about the spacing (2 / 20000^(1/3) = 0.07) with jumps: the ratio was
   // 0.073 for seeds 4, 5 and 6 (a numpy copy of the order), so 0.15 leaves a factor 2.
   EXPECT_LT(along_order, 0.15 * along_rows);
-  EXPECT_EQ(detail::spatial_order(V, 1), order);
-  EXPECT_TRUE(detail::spatial_order(RowMatrixX3d(0, 3), 2).empty());
+  EXPECT_EQ(detail::morton_order(V, 1), order);
+  EXPECT_TRUE(detail::morton_order(RowMatrixX3d(0, 3), 2).empty());
 }
 
 TEST(Neighbours, RejectInvalidArguments) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/spatial_order.h"
 #include "curvature/corrected_step.h"
 #include "curvature/curvature_detail.h"
 #include "curvature/detail.h"
@@ -293,7 +294,7 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
     // mostly those its predecessors have just read, where a cloud's rows often come in no order
     // (the randomly ordered 1M torus of docs/POINTS.md: their shares of the default's samples
     // 11.6% -> 8.3% and 10.1% -> 8.5%); each point writes its own row only, so no bit changes.
-    const std::vector<int> order = detail::spatial_order(V, options.threads);
+    const std::vector<int> order = detail::morton_order(V, options.threads);
     // The default, as the mesh default on noisy positions: where rays lie far off the fit
     // (a neighbour off the surface, or with a normal bent by one), it is repeated without them
     // (curvature/robust_fit.h; clean fits keep every ray, bit for bit).

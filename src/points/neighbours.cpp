@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/spatial_order.h"
 #include "focal/core/error.h"
 #include "points/neighbours_detail.h"
 
@@ -63,7 +64,7 @@ class PointTree {
     // near in memory too (on the randomly ordered 1M torus its splits took 2.4 times less CPU,
     // the whole `--k 16` run 3-4% less). The lists do not depend on the tree's shape: they are
     // the nearest by distance, ties broken by row.
-    for (const int i : detail::spatial_order(V, threads)) {
+    for (const int i : detail::morton_order(V, threads)) {
       const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
       if (!out && V.row(i).allFinite()) points_.rows.push_back(i);
     }

@@ -46,11 +46,6 @@ std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbour
 std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
                                      const OutlierMeasures& measures, double ratio, int threads);
 
-/// The rows of V along a Morton (Z-order) curve over a grid of 1024 cells per axis on the box
-/// of V's finite rows (ties by row; non-finite rows last): rows near in space come near in the
-/// order. The kd-tree takes its points in this order (docs/POINTS.md, "Speed and memory").
-std::vector<int> spatial_order(PositionsRef V, int threads);
-
 /// mean_spacing(V, neighbours) on `threads` threads (the same value for any count).
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads);
 

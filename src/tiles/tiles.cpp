@@ -13,68 +13,12 @@
 
 #include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/spatial_order.h"
 #include "focal/core/error.h"
 #include "mesh/topology.h"
 
 namespace focal {
 namespace {
-
-/// Bits per axis of the Morton code: 3 x 21 = 63 bits, a cell of 2^-21 of the box.
-constexpr int kMortonBits = 21;
-
-/// The bits of x spread to every third position.
-std::uint64_t spread_bits(std::uint64_t x) {
-  x &= (1ULL << kMortonBits) - 1;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
-/// Morton codes of the vertices in the box of the finite ones; non-finite ones get the largest
-/// code, so that they come last.
-std::vector<std::uint64_t> morton_codes(PositionsRef V, int threads) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const Eigen::Vector3d p = V.row(i).transpose();
-    if (!p.allFinite()) continue;
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double cells = static_cast<double>((1ULL << kMortonBits) - 1);
-  std::vector<std::uint64_t> codes(static_cast<std::size_t>(V.rows()));
-  detail::parallel_for(V.rows(), threads, [&](std::int64_t i) {
-    const Eigen::Vector3d p = V.row(i).transpose();
-    if (!p.allFinite()) {
-      codes[static_cast<std::size_t>(i)] = std::numeric_limits<std::uint64_t>::max();
-      return;
-    }
-    std::uint64_t code = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double extent = hi[a] - lo[a];
-      const double t = extent > 0.0 ? (p[a] - lo[a]) / extent : 0.0;
-      const auto cell = static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * cells);
-      code |= spread_bits(cell) << a;
-    }
-    codes[static_cast<std::size_t>(i)] = code;
-  });
-  return codes;
-}
-
-/// The vertices in Morton order, ties by index: (code, index) pairs sorted in place, which is
-/// cache-friendlier than sorting indices by a looked-up code.
-std::vector<int> morton_order(PositionsRef V, int threads) {
-  const std::vector<std::uint64_t> codes = morton_codes(V, threads);
-  std::vector<std::pair<std::uint64_t, int>> keyed(codes.size());
-  for (std::size_t i = 0; i < codes.size(); ++i) keyed[i] = {codes[i], static_cast<int>(i)};
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<int> order(keyed.size());
-  for (std::size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
-  return order;
-}
 
 /// Sorts non-negative ids ascending: two passes of a counting sort on 16-bit digits (the ids
 /// of a tile number hundreds of thousands; measured 3 to 4 times faster than std::sort here).
@@ -208,7 +152,7 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
   if (options.tile_vertices < 1) throw InvalidInput("partition_mesh: tile_vertices must be >= 1");
   detail::check_face_indices(V.rows(), F, "partition_mesh");
   const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, options.threads);
-  const std::vector<int> order = morton_order(V, options.threads);
+  const std::vector<int> order = detail::morton_order(V, options.threads);
   Tiling out;
   out.halo_rings = halo_rings;
   // Tiles in parallel, each thread with its own marks (a tile's stamp is its index, so marks
@@ -353,7 +297,7 @@ Tiling partition_cloud(PositionsRef V, const Neighbourhoods& neighbours, int hal
   if (neighbours.vertex_count() != V.rows()) {
     throw InvalidInput("partition_cloud: the neighbourhoods are not V's");
   }
-  const std::vector<int> order = morton_order(V, options.threads);
+  const std::vector<int> order = detail::morton_order(V, options.threads);
   Tiling out;
   out.halo_rings = halo_depth;
   std::vector<std::unique_ptr<std::vector<int>>> marks(

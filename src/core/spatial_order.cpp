@@ -1,0 +1,87 @@
+#include "core/spatial_order.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+#include "core/parallel.h"
+
+namespace focal::detail {
+namespace {
+
+/// Bits per axis of the Morton code: 3 x 21 = 63 bits, a cell of 2^-21 of the box.
+constexpr int kMortonBits = 21;
+
+/// The bits of x spread to every third position.
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= (1ULL << kMortonBits) - 1;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Morton codes of the rows in the box of the finite ones; non-finite ones get the largest
+/// code, so that they come last.
+std::vector<std::uint64_t> morton_codes(PositionsRef V, int threads) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Eigen::Vector3d p = V.row(i).transpose();
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double cells = static_cast<double>((1ULL << kMortonBits) - 1);
+  std::vector<std::uint64_t> codes(static_cast<std::size_t>(V.rows()));
+  parallel_for(V.rows(), threads, [&](std::int64_t i) {
+    const Eigen::Vector3d p = V.row(i).transpose();
+    if (!p.allFinite()) {
+      codes[static_cast<std::size_t>(i)] = std::numeric_limits<std::uint64_t>::max();
+      return;
+    }
+    std::uint64_t code = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double extent = hi[a] - lo[a];
+      const double t = extent > 0.0 ? (p[a] - lo[a]) / extent : 0.0;
+      const auto cell = static_cast<std::uint64_t>(std::clamp(t, 0.0, 1.0) * cells);
+      code |= spread_bits(cell) << a;
+    }
+    codes[static_cast<std::size_t>(i)] = code;
+  });
+  return codes;
+}
+
+}  // namespace
+
+std::vector<int> morton_order(PositionsRef V, int threads) {
+  const std::vector<std::uint64_t> codes = morton_codes(V, threads);
+  // A stable counting sort on 16-bit digits (ties stay by row): at 1M rows several times
+  // faster than sorting (code, row) pairs, and 16 bytes a row of scratch where they took 32.
+  constexpr int kDigitBits = 16;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  std::vector<int> order(codes.size()), next(codes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<std::size_t> start(kBuckets);
+  for (int shift = 0; shift < 64; shift += kDigitBits) {
+    const auto digit = [&](int row) {
+      return static_cast<std::size_t>(codes[static_cast<std::size_t>(row)] >> shift) &
+             (kBuckets - 1);
+    };
+    std::fill(start.begin(), start.end(), 0);
+    for (const int row : order) ++start[digit(row)];
+    std::size_t sum = 0;
+    for (std::size_t& s : start) sum += std::exchange(s, sum);
+    for (const int row : order) next[start[digit(row)]++] = row;
+    order.swap(next);
+  }
+  return order;
+}
+
+}  // namespace focal::detail
