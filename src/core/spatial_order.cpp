@@ -62,8 +62,9 @@ std::vector<std::uint64_t> morton_codes(PositionsRef V, int threads) {
 
 std::vector<int> morton_order(PositionsRef V, int threads) {
   const std::vector<std::uint64_t> codes = morton_codes(V, threads);
-  // A stable counting sort on 16-bit digits (ties stay by row): at 1M rows several times
-  // faster than sorting (code, row) pairs, and 16 bytes a row of scratch where they took 32.
+  // A stable counting sort on 16-bit digits (ties stay by row): at 1M rows 71 ms against 112-128
+  // ms for sorting (code, row) pairs (one thread, the same order), with 16 bytes a row of
+  // scratch where the pairs took 32.
   constexpr int kDigitBits = 16;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
   std::vector<int> order(codes.size()), next(codes.size());
