@@ -111,7 +111,8 @@ void add_curvature_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("curvature", "Principal curvatures and directions per vertex");
   auto f = std::make_shared<CurvatureFlags>();
   cmd->add_option("input", f->input,
-                  "mesh or point cloud (.obj .ply .off .stl .xyz .pwn .pts .txt .csv)")
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .xyzn .xyzrgb .pwn .pts .txt .csv "
+                  ".pcd .las)")
       ->required();
   cmd->add_option("-o,--output", f->output,
                   "OUT.csv (one row per input vertex) or OUT.ply (the mesh with per-vertex "
@@ -152,7 +153,8 @@ void add_focal_mesh_command(CLI::App& app, const Log& log) {
       app.add_subcommand("focal-mesh", "The two focal meshes Gamma_1, Gamma_2 (paper eq. 2)");
   auto f = std::make_shared<FocalMeshFlags>();
   cmd->add_option("input", f->input,
-                  "mesh or point cloud (.obj .ply .off .stl .xyz .pwn .pts .txt .csv)")
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .xyzn .xyzrgb .pwn .pts .txt .csv "
+                  ".pcd .las)")
       ->required();
   cmd->add_option("-o,--output", f->prefix, "writes PREFIX.focal1.ply and PREFIX.focal2.ply")
       ->required();

@@ -291,7 +291,7 @@ EstimateOptions EstimatorFlags::estimate_options() const {
   return o;
 }
 
-Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& log) {
+Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& log) : path(path) {
   {
     Stage stage(log, "read");
     ReadOptions read = flags.read;
@@ -383,6 +383,14 @@ CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flag
   log.info(std::string("  normals: ") +
            (c.normals_estimated ? "estimated from the positions" : "the file's") +
            "; mean spacing " + std::to_string(c.spacing));
+  const auto& classes = c.curvature.point_class;
+  if (classes.size() > 0 && std::all_of(classes.begin(), classes.end(), [](std::uint8_t k) {
+        return k == static_cast<std::uint8_t>(PointClass::undefined);
+      })) {
+    log.warning(input.path + ": every point is undefined (" + std::to_string(classes.size()) +
+                "): no point has two neighbours apart from it with normals to fit (fewer than 3 "
+                "distinct points, or points along a line, span no surface)");
+  }
   print_summary(c.curvature, log);
   return c;
 }

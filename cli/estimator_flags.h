@@ -60,6 +60,7 @@ struct Input {
   Input(const Input&) = delete;
   Input& operator=(const Input&) = delete;
 
+  std::string path;  ///< as given, for messages
   Mesh mesh;
   /// The file has no faces: a point cloud (`prepared` is then empty; the cloud functions take
   /// mesh.V and mesh.N).

@@ -96,7 +96,7 @@ void add_generate_command(CLI::App& app, const Log& log) {
       ->required()
       ->check(CLI::IsMember(known));
   cmd->add_option("-o,--output", f->output,
-                  "output mesh (.ply .obj .off) or cloud (also .xyz), with exact normals")
+                  "output mesh (.ply .obj .off) or cloud (also .xyz .xyzn), with exact normals")
       ->required();
   cmd->add_option("--truth", f->truth, "also write the exact k1,k2,H,K,d1,d2 per vertex as CSV");
   const std::map<std::string, Triangulation> tri = {{"regular", Triangulation::regular},
@@ -134,7 +134,7 @@ void add_generate_command(CLI::App& app, const Log& log) {
       "  focal generate torus --cloud --vertices 5000 --no-normals -o torus.xyz --truth t.csv");
   cmd->add_flag("--force", f->force, "replace read-only output files");
   cmd->parse_complete_callback([f] {
-    require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz"});
+    require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz", ".xyzn"});
     if (!f->cloud && (f->graded > 0 || f->outliers > 0)) {
       throw CLI::ValidationError("--graded and --outliers need --cloud");
     }

@@ -79,7 +79,9 @@ void print_info(const InfoFlags& f, const Log& log) {
 void add_info_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("info", "Counts, bounds and connectivity statistics of a mesh");
   auto f = std::make_shared<InfoFlags>();
-  cmd->add_option("input", f->path, "mesh or point cloud (.obj .ply .off .stl .xyz .pwn .pts .txt .csv)")
+  cmd->add_option("input", f->path,
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .xyzn .xyzrgb .pwn .pts .txt .csv "
+                  ".pcd .las)")
       ->required();
   add_read_flags(*cmd, f->read);
   cmd->footer("Example:\n  focal info bunny.off");

@@ -57,10 +57,11 @@ void add_normals_command(CLI::App& app, const Log& log) {
   auto* cmd = app.add_subcommand("normals", "Estimated, oriented vertex normals (meshes, clouds)");
   auto f = std::make_shared<NormalsFlags>();
   cmd->add_option("input", f->input,
-                  "mesh or point cloud (.obj .ply .off .stl .xyz .pwn .pts .txt .csv)")
+                  "mesh or point cloud (.obj .ply .off .stl .xyz .xyzn .xyzrgb .pwn .pts .txt .csv "
+                  ".pcd .las)")
       ->required();
   cmd->add_option("-o,--output", f->output,
-                  "OUT.ply, .obj, .off or .xyz: positions, faces, normals")
+                  "OUT.ply, .obj, .off, .xyz or .xyzn: positions, faces, normals")
       ->required();
   f->out.add_to(*cmd);
   f->estimator.add_to(*cmd);
@@ -75,7 +76,7 @@ void add_normals_command(CLI::App& app, const Log& log) {
       "those, on the side of the file's normals. Meshes get the recommended estimator's\n"
       "normals (docs/POINTS.md, docs/ESTIMATOR.md).");
   cmd->parse_complete_callback([f] {
-    require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz"});
+    require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz", ".xyzn"});
     check_output("-o", f->output, f->input, f->force);
   });
   cmd->callback([f, &log] { run_normals(*f, log); });

@@ -8,13 +8,13 @@
 #   build/fuzz/fuzz/<format>_fuzzer build/fuzz/crash-<format>-<hash>
 # and add it to tests/mesh_io_test.cpp as a regression test once fixed.
 #
-# Usage: scripts/fuzz.sh [FORMAT...]     (default: ply obj off stl)
+# Usage: scripts/fuzz.sh [FORMAT...]     (default: ply obj off stl xyz pcd las)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=${FUZZ_SECONDS:-15}
 formats=("$@")
-[[ ${#formats[@]} -gt 0 ]] || formats=(ply obj off stl)
+[[ ${#formats[@]} -gt 0 ]] || formats=(ply obj off stl xyz pcd las)
 
 bash scripts/install-deps.sh fuzz
 cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \

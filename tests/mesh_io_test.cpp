@@ -532,6 +532,74 @@ TEST_F(MeshIo, PlyWithoutFacesIsAPointCloud) {
   EXPECT_EQ(m.face_source.size(), 0);
 }
 
+// x y z r g b without a header, as photogrammetry tools and CloudCompare write clouds: read as
+// normals, the colours would pick the side of every estimated normal. An error asking for a
+// header, and the header read; unit normals of one sign (a plane's) and zero rows stay normals.
+TEST_F(MeshIo, PointTextWhoseLastColumnsLookLikeColoursAsksForAHeader) {
+  expect_io_error(write("rgb.xyz", "0 0 0 200 100 50\n1 0 0 0 255 3\n0 1 0 9 9 9\n"),
+                  {"rgb.xyz", "look like colours", "'200 100 50'", "'x y z r g b'"});
+  expect_io_error(write("unit.xyz", "0 0 0 0.2 0.5 0.1\n1 0 0 0.9 0.9 0.9\n0 1 0 0 0 1\n"),
+                  {"unit.xyz", "look like colours"});
+  const Mesh named =
+      focal::read_mesh(write("rgb.txt", "//X,Y,Z,R,G,B\n0,0,0,200,100,50\n1,2,3,0,0,0\n"));
+  expect_same(named.V, rows({{0, 0, 0}, {1, 2, 3}}));
+  EXPECT_FALSE(named.has_normals());
+  const Mesh plane =
+      focal::read_mesh(write("plane.xyz", "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 0\n"));
+  expect_same(plane.N, rows({{0, 0, 1}, {0, 0, 1}, {0, 0, 0}}));
+  const Mesh mixed = focal::read_mesh(write("mixed.xyz", "0 0 0 2 0 0\n1 0 0 0 -3 0\n"));
+  EXPECT_TRUE(mixed.has_normals());  // a negative value: not colours, kept as written
+}
+
+// Open3D's extensions say what six columns hold: .xyzn normals even where they would look like
+// colours, .xyzrgb colours (skipped), and a file of another width is an error; focal writes .xyzn
+// but not .xyzrgb (its normals would read back as colours).
+TEST_F(MeshIo, Open3dExtensionsSayWhatSixColumnsHold) {
+  EXPECT_EQ(focal::mesh_format_from_path("a.XYZN"), focal::MeshFormat::xyz);
+  EXPECT_EQ(focal::mesh_format_from_path("a.xyzrgb"), focal::MeshFormat::xyz);
+  const Mesh n = focal::read_mesh(write("n.xyzn", "0 0 0 0.2 0.5 0.1\n1 2 3 2 0 0\n"));
+  expect_same(n.N, rows({{0.2, 0.5, 0.1}, {2, 0, 0}}));
+  const Mesh c = focal::read_mesh(write("c.xyzrgb", "0 0 0 0 0 1\n1 2 3 0.5 0.5 0.5\n"));
+  expect_same(c.V, rows({{0, 0, 0}, {1, 2, 3}}));
+  EXPECT_FALSE(c.has_normals());
+  expect_io_error(write("short.xyzn", "0 0 0\n"), {"line 1", "expected 6 numbers (x y z nx ny nz"});
+  expect_io_error(write("long.xyzrgb", "0 0 0 1 1 1 1\n"), {"expected 6 numbers (x y z r g b"});
+  Mesh cloud;
+  cloud.V = rows({{0, 0, 0}});
+  cloud.N = rows({{0, 0, 1}});
+  cloud.F.resize(0, 3);
+  focal::write_mesh(file("w.xyzn"), cloud);
+  expect_same(focal::read_mesh(file("w.xyzn")).N, cloud.N);
+  expect_error<focal::IoError>([&] { focal::write_mesh(file("w.xyzrgb"), cloud); },
+                               {"w.xyzrgb", "writing .xyzrgb is not supported"});
+  EXPECT_FALSE(fs::exists(file("w.xyzrgb")));
+}
+
+// PCL writes its normals as normal_x normal_y normal_z (with a curvature beside them).
+TEST_F(MeshIo, PclNormalNamesAreNormals) {
+  const Mesh ply = focal::read_mesh(
+      write("pcl.ply",
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+            "property float z\nproperty float normal_x\nproperty float normal_y\n"
+            "property float normal_z\nproperty float curvature\nend_header\n"
+            "1 2 3 0 0 1 0.5\n4 5 6 0 -1 0 0.25\n"));
+  expect_same(ply.N, rows({{0, 0, 1}, {0, -1, 0}}));
+  const Mesh csv = focal::read_mesh(
+      write("pcl.csv", "x,y,z,curvature,normal_x,normal_y,normal_z\n1,2,3,9,0,0,1\n"));
+  expect_same(csv.V, rows({{1, 2, 3}}));
+  expect_same(csv.N, rows({{0, 0, 1}}));
+}
+
+// A header may name its normal's columns in any order; a row shorter than the last column named
+// is an error (the fuzzer found it read past the row when ny came after nz).
+TEST_F(MeshIo, PointHeaderInAnyOrderNeedsEveryColumnItNames) {
+  const Mesh m = focal::read_mesh(write("order.csv", "nz,x,ny,y,nx,z\n1,2,0,3,0,4\n"));
+  expect_same(m.V, rows({{2, 3, 4}}));
+  expect_same(m.N, rows({{0, 0, 1}}));
+  expect_io_error(write("short.csv", "x,y,z,nx,nz,nx,ny,nz\n0,0,1,0,0,1\n"),
+                  {"line 2", "expected at least 7 numbers", "found 6"});
+}
+
 TEST_F(MeshIo, PlyWritesExtraVertexPropertiesWithTheirTypes) {
   const Mesh m = sample_mesh(false);
   std::vector<focal::VertexProperty> props(4);

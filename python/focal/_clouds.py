@@ -3,7 +3,8 @@
 ``focal.cloud_curvature(points, normals=None, k=16)`` takes what Open3D, trimesh or a scanner
 gives (``np.asarray(pcd.points)``, ``np.asarray(pcd.normals)``; ``trimesh.PointCloud.vertices``)
 and returns the same ``Curvature`` as ``focal.curvature`` on a mesh. ``focal.read_mesh`` reads a
-cloud file (PLY/OBJ without faces, .xyz .pts .txt .csv text) with ``F`` of shape ``(0, 3)``.
+cloud file (PLY/OBJ without faces, PCL's .pcd, LAS, .xyz .xyzn .xyzrgb .pts .txt .csv text)
+with ``F`` of shape ``(0, 3)``.
 See docs/POINTS.md.
 """
 

@@ -426,7 +426,7 @@ def main(argv: Optional[list] = None) -> int:
         "numbers as `focal curvature`).",
     )
     p.add_argument("input", help="mesh or point cloud file (.ply, .obj, .off, .stl; clouds: "
-                   ".xyz .pts .txt .csv, PLY/OBJ without faces)")
+                   ".xyz .xyzn .xyzrgb .pts .txt .csv .pcd .las, PLY/OBJ without faces)")
     p.add_argument("-o", "--output", help="fields, .npz or .csv (input order); with --parts, "
                    "the parts concatenated (.npz or .csv, as the parts)")
     p.add_argument("--parts", help="stream the input (binary PLY with normals): no process "

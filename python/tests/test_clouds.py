@@ -99,6 +99,21 @@ def test_read_mesh_of_a_cloud_has_no_faces(tmp_path):
     np.testing.assert_allclose(c.H, 0.5, atol=1e-9)
 
 
+def test_read_mesh_of_a_binary_pcd(tmp_path):
+    # PCL's binary layout: little-endian float32 records, fields in the header's order.
+    P, N = sphere_points(n=300, seed=3)
+    records = np.hstack([P, N]).astype("<f4")
+    header = (f"VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n"
+              f"TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH {len(P)}\nHEIGHT 1\n"
+              f"POINTS {len(P)}\nDATA binary\n")
+    path = tmp_path / "cloud.pcd"
+    path.write_bytes(header.encode() + records.tobytes())
+    mesh = focal.read_mesh(path)
+    assert mesh.F.shape == (0, 3)
+    np.testing.assert_array_equal(mesh.V, records[:, :3].astype(float))
+    np.testing.assert_array_equal(mesh.N, records[:, 3:].astype(float))
+
+
 def test_adaptive_radius():
     P, N = sphere_points(n=2000, seed=6)
     c = focal.cloud_curvature(P, N, adaptive_radius=1.2)

@@ -68,20 +68,37 @@ FileBytes read_whole_file(const std::filesystem::path& path) {
   return {std::move(data), used};
 }
 
-void check_count_fits(const std::filesystem::path& path, std::string_view where,
-                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
-                      std::string_view what) {
-  // The last element of a text file may lack its separator, hence the +1.
-  if (min_bytes > 0 && count > (available + 1) / min_bytes) {
+namespace {
+
+/// check_count_fits and check_records_fit: `slack` bytes of the last element may be missing.
+void check_elements_fit(const std::filesystem::path& path, std::string_view where,
+                        std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                        std::uint64_t slack, std::string_view what) {
+  if (min_bytes > 0 && count > (available + slack) / min_bytes) {
     fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
                    std::string(what) + " but the " + std::to_string(available) +
                    " bytes that follow can hold at most " +
-                   std::to_string((available + 1) / min_bytes));
+                   std::to_string((available + slack) / min_bytes));
   }
   if (count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
     fail(path, std::string(where) + ": header declares " + std::to_string(count) + " " +
                    std::string(what) + ", more than 32-bit indices can address");
   }
+}
+
+}  // namespace
+
+void check_count_fits(const std::filesystem::path& path, std::string_view where,
+                      std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
+                      std::string_view what) {
+  // The last element of a text file may lack its separator, hence the slack of 1.
+  check_elements_fit(path, where, count, min_bytes, available, 1, what);
+}
+
+void check_records_fit(const std::filesystem::path& path, std::string_view where,
+                       std::uint64_t count, std::uint64_t record_bytes, std::uint64_t available,
+                       std::string_view what) {
+  check_elements_fit(path, where, count, record_bytes, available, 0, what);
 }
 
 std::string quoted(std::string_view text) {

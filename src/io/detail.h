@@ -55,6 +55,12 @@ void check_count_fits(const std::filesystem::path& path, std::string_view where,
                       std::uint64_t count, std::uint64_t min_bytes, std::uint64_t available,
                       std::string_view what);
 
+/// The same for binary records of exactly `record_bytes` each, which must all be there (a text
+/// file's last element may lack its separator, a binary record may not lack its last byte).
+void check_records_fit(const std::filesystem::path& path, std::string_view where,
+                       std::uint64_t count, std::uint64_t record_bytes, std::uint64_t available,
+                       std::string_view what);
+
 /// `'text'`, for messages. (Also avoids "'" + std::string temporaries, on which GCC 12 gives a
 /// false -Wrestrict warning.)
 [[nodiscard]] std::string quoted(std::string_view text);
@@ -213,6 +219,10 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path, int threads);
 /// Point-cloud text (xyz.cpp); Mesh::F has 0 rows.
 [[nodiscard]] Mesh read_xyz(const std::filesystem::path& path);
+/// PCL's .pcd (pcd.cpp): ascii, binary or binary_compressed; Mesh::F has 0 rows.
+[[nodiscard]] Mesh read_pcd(const std::filesystem::path& path);
+/// ASPRS LAS (las.cpp): the positions of every point record; Mesh::F has 0 rows, no normals.
+[[nodiscard]] Mesh read_las(const std::filesystem::path& path);
 [[nodiscard]] Mesh read_stl(const std::filesystem::path& path, int threads);
 
 // The same readers on the contents of a file already in memory (read_X(path) is
@@ -230,6 +240,10 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld, int threads);
                                                       std::string_view data, int threads,
                                                       std::size_t chunk_bytes);
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data);
+/// Point-cloud text; the extension of `path` says what six columns hold (xyz.cpp).
+[[nodiscard]] Mesh parse_xyz(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_pcd(const std::filesystem::path& path, std::string_view data);
+[[nodiscard]] Mesh parse_las(const std::filesystem::path& path, std::string_view data);
 /// parse_ply with its parallel passes on `threads` threads (0: the default).
 [[nodiscard]] Mesh parse_ply(const std::filesystem::path& path, std::string_view data, int threads);
 /// That parse_ply with an ascii body read as parse_obj reads a file: runs of `chunk_bytes`, the

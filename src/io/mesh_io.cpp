@@ -15,11 +15,14 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::ply;
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".stl") return MeshFormat::stl;
-  if (ext == ".xyz" || ext == ".pwn" || ext == ".pts" || ext == ".txt" || ext == ".csv")
+  if (ext == ".xyz" || ext == ".xyzn" || ext == ".xyzrgb" || ext == ".pwn" || ext == ".pts" ||
+      ext == ".txt" || ext == ".csv")
     return MeshFormat::xyz;
+  if (ext == ".pcd") return MeshFormat::pcd;
+  if (ext == ".las" || ext == ".laz") return MeshFormat::las;
   io_detail::fail(path, "unknown mesh format '" + path.extension().string() +
-                            "' (expected .obj, .ply, .off, .stl, or .xyz .pwn .pts .txt .csv for "
-                            "point clouds)");
+                            "' (expected .obj, .ply, .off, .stl, or .xyz .xyzn .xyzrgb .pwn .pts "
+                            ".txt .csv .pcd .las for point clouds)");
 }
 
 Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
@@ -41,6 +44,10 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
     }
     case MeshFormat::xyz:
       return io_detail::read_xyz(path);
+    case MeshFormat::pcd:
+      return io_detail::read_pcd(path);
+    case MeshFormat::las:
+      return io_detail::read_las(path);
   }
   io_detail::fail(path, "unknown mesh format");
 }
@@ -63,6 +70,10 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
     case MeshFormat::xyz:
       write_xyz(path, mesh, options);
       return;
+    case MeshFormat::pcd:
+    case MeshFormat::las:
+      io_detail::fail(path, "writing " + path.extension().string() +
+                                " is not supported (use .ply, or .xyz / .xyzn)");
     case MeshFormat::stl:
       break;
   }

@@ -6,17 +6,15 @@
 /// Format reference: Greg Turk, "The PLY Polygon File Format" (1994), and the type aliases
 /// (int8..float64) added by later writers such as VTK and rply.
 
-#include <algorithm>
-#include <bit>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <span>
 #include <string_view>
 
 #include "focal/core/mesh.h"
 #include "focal/io/mesh_io.h"
+#include "io/bytes.h"
 
 namespace focal::io_detail {
 
@@ -106,28 +104,6 @@ constexpr Scalar scalar_of(PropertyType t) {
       return Scalar::int32;
   }
   return Scalar::float64;
-}
-
-/// The T stored at p, its bytes reversed when `swap` (the file's byte order is not the host's).
-template <class T>
-T load(const unsigned char* p, bool swap) {
-  unsigned char bytes[sizeof(T)];
-  if (swap) {
-    for (std::size_t i = 0; i < sizeof(T); ++i) bytes[i] = p[sizeof(T) - 1 - i];
-  } else {
-    std::memcpy(bytes, p, sizeof(T));
-  }
-  T value;
-  std::memcpy(&value, bytes, sizeof(T));
-  return value;
-}
-
-/// Stores `value` little endian at p (the byte order focal writes); returns the byte after it.
-template <class T>
-char* put_little_endian(char* p, T value) {
-  std::memcpy(p, &value, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(p, p + sizeof(T));
-  return p + sizeof(T);
 }
 
 }  // namespace ply

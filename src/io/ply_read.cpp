@@ -21,7 +21,7 @@ using io_detail::fail;
 using io_detail::fail_at_line;
 using io_detail::fail_at_offset;
 using io_detail::ply::is_integer;
-using io_detail::ply::load;
+using io_detail::load;
 using io_detail::ply::parse_scalar_type;
 using io_detail::ply::Scalar;
 using io_detail::ply::scalar_size;
@@ -139,16 +139,19 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view data)
   fail(path, "the header has no end_header line");
 }
 
-/// Where each property of the vertex element goes: 0..2 x y z, 3..5 nx ny nz, -1 skipped.
+/// Where each property of the vertex element goes: 0..2 x y z, 3..5 nx ny nz (or PCL's
+/// normal_x normal_y normal_z), -1 skipped; the first property of a role takes it.
 std::vector<int> vertex_roles(const std::filesystem::path& path, const PlyElement& vertex,
                               bool& has_normals) {
   static constexpr std::string_view kNames[6] = {"x", "y", "z", "nx", "ny", "nz"};
+  static constexpr std::string_view kPclNames[6] = {"x",        "y",        "z",
+                                                    "normal_x", "normal_y", "normal_z"};
   std::vector<int> roles(vertex.properties.size(), -1);
   int found[6] = {-1, -1, -1, -1, -1, -1};
   for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
     const auto& p = vertex.properties[i];
     for (int r = 0; r < 6; ++r) {
-      if (p.name == kNames[r] && !p.is_list && found[r] < 0) {
+      if ((p.name == kNames[r] || p.name == kPclNames[r]) && !p.is_list && found[r] < 0) {
         found[r] = static_cast<int>(i);
         roles[i] = r;
       }

@@ -18,7 +18,7 @@ namespace focal {
 namespace {
 
 using io_detail::PlyColumn;
-using io_detail::ply::put_little_endian;
+using io_detail::put_little_endian;
 using io_detail::ply::scalar_name;
 using io_detail::ply::scalar_of;
 using io_detail::ply::scalar_size;

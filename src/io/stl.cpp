@@ -5,14 +5,13 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
-#include <cstring>
 #include <limits>
 #include <optional>
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
+#include "io/bytes.h"
 #include "io/detail.h"
 
 namespace focal {
@@ -21,18 +20,10 @@ namespace {
 using io_detail::fail;
 using io_detail::fail_at_line;
 using io_detail::fail_at_offset;
+using io_detail::load_little_endian;
 
 constexpr std::size_t kHeaderBytes = 80;
 constexpr std::size_t kFacetBytes = 50;  // normal, 3 corners (float32 x 12), attribute (uint16)
-
-std::uint32_t load_u32_le(const char* p) {
-  unsigned char b[4];
-  std::memcpy(b, p, 4);
-  return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
-         static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
-}
-
-float load_f32_le(const char* p) { return std::bit_cast<float>(load_u32_le(p)); }
 
 /// Skips blanks and `#` comment lines (some exporters write one before `solid`).
 std::string_view skip_leading_comments(std::string_view data) {
@@ -82,7 +73,7 @@ std::string_view without_byte_order_mark(std::string_view data) {
 /// ends with `endsolid` and happens to have that size).
 bool binary_by_size(std::string_view data) {
   if (data.size() < kHeaderBytes + 4) return false;
-  const std::uint64_t count = load_u32_le(data.data() + kHeaderBytes);
+  const std::uint64_t count = load_little_endian<std::uint32_t>(data.data() + kHeaderBytes);
   const bool size_matches = data.size() == kHeaderBytes + 4 + count * kFacetBytes;
   return size_matches && !(starts_with_solid(data) && ends_with_endsolid(data));
 }
@@ -94,7 +85,7 @@ bool ascii_text(std::string_view data) {
 }
 
 Mesh read_binary(const std::filesystem::path& path, std::string_view data, int threads) {
-  const std::uint64_t count = load_u32_le(data.data() + kHeaderBytes);
+  const std::uint64_t count = load_little_endian<std::uint32_t>(data.data() + kHeaderBytes);
   const std::uint64_t expected = kHeaderBytes + 4 + count * kFacetBytes;
   if (data.size() < expected) {
     const std::uint64_t complete = (data.size() - kHeaderBytes - 4) / kFacetBytes;
@@ -120,7 +111,7 @@ Mesh read_binary(const std::filesystem::path& path, std::string_view data, int t
     const char* p = facet_data + f * static_cast<std::int64_t>(kFacetBytes);
     for (int c = 0; c < 3; ++c) {
       const Eigen::Index v = 3 * f + c;
-      for (int k = 0; k < 3; ++k) mesh.V(v, k) = load_f32_le(p + 12 + 12 * c + 4 * k);
+      for (int k = 0; k < 3; ++k) mesh.V(v, k) = load_little_endian<float>(p + 12 + 12 * c + 4 * k);
       mesh.F(f, c) = static_cast<std::int32_t>(v);
     }
     mesh.face_source[f] = static_cast<int>(f);

@@ -77,6 +77,11 @@ awk '{ print "v", $1, $2, $3 } END { }' sphere.xyz >s.obj
 awk '{ print "vn", $4, $5, $6 }' sphere.xyz >>s.obj
 run curvature s.obj -o obj.csv
 check "OBJ v/vn without faces: normals paired in order, k1 = 1 to 1e-9" below "$(max_dev obj.csv 1 1)" 1e-9
+{ printf 'VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 8 8 8 8 8 8\nTYPE F F F F F F\n'
+  printf 'WIDTH %d\nHEIGHT 1\nPOINTS %d\nDATA ascii\n' "$(wc -l <sphere.xyz)" "$(wc -l <sphere.xyz)"
+  cat sphere.xyz; } >s.pcd
+run curvature s.pcd -o pcd.csv
+check "PCL's .pcd (ascii, normal_x ...): k1 = 1 to 1e-9" below "$(max_dev pcd.csv 1 1)" 1e-9
 { echo "x,y,z,nx,ny,nz"; tr ' ' ',' <sphere.xyz; } >s.csv
 run curvature s.csv -o csv-out.csv
 check "comma-separated text with a header: k1 = 1 to 1e-9" below "$(max_dev csv-out.csv 1 1)" 1e-9
@@ -137,6 +142,17 @@ expect_error "--off-surface-ratio 1: what is wrong named" \
   --off-surface-ratio 1
 printf '1 2\n3 4\n' >two.xyz
 expect_error "two columns" "at least 3 numbers" two.csv curvature two.xyz -o two.csv
+# Points along a line span no surface: every row undefined, and a warning that says why.
+for i in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20; do echo "$i 0 0"; done >line.xyz
+run curvature line.xyz -o line.csv
+check "a cloud on a line: exit 0, every row undefined, a warning saying so" \
+  bash -c '[[ $1 -eq 0 && $(grep -c ",undefined$" line.csv) -eq 20 ]] && grep -q "every point is undefined (20)" "$2"' _ "$rc" "$ERR"
+# x y z r g b without a header: colours are not normals (docs/IO.md).
+awk '{ print $1, $2, $3, 200, 100, 50 }' bare.xyz >rgb.xyz
+expect_error "x y z r g b without a header: an error asking for one" "look like colours" rgb.csv curvature rgb.xyz -o rgb.csv
+{ echo "//X,Y,Z,R,G,B"; awk '{ print $1 "," $2 "," $3 ",200,100,50" }' bare.xyz; } >rgb.txt
+run curvature rgb.txt -o rgb-named.csv
+check "with CloudCompare's header: the positions alone, as the bare cloud" cmp -s bare.csv rgb-named.csv
 printf 'k1,k2,H\n1,2,3\n' >table.csv
 expect_error "a CSV whose header names no x, y, z: an error, not positions" "names no x, y, z" t.csv curvature table.csv -o t.csv
 expect_error "--rings on a cloud" "applies to meshes" r.csv curvature bare.xyz -o r.csv --rings 2

@@ -3,7 +3,9 @@
 /// Reading and writing meshes and per-vertex tables.
 ///
 /// Readers: OBJ, PLY (ascii, binary little and big endian), OFF, STL (ascii and binary), and
-/// point-cloud text (.xyz .pwn .pts .txt .csv: `x y z [nx ny nz]` per line, see docs/POINTS.md).
+/// point-cloud text (.xyz .xyzn .xyzrgb .pwn .pts .txt .csv: `x y z [nx ny nz]` per line, see
+/// docs/IO.md), PCL's .pcd (ascii, binary, binary_compressed) and ASPRS LAS 1.0-1.4 (.las),
+/// these two read only.
 /// A file without faces is a point cloud: Mesh::F has 0 rows (Mesh::is_cloud).
 /// Vertex order and count of indexed formats (OBJ, PLY, OFF) are preserved exactly; polygons are
 /// fan-triangulated and Mesh::face_source maps each triangle to its input polygon. STL has no
@@ -31,10 +33,11 @@
 
 namespace focal {
 
-enum class MeshFormat { obj, ply, off, stl, xyz };
+enum class MeshFormat { obj, ply, off, stl, xyz, pcd, las };
 
-/// The format named by the file extension (case-insensitive .obj .ply .off .stl; .xyz .pts .txt
-/// and .csv are point-cloud text, MeshFormat::xyz).
+/// The format named by the file extension (case-insensitive .obj .ply .off .stl; .xyz .xyzn
+/// .xyzrgb .pwn .pts .txt and .csv are point-cloud text, MeshFormat::xyz; .pcd is PCL's format;
+/// .las (and .laz, whose compressed points are an error naming a way out) is ASPRS LAS).
 /// \throw IoError for any other extension.
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
@@ -129,13 +132,14 @@ void write_off(const std::filesystem::path& path, const Mesh& mesh,
                const WriteOptions& options = {});
 
 /// Writes V (and N when present) as point-cloud text: one `x y z [nx ny nz]` line per point,
-/// faces left out. \throw InvalidInput for invalid arrays; IoError naming the path on failure.
+/// faces left out. \throw InvalidInput for invalid arrays; IoError naming the path on failure,
+/// and for a .xyzrgb path (Open3D's x y z r g b: read back, the normals would be colours).
 void write_xyz(const std::filesystem::path& path, const Mesh& mesh,
                const WriteOptions& options = {});
 
 /// Writes a mesh in the format named by the extension (.ply binary, .obj, .off; .xyz and the
 /// other point-cloud text extensions: write_xyz), with the options' precision and threads.
-/// \throw IoError for .stl (it cannot keep shared vertices) and unknown extensions.
+/// \throw IoError for .stl (it cannot keep shared vertices), .pcd, .las and unknown extensions.
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const WriteOptions& options = {});
 
