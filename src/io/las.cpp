@@ -89,9 +89,8 @@ LasHeader parse_header(const std::filesystem::path& path, std::string_view data)
     h.scale[d] = load_at<double>(data, kScale + 8 * static_cast<std::size_t>(d));
     h.shift[d] = load_at<double>(data, kOffset + 8 * static_cast<std::size_t>(d));
     if (!std::isfinite(h.scale[d]) || h.scale[d] == 0.0 || !std::isfinite(h.shift[d])) {
-      fail(path, std::string("the ") + "xyz"[d] +
-                     " scale and offset must be finite, the scale "
-                     "nonzero");
+      fail(path,
+           std::string("the ") + "xyz"[d] + " scale and offset must be finite, the scale nonzero");
     }
   }
   io_detail::check_records_fit(path, "byte offset " + std::to_string(h.offset), h.points, h.record,
@@ -111,8 +110,7 @@ Mesh parse_las(const std::filesystem::path& path, std::string_view data) {
   for (Eigen::Index i = 0; i < n; ++i) {
     const std::size_t at = h.offset + static_cast<std::size_t>(i) * h.record;
     for (int d = 0; d < 3; ++d) {
-      const auto raw = static_cast<std::int32_t>(
-          load_at<std::uint32_t>(data, at + 4 * static_cast<std::size_t>(d)));
+      const auto raw = load_at<std::int32_t>(data, at + 4 * static_cast<std::size_t>(d));
       mesh.V(i, d) = raw * h.scale[d] + h.shift[d];
     }
   }

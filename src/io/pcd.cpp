@@ -314,7 +314,8 @@ class PcdReader {
   void read_ascii() {
     std::size_t values = 0;
     for (const Field& f : header_.fields) values += static_cast<std::size_t>(f.count);
-    // A value and its blank take 2 bytes at least (the last line's newline may be missing).
+    // Only a bound against absurd counts (allocation): one byte less than a line of one-digit
+    // values per point, so that a file short of a value or a line gets the row's own message.
     io_detail::check_count_fits(path_, body_line(), header_.points, 2 * values - 1,
                                 text_.size() - header_.body, "points");
     reserve_points();

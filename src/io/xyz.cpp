@@ -152,7 +152,7 @@ class XyzReader {
       fail(path_,
            "its columns 4-6 (read as normals in a six-column file without a header) look like "
            "colours, not normals (none negative; first row " +
-               io_detail::quoted(first_extra_) +
+               io_detail::quoted(first_normal()) +
                "); give the file a header line naming its columns ('x y z r g b' reads the "
                "positions alone, 'x y z nx ny nz' reads them as normals), or Open3D's extension "
                "(.xyzrgb or .xyzn)");
@@ -174,6 +174,16 @@ class XyzReader {
 
   /// A header may name its columns in any order (nx after nz), so the last one read is the
   /// largest of all six, not the normal's third.
+  /// The first row's three values read as a normal, for the colour error.
+  [[nodiscard]] std::string first_normal() const {
+    std::string text;
+    for (int c = 0; c < 3; ++c) {
+      if (c > 0) text += ' ';
+      io_detail::append_number(text, normals_[static_cast<std::size_t>(c)]);
+    }
+    return text;
+  }
+
   void check_columns_exist() {
     int last = *std::max_element(columns_.position.begin(), columns_.position.end());
     if (columns_.normal) {
@@ -203,10 +213,6 @@ class XyzReader {
                        std::to_string(tokens_.size()));
     }
     for (const int c : columns_.position) positions_.push_back(number(static_cast<std::size_t>(c)));
-    if (columns_.normal && normals_.empty()) {
-      first_extra_ =
-          std::string(tokens_[3]) + " " + std::string(tokens_[4]) + " " + std::string(tokens_[5]);
-    }
     if (columns_.normal) {
       for (const int c : *columns_.normal) normals_.push_back(number(static_cast<std::size_t>(c)));
     }
@@ -232,7 +238,6 @@ class XyzReader {
   Columns columns_;
   std::vector<double> positions_;
   std::vector<double> normals_;
-  std::string first_extra_;  ///< the first row's columns 4-6, for the colour error
   SixColumns six_;
 };
 
