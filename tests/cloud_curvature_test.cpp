@@ -5,11 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
+#include <random>
+#include <string>
 
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
 #include "focal/surfaces/cloud_samples.h"
 #include "test_clouds.h"
+#include "test_identical.h"
 
 namespace focal {
 namespace {
@@ -131,6 +135,81 @@ TEST(CloudCurvature, SameBitsForAnyThreadCount) {
   EXPECT_EQ(one.N, two.N);
   EXPECT_EQ(one.curvature.k1, two.curvature.k1);
   EXPECT_EQ(one.curvature.d1, two.curvature.d1);
+}
+
+/// Bitwise equality of two matrices, NaN included.
+template <class Matrix>
+bool same_bits(const Matrix& a, const Matrix& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(),
+                     sizeof(typename Matrix::Scalar) * static_cast<std::size_t>(a.size())) == 0;
+}
+
+/// A cloud whose lists tie everywhere: an integer lattice (every distance exact, each repeated
+/// 4 or 8 times) on two planes 3 apart, rows shuffled; with a duplicated point, a non-finite
+/// row, a zero normal, far points (statistical outliers) and points 1 above the lower plane
+/// (off its surface), and normals tilted with x and y so that the fits are not all flat.
+AnalyticSurface tied_cloud() {
+  std::vector<Eigen::RowVector3d> points;
+  for (int z : {0, 3}) {
+    for (int x = 0; x < 24; ++x) {
+      for (int y = 0; y < 24; ++y) points.emplace_back(x, y, z);
+    }
+  }
+  for (int i = 0; i < 6; ++i) points.emplace_back(100.0 + 37 * i, -80.0 * i, 50.0);  // far
+  points.emplace_back(11, 11, 1);                                                    // off
+  points.emplace_back(points[200]);                                                  // duplicate
+  std::vector<int> order(points.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  AnalyticSurface s;
+  s.mesh.V.resize(static_cast<Eigen::Index>(points.size()), 3);
+  s.mesh.N.resize(s.mesh.V.rows(), 3);
+  for (Eigen::Index i = 0; i < s.mesh.V.rows(); ++i) {
+    s.mesh.V.row(i) = points[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    s.mesh.N.row(i) =
+        Eigen::RowVector3d(0.03 * s.mesh.V(i, 0), -0.02 * s.mesh.V(i, 1), 1.0).normalized();
+  }
+  s.mesh.V(5, 1) = NAN;
+  s.mesh.N.row(9).setZero();
+  return s;
+}
+
+// estimate_cloud_curvature runs the k nearest with the cloud's normals on a copy of the cloud
+// in Morton order (docs/POINTS.md, "Speed and memory"); plan_cloud_curvature then
+// fit_cloud_curvature (the tiles' halves) run on the cloud as it comes. Both must give the same
+// bits and lists: on the tied lattice (ties broken by the cloud's rows, not the copy's), on a
+// pear with 2% outliers, with k = 16 (the outlier tests' own lists) and k = 7, with
+// and without the tests, on 1, 2 and 3 threads.
+TEST(CloudCurvature, SpatialCopyGivesTheBitsOfTheCloudsOwnOrder) {
+  CloudSampleOptions pear;
+  pear.surface.kind = SurfaceKind::pear;
+  pear.surface.target_vertices = 4000;
+  pear.outliers = 0.02;
+  for (const AnalyticSurface& s : {tied_cloud(), sample_cloud(pear)}) {
+    for (const CloudOptions& o :
+         {CloudOptions{.k = 16, .threads = 1}, CloudOptions{.k = 16, .threads = 2},
+          CloudOptions{.k = 7, .threads = 3},
+          CloudOptions{.k = 16, .outlier_ratio = 0, .off_surface_ratio = 0, .threads = 2}}) {
+      const std::string what = std::to_string(s.mesh.V.rows()) + " points, k " +
+                               std::to_string(o.k) + ", " + std::to_string(o.threads) +
+                               " threads, tests " + (o.outlier_ratio > 0 ? "on" : "off");
+      const CloudCurvature copy = estimate_cloud_curvature(s.mesh.V, NormalsRef(s.mesh.N), o);
+      CloudCurvature own = plan_cloud_curvature(s.mesh.V, NormalsRef(s.mesh.N), o);
+      fit_cloud_curvature(s.mesh.V, own, o);
+      test::expect_identical(copy.curvature, own.curvature, what);
+      EXPECT_TRUE(same_bits(copy.N, own.N)) << what;
+      EXPECT_EQ(copy.neighbours.offsets, own.neighbours.offsets) << what;
+      EXPECT_EQ(copy.neighbours.indices, own.neighbours.indices) << what;
+      EXPECT_EQ(copy.outlier, own.outlier) << what;
+      EXPECT_EQ(std::memcmp(&copy.spacing, &own.spacing, sizeof(double)), 0) << what;
+      EXPECT_EQ(copy.k, own.k) << what;
+      EXPECT_TRUE(copy.file_normals_used && !copy.normals_estimated) << what;
+      if (o.outlier_ratio > 0) {
+        EXPECT_GT(std::count(copy.outlier.begin(), copy.outlier.end(), 1), 0) << what;
+      }
+    }
+  }
 }
 
 TEST(CloudCurvature, UndefinedWhereNoNormalOrNoNeighbours) {

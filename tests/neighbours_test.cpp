@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "focal/core/error.h"
 #include "core/spatial_order.h"
+#include "focal/core/error.h"
 #include "points/neighbours_detail.h"
 
 namespace focal {
@@ -423,43 +423,55 @@ TEST(Neighbours, OutlierTestsMatchTheirDefinitionsInAnyOrder) {
   }
 }
 
-// The order the kd-tree takes its points in: a permutation (non-finite rows last, duplicates by
-// row), whose neighbours in the order are near in space: on a shuffled random cloud the mean
-// distance between consecutive points is a small fraction of that in row order.
+// The order the kd-tree takes its points in (21 bits per axis), and the coarser one of a cloud's
+// spatial copy (10, detail::morton_permutation): a permutation (non-finite rows last, also after
+// a point whose code has every bit set, duplicates by row), whose neighbours in the order are
+// near in space: on a shuffled random cloud the mean distance between consecutive points is a
+// small fraction of that in row order.
 TEST(MortonOrder, APermutationThatKeepsNeighboursTogether) {
   RowMatrixX3d V = random_cloud(20000, 4);
+  V.row(3) = V.colwise().maxCoeff();  // the box's far corner: every bit of its code set
   V.row(7).setConstant(NAN);
   V(11, 2) = INFINITY;
   V.row(100) = V.row(50);
   V.row(30) = V.row(50);
-  const std::vector<int> order = detail::morton_order(V, 2);
-  ASSERT_EQ(order.size(), static_cast<std::size_t>(V.rows()));
-  std::vector<int> sorted = order;
-  std::sort(sorted.begin(), sorted.end());
-  for (int i = 0; i < V.rows(); ++i) ASSERT_EQ(sorted[static_cast<std::size_t>(i)], i);
-  EXPECT_EQ(order[order.size() - 2], 7);
-  EXPECT_EQ(order.back(), 11);
-  const auto at = [&](int row) {
-    return std::find(order.begin(), order.end(), row) - order.begin();
-  };
-  EXPECT_LT(at(30), at(50));
-  EXPECT_LT(at(50), at(100));
-  const auto path = [&](const auto& row_at) {  // summed steps between finite consecutive rows
-    double sum = 0.0;
-    for (std::size_t j = 1; j < order.size(); ++j) {
-      const double step = (V.row(row_at(j)) - V.row(row_at(j - 1))).norm();
-      if (std::isfinite(step)) sum += step;
-    }
-    return sum;
-  };
-  const double along_order = path([&](std::size_t j) { return order[j]; });
-  const double along_rows = path([](std::size_t j) { return static_cast<int>(j); });
-  // In row order consecutive points are about 1.3 apart (uniform in a cube of side 2); along the
-  // Z-order curve, steps of about the spacing (2 / 20000^(1/3) = 0.07) with jumps: the ratio was
-  // 0.073 for seeds 4, 5 and 6 (a numpy copy of the order), so 0.15 leaves a factor 2.
-  EXPECT_LT(along_order, 0.15 * along_rows);
-  EXPECT_EQ(detail::morton_order(V, 1), order);
+  for (const int bits : {21, 16, 10}) {
+    const std::vector<int> order = detail::morton_order(V, 2, bits);
+    ASSERT_EQ(order.size(), static_cast<std::size_t>(V.rows()));
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    for (int i = 0; i < V.rows(); ++i) ASSERT_EQ(sorted[static_cast<std::size_t>(i)], i);
+    EXPECT_EQ(order[order.size() - 2], 7) << bits;
+    EXPECT_EQ(order.back(), 11) << bits;
+    const auto at = [&](int row) {
+      return std::find(order.begin(), order.end(), row) - order.begin();
+    };
+    EXPECT_LT(at(30), at(50));
+    EXPECT_LT(at(50), at(100));
+    const auto path = [&](const auto& row_at) {  // summed steps between finite consecutive rows
+      double sum = 0.0;
+      for (std::size_t j = 1; j < order.size(); ++j) {
+        const double step = (V.row(row_at(j)) - V.row(row_at(j - 1))).norm();
+        if (std::isfinite(step)) sum += step;
+      }
+      return sum;
+    };
+    const double along_order = path([&](std::size_t j) { return order[j]; });
+    const double along_rows = path([](std::size_t j) { return static_cast<int>(j); });
+    // In row order consecutive points are about 1.3 apart (uniform in a cube of side 2); along
+    // the Z-order curve, steps of about the spacing (2 / 20000^(1/3) = 0.07) with jumps: the
+    // ratio was 0.073 for seeds 4, 5 and 6 (a numpy copy of the order), so 0.15 leaves a factor
+    // 2 (10 bits: cells of 0.002, far below the spacing, so the same curve).
+    EXPECT_LT(along_order, 0.15 * along_rows) << bits;
+    EXPECT_EQ(detail::morton_order(V, 1, bits), order) << bits;
+  }
+  EXPECT_EQ(detail::morton_order(V, 2), detail::morton_order(V, 2, 21));
   EXPECT_TRUE(detail::morton_order(RowMatrixX3d(0, 3), 2).empty());
+  const detail::RowPermutation p = detail::morton_permutation(V, 2);
+  EXPECT_EQ(p.order, detail::morton_order(V, 2, detail::kPermutationBits));
+  for (int i = 0; i < V.rows(); ++i) {
+    ASSERT_EQ(p.order[static_cast<std::size_t>(p.position[static_cast<std::size_t>(i)])], i);
+  }
 }
 
 TEST(Neighbours, RejectInvalidArguments) {

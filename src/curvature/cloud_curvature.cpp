@@ -66,9 +66,12 @@ void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o
   }
 }
 
-/// The neighbourhoods the options select, leaving out the `excluded` points (or none).
+/// The neighbourhoods the options select, leaving out the `excluded` points (or none). The k
+/// nearest of a cloud's spatially ordered copy order their ties by `tie_rows` (the copy's rows
+/// in the cloud: detail::nearest_neighbours); the radius ones are never asked for on a copy.
 Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& options,
-                                      const std::vector<char>& excluded) {
+                                      const std::vector<char>& excluded,
+                                      const std::vector<int>& tie_rows = {}) {
   if (options.k < 0 || !(options.radius >= 0.0) || options.threads < 0) {
     throw InvalidInput("cloud neighbourhoods: k, radius and threads must be >= 0");
   }
@@ -80,7 +83,7 @@ Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& option
     return adaptive_radius_neighbours(V, k, options.adaptive_radius, kMaxRadiusNeighbours, excluded,
                                       options.threads);
   }
-  return nearest_neighbours(V, k, excluded, options.threads);
+  return detail::nearest_neighbours(V, k, excluded, options.threads, tie_rows);
 }
 
 bool any_flag(const std::vector<char>& flags) {
@@ -91,9 +94,10 @@ bool tests_on(const CloudOptions& o) { return o.outlier_ratio > 0.0 || o.off_sur
 
 /// The outlier tests of the options over `nearest16`, the 16 nearest of every point (with their
 /// measures, points/neighbours_detail.h): statistical outliers, then points off the surface of
-/// their 16 nearest among the rest. Empty when both tests are off.
+/// their 16 nearest among the rest. Empty when both tests are off. `tie_rows` as
+/// neighbourhoods_without.
 std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours& nearest16,
-                                const CloudOptions& o) {
+                                const CloudOptions& o, const std::vector<int>& tie_rows = {}) {
   std::vector<char> flags;
   if (o.outlier_ratio > 0.0) {
     flags = detail::outlier_points(V, nearest16.neighbours, nearest16.measures.reach,
@@ -103,8 +107,8 @@ std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours
   // The planes without the isolated outliers, which would tilt them.
   std::vector<char> off;
   if (any_flag(flags)) {
-    const detail::MeasuredNeighbours rest =
-        detail::measured_nearest_neighbours(V, default_cloud_neighbours, flags, o.threads);
+    const detail::MeasuredNeighbours rest = detail::measured_nearest_neighbours(
+        V, default_cloud_neighbours, flags, o.threads, tie_rows);
     off = detail::off_surface_points(V, rest.neighbours, rest.measures, o.off_surface_ratio,
                                      o.threads);
   } else {
@@ -122,31 +126,42 @@ CloudNormalOptions normal_options(const CloudOptions& o) {
   return normals;
 }
 
-/// Neighbours as given (k or radius), the cloud's normals or cloud_normals over them.
-CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
-                                const CloudOptions& options) {
+/// Neighbours as given (k or radius), with the outlier tests and the spacing: every field of the
+/// plan but N. `tie_rows` as neighbourhoods_without (only with k nearest: in_spatial_order).
+CloudCurvature given_lists(PositionsRef V, const CloudOptions& options,
+                           const std::vector<int>& tie_rows = {}) {
   CloudCurvature out;
   // The tests are over the 16 nearest (where their ratios were measured): the lists asked for
   // when they are those, else a query of their own.
   const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
                        options.k == default_cloud_neighbours;
+  const auto nearest16 = [&] {
+    return detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads,
+                                               tie_rows);
+  };
   if (!tests_on(options)) {
-    out.neighbours = neighbourhoods_without(V, options, {});
+    out.neighbours = neighbourhoods_without(V, options, {}, tie_rows);
   } else if (sixteen) {
-    detail::MeasuredNeighbours nearest16 =
-        detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads);
-    out.outlier = outlier_flags(V, nearest16, options);
-    out.neighbours = any_flag(out.outlier) ? neighbourhoods_without(V, options, out.outlier)
-                                           : std::move(nearest16.neighbours);
+    detail::MeasuredNeighbours measured = nearest16();
+    out.outlier = outlier_flags(V, measured, options, tie_rows);
+    out.neighbours = any_flag(out.outlier)
+                         ? neighbourhoods_without(V, options, out.outlier, tie_rows)
+                         : std::move(measured.neighbours);
   } else {
-    out.neighbours = neighbourhoods_without(V, options, {});
-    out.outlier = outlier_flags(
-        V, detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads),
-        options);
-    if (any_flag(out.outlier)) out.neighbours = neighbourhoods_without(V, options, out.outlier);
+    out.neighbours = neighbourhoods_without(V, options, {}, tie_rows);
+    out.outlier = outlier_flags(V, nearest16(), options, tie_rows);
+    if (any_flag(out.outlier))
+      out.neighbours = neighbourhoods_without(V, options, out.outlier, tie_rows);
   }
-  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads, tie_rows);
   out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
+  return out;
+}
+
+/// Neighbours as given, the cloud's normals or cloud_normals over them.
+CloudCurvature given_neighbours(PositionsRef V, std::optional<NormalsRef> N,
+                                const CloudOptions& options) {
+  CloudCurvature out = given_lists(V, options);
   out.file_normals_used = N.has_value();
   out.normals_estimated = !N;
   out.N = N ? RowMatrixX3d(*N) : cloud_normals(V, out.neighbours, normal_options(options));
@@ -310,8 +325,66 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
   }
 }
 
+namespace {
+
+/// The k nearest with the cloud's own normals (`focal curvature --k 16` on a scan with normals):
+/// neither reads anything but each point's and its neighbours' rows.
+bool runs_in_spatial_order(std::optional<NormalsRef> N, const CloudOptions& o) {
+  return N && o.k > 0 && o.radius == 0.0 && o.adaptive_radius == 0.0;
+}
+
+/// M's rows taken in the order `from` (detail::rows_from), in place: one field at a time, so that
+/// a cloud's results are not held twice.
+template <class Matrix>
+void take_rows(Matrix& M, const std::vector<int>& from, int threads) {
+  M = detail::rows_from(M, from, threads);
+}
+
+void take_rows(CurvatureResult& r, const std::vector<int>& from, int threads) {
+  for (Eigen::VectorXd* v : {&r.k1, &r.k2, &r.H, &r.K, &r.residual}) take_rows(*v, from, threads);
+  take_rows(r.d1, from, threads);
+  take_rows(r.d2, from, threads);
+  take_rows(r.point_class, from, threads);
+  take_rows(r.rays_used, from, threads);
+  take_rows(r.rays_excluded, from, threads);
+}
+
+/// estimate_cloud_curvature on a copy of the cloud in Morton order, its results taken back to the
+/// cloud's rows. The lists, the tests and the fit read each point's neighbours' rows: on a cloud
+/// whose rows come in no spatial order (scanners' and generators' files often do) each read
+/// is a cache miss, on the copy mostly a hit (the randomly ordered 1M torus of docs/POINTS.md,
+/// `--k 16`, 2 threads: 956-959 ms instead of 1,200-1,206, the copy and the way back included).
+/// The same bits: every list is that of the cloud's own order renamed, in the
+/// same order (ties by the cloud's rows, detail::nearest_neighbours), and each point's tests
+/// and fit read only its own and its list's rows; mean_spacing sums in the cloud's row order.
+CloudCurvature in_spatial_order(PositionsRef V, NormalsRef N, const CloudOptions& options) {
+  const detail::RowPermutation p = detail::morton_permutation(V, options.threads);
+  RowMatrixX3d copy = detail::rows_from(V, p.order, options.threads);
+  CloudCurvature c = given_lists(copy, options, p.order);
+  c.file_normals_used = true;
+  c.N = detail::rows_from(N, p.order, options.threads);
+  fit_cloud_curvature(copy, c, options);
+  copy = RowMatrixX3d();
+  // Each field's copy is let go as it is taken back: the results are held once, as without the
+  // copy, but for the one field in flight (docs/POINTS.md, "Speed and memory").
+  c.neighbours = detail::unpermuted_neighbours(c.neighbours, p, options.threads);
+  take_rows(c.curvature, p.position, options.threads);
+  take_rows(c.N, p.position, options.threads);
+  if (!c.outlier.empty()) {
+    std::vector<char> outlier(c.outlier.size());
+    for (std::size_t i = 0; i < outlier.size(); ++i)
+      outlier[i] = c.outlier[static_cast<std::size_t>(p.position[i])];
+    c.outlier = std::move(outlier);
+  }
+  return c;
+}
+
+}  // namespace
+
 CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
                                         const CloudOptions& options) {
+  validate(V, N, options);
+  if (runs_in_spatial_order(N, options)) return in_spatial_order(V, *N, options);
   CloudCurvature out = plan_cloud_curvature(V, N, options);
   fit_cloud_curvature(V, out, options);
   return out;

@@ -54,7 +54,9 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 class PointTree {
  public:
   /// `excluded`: empty, or #V flags of points to leave out as the non-finite ones are.
-  PointTree(PositionsRef V, const std::vector<char>& excluded, int threads) {
+  /// `spatial`: V's rows are in a spatial order already (a copy of a cloud in Morton order), so
+  /// they are taken as they come.
+  PointTree(PositionsRef V, const std::vector<char>& excluded, int threads, bool spatial = false) {
     if (!excluded.empty() && excluded.size() != static_cast<std::size_t>(V.rows())) {
       throw InvalidInput("neighbours: " + std::to_string(excluded.size()) +
                          " exclusion flags for " + std::to_string(V.rows()) + " points");
@@ -64,9 +66,14 @@ class PointTree {
     // near in memory too (on the randomly ordered 1M torus its splits took 2.4 times less CPU,
     // the whole `--k 16` run 3-4% less). The lists do not depend on the tree's shape: they are
     // the nearest by distance, ties broken by row.
-    for (const int i : detail::morton_order(V, threads)) {
+    const auto add = [&](int i) {
       const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
       if (!out && V.row(i).allFinite()) points_.rows.push_back(i);
+    };
+    if (spatial) {
+      for (int i = 0; i < V.rows(); ++i) add(i);
+    } else {
+      for (const int i : detail::morton_order(V, threads)) add(i);
     }
     points_.xyz.resize(3 * points_.rows.size());
     for (std::size_t j = 0; j < points_.rows.size(); ++j) {
@@ -381,8 +388,10 @@ struct PlaneSums {
 /// rather than by the traversal order (rare on measured data, common on grids).
 class NearestQuery {
  public:
-  NearestQuery(const PointTree& tree, std::size_t k)
-      : tree_(tree), k_(k), wanted_(std::min(k + 2, tree.size())) {}
+  /// `tie_rows`: null, or per row of V the index that orders its ties instead of the row
+  /// (detail::nearest_neighbours).
+  NearestQuery(const PointTree& tree, std::size_t k, const std::vector<int>* tie_rows = nullptr)
+      : tree_(tree), k_(k), wanted_(std::min(k + 2, tree.size())), tie_rows_(tie_rows) {}
   /// Every finite point gets this many (fewer only when the cloud has fewer other points).
   [[nodiscard]] std::size_t list_size() const { return std::min(k_, tree_.size() - 1); }
 
@@ -393,12 +402,10 @@ class NearestQuery {
     const std::size_t found = tree_.tree().knnSearch(q, wanted_, index_.data(), distance_.data());
     candidates_.clear();
     if (found == wanted_ && wanted_ >= 2 && distance_[wanted_ - 1] == distance_[wanted_ - 2]) {
-      tree_.within(q, distance_[wanted_ - 1], [&](double distance, std::uint32_t index) {
-        candidates_.push_back({distance, tree_.row(index), index});
-      });
+      tree_.within(q, distance_[wanted_ - 1],
+                   [&](double distance, std::uint32_t index) { add(distance, index); });
     } else {
-      for (std::size_t j = 0; j < found; ++j)
-        candidates_.push_back({distance_[j], tree_.row(index_[j]), index_[j]});
+      for (std::size_t j = 0; j < found; ++j) add(distance_[j], index_[j]);
     }
     // Sorted by distance already (nanoflann's insertion), so the sort only orders ties.
     std::sort(candidates_.begin(), candidates_.end());
@@ -415,15 +422,23 @@ class NearestQuery {
   }
 
  private:
-  /// A candidate: ordered by (squared distance, row) as Candidate, its tree index carried.
+  /// A candidate: ordered by (squared distance, row) as Candidate, or by (squared distance, its
+  /// tie row) with tie rows; its row and tree index carried.
   struct Found {
     double distance;
+    int tie;
     int row;
     std::uint32_t index;
     bool operator<(const Found& o) const {
-      return distance < o.distance || (distance == o.distance && row < o.row);
+      return distance < o.distance || (distance == o.distance && tie < o.tie);
     }
   };
+
+  void add(double distance, std::uint32_t index) {
+    const int row = tree_.row(index);
+    const int tie = tie_rows_ ? (*tie_rows_)[static_cast<std::size_t>(row)] : row;
+    candidates_.push_back({distance, tie, row, index});
+  }
 
   /// outlier_points' mean distance and plane_offset over p's list (its `kept` tree indices in
   /// index_), from the tree's copies of the points, which the search has just read (in cache),
@@ -452,6 +467,7 @@ class NearestQuery {
 
   const PointTree& tree_;
   std::size_t k_, wanted_;
+  const std::vector<int>* tie_rows_;
   std::vector<std::uint32_t> index_;
   std::vector<double> distance_;
   std::vector<Found> candidates_;
@@ -486,12 +502,18 @@ Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
 
 namespace {
 
-/// nearest_neighbours, and the outlier tests' measures of its lists into `measures` (not null).
+/// nearest_neighbours, and the outlier tests' measures of its lists into `measures` (or null),
+/// ties ordered by `tie_rows` (empty: by row).
 Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded, int threads,
-                       detail::OutlierMeasures* measures) {
+                       detail::OutlierMeasures* measures, const std::vector<int>& tie_rows) {
   if (k < 1) throw InvalidInput("neighbours: k must be >= 1, got " + std::to_string(k));
   check_threads(threads);
-  const PointTree tree(V, excluded, threads);
+  if (!tie_rows.empty() && tie_rows.size() != static_cast<std::size_t>(V.rows())) {
+    throw InvalidInput("neighbours: " + std::to_string(tie_rows.size()) + " tie rows for " +
+                       std::to_string(V.rows()) + " points");
+  }
+  const std::vector<int>* ties = tie_rows.empty() ? nullptr : &tie_rows;
+  const PointTree tree(V, excluded, threads, ties != nullptr);
   const auto count = static_cast<std::int64_t>(tree.size());
   // Every finite point has the same number of neighbours: the CSR is laid out before the
   // queries, which write into it directly (no per-block lists, no second pass).
@@ -511,7 +533,7 @@ Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded,
     }
   }
   detail::parallel_for_blocks(count, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
-    NearestQuery query(tree, static_cast<std::size_t>(k));
+    NearestQuery query(tree, static_cast<std::size_t>(k), ties);
     for (std::int64_t p = begin; p < end; ++p) {
       // The rows of the next points, in leaf order, are scattered over V's: their offsets and
       // list slots are fetched a query ahead (a query takes about 1 us, a miss 0.1 us).
@@ -537,15 +559,21 @@ Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded,
 
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
                                   int threads) {
-  return nearest(V, k, excluded, threads, nullptr);
+  return nearest(V, k, excluded, threads, nullptr, {});
 }
 
 namespace detail {
 
+Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
+                                  int threads, const std::vector<int>& tie_rows) {
+  return nearest(V, k, excluded, threads, nullptr, tie_rows);
+}
+
 MeasuredNeighbours measured_nearest_neighbours(PositionsRef V, int k,
-                                               const std::vector<char>& excluded, int threads) {
+                                               const std::vector<char>& excluded, int threads,
+                                               const std::vector<int>& tie_rows) {
   MeasuredNeighbours out;
-  out.neighbours = nearest(V, k, excluded, threads, &out.measures);
+  out.neighbours = nearest(V, k, excluded, threads, &out.measures, tie_rows);
   return out;
 }
 
@@ -751,25 +779,62 @@ double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {
   return detail::mean_spacing(V, neighbours, 0);
 }
 
-double detail::mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads) {
+double detail::mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads,
+                            const std::vector<int>& tie_rows) {
   check_threads(threads);
-  // The distances in parallel (each a read of a row scattered over V), their sum in row order
-  // as before: the same bits for any thread count.
   const int n = neighbours.vertex_count();
+  if (!tie_rows.empty() && tie_rows.size() != static_cast<std::size_t>(n)) {
+    throw InvalidInput("mean_spacing: " + std::to_string(tie_rows.size()) + " tie rows for " +
+                       std::to_string(n) + " points");
+  }
+  // The distances in parallel (each a read of a row scattered over V), each stored at its
+  // point's row before any permutation (NaN: no list); their sum in that order: the same bits
+  // for any thread count and any permutation.
   std::vector<double> nearest(static_cast<std::size_t>(n), NAN);
   detail::parallel_for(n, threads, [&](std::int64_t i) {
     const int p = static_cast<int>(i);
     if (neighbours.size(p) == 0) return;
-    nearest[static_cast<std::size_t>(i)] = (V.row(*neighbours.begin(p)) - V.row(p)).norm();
+    const auto at = static_cast<std::size_t>(tie_rows.empty() ? p : tie_rows[p]);
+    nearest[at] = (V.row(*neighbours.begin(p)) - V.row(p)).norm();
   });
   double sum = 0.0;
   std::int64_t count = 0;
-  for (int i = 0; i < n; ++i) {
-    if (neighbours.size(i) == 0) continue;
-    sum += nearest[static_cast<std::size_t>(i)];
+  for (const double d : nearest) {
+    if (std::isnan(d)) continue;
+    sum += d;
     ++count;
   }
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+Neighbourhoods detail::unpermuted_neighbours(const Neighbourhoods& copy, const RowPermutation& p,
+                                             int threads) {
+  const auto n = static_cast<std::int64_t>(p.order.size());
+  if (copy.vertex_count() != n || p.position.size() != p.order.size()) {
+    throw InvalidInput("neighbours: the lists are not the permuted cloud's");
+  }
+  std::vector<int> sizes(static_cast<std::size_t>(n));
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    sizes[static_cast<std::size_t>(i)] = copy.size(p.position[static_cast<std::size_t>(i)]);
+  });
+  Neighbourhoods out;
+  out.offsets = offsets_of(sizes);
+  out.indices.resize(out.offsets[n]);
+  detail::parallel_for(n, threads, [&](std::int64_t i) {
+    // Each list's row in the copy, and the renaming of its entries, are scattered reads: a
+    // chain of three misses (offset, list, name) per row, started ahead of time.
+    if (i + 16 < n) __builtin_prefetch(&copy.offsets[p.position[static_cast<std::size_t>(i + 16)]]);
+    if (i + 8 < n) {
+      const int ahead = p.position[static_cast<std::size_t>(i + 8)];
+      __builtin_prefetch(copy.begin(ahead));
+      __builtin_prefetch(&p.order[static_cast<std::size_t>(ahead)]);
+    }
+    const int from = p.position[static_cast<std::size_t>(i)];
+    int* to = out.indices.data() + out.offsets[i];
+    for (const int* j = copy.begin(from); j != copy.end(from); ++j)
+      *to++ = p.order[static_cast<std::size_t>(*j)];
+  });
+  return out;
 }
 
 }  // namespace focal

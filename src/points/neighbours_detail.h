@@ -9,6 +9,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/spatial_order.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 
@@ -33,10 +34,21 @@ struct MeasuredNeighbours {
   OutlierMeasures measures;
 };
 
-/// nearest_neighbours(V, k, excluded, threads) and the outlier tests' measures of its lists, in
-/// the same pass. Identical for any thread count.
+/// nearest_neighbours(V, k, excluded, threads) of a cloud whose rows were permuted: ties ordered
+/// by tie_rows[row] (#V: each row's index before the permutation) instead of by row, so that
+/// every list is, entry by entry, the permuted cloud's image of the list its point gets in the
+/// cloud's own order. Empty: by row (nearest_neighbours itself). With tie rows, V is taken to be
+/// in a spatial order already (detail::morton_permutation's copy): the kd-tree takes its rows as
+/// they come instead of sorting them (the lists do not depend on the tree's shape).
+/// \throw InvalidInput as nearest_neighbours, or when tie_rows is neither empty nor #V long.
+Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
+                                  int threads, const std::vector<int>& tie_rows);
+
+/// detail::nearest_neighbours(V, k, excluded, threads, tie_rows) and the outlier tests' measures
+/// of its lists, in the same pass. Identical for any thread count.
 MeasuredNeighbours measured_nearest_neighbours(PositionsRef V, int k,
-                                               const std::vector<char>& excluded, int threads);
+                                               const std::vector<char>& excluded, int threads,
+                                               const std::vector<int>& tie_rows = {});
 
 /// outlier_points(V, neighbours, ratio, threads) from `reach`, the measures of those lists.
 std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
@@ -46,7 +58,16 @@ std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbour
 std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
                                      const OutlierMeasures& measures, double ratio, int threads);
 
-/// mean_spacing(V, neighbours) on `threads` threads (the same value for any count).
-double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads);
+/// mean_spacing(V, neighbours) on `threads` threads (the same value for any count), its sum
+/// taken in the order of `tie_rows` (as above: the rows before a permutation; empty: by row), so
+/// a permuted cloud gets the bits of the cloud in its own order.
+double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours, int threads,
+                    const std::vector<int>& tie_rows = {});
+
+/// The lists of a permuted copy of a cloud (copy row j is cloud row p.order[j]) in the cloud's
+/// own rows: row i's list is the copy's list of its row p.position[i], each entry j renamed
+/// p.order[j], in the same order.
+Neighbourhoods unpermuted_neighbours(const Neighbourhoods& copy, const RowPermutation& p,
+                                     int threads);
 
 }  // namespace focal::detail
