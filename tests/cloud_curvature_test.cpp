@@ -6,8 +6,11 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
@@ -175,39 +178,68 @@ AnalyticSurface tied_cloud() {
   return s;
 }
 
-// estimate_cloud_curvature runs the k nearest with the cloud's normals on a copy of the cloud
-// in Morton order (docs/POINTS.md, "Speed and memory"); plan_cloud_curvature then
-// fit_cloud_curvature (the tiles' halves) run on the cloud as it comes. Both must give the same
-// bits and lists: on the tied lattice (ties broken by the cloud's rows, not the copy's), on a
-// pear with 2% outliers, with k = 16 (the outlier tests' own lists) and k = 7, with
-// and without the tests, on 1, 2 and 3 threads.
+// estimate_cloud_curvature runs the default's plan, and the k nearest with the cloud's normals,
+// on a copy of the cloud in Morton order (docs/POINTS.md, "Speed and memory"); plan_cloud_curvature
+// then fit_cloud_curvature (the tiles' halves) run on the cloud as it comes. Both must give the
+// same bits, lists and choices: on the tied lattice (ties broken by the cloud's rows, not the
+// copy's; the MST's too), on a pear with 2% outliers, one with noisy normals (the file's
+// rejected: the MST orients the jets) and one with noisy positions (64 neighbours); with the
+// cloud's normals and without; k = 16 (the outlier tests' own lists), k = 7 and the default,
+// with and without the tests, on 1, 2 and 3 threads.
 TEST(CloudCurvature, SpatialCopyGivesTheBitsOfTheCloudsOwnOrder) {
   CloudSampleOptions pear;
   pear.surface.kind = SurfaceKind::pear;
   pear.surface.target_vertices = 4000;
   pear.outliers = 0.02;
-  for (const AnalyticSurface& s : {tied_cloud(), sample_cloud(pear)}) {
-    for (const CloudOptions& o :
-         {CloudOptions{.k = 16, .threads = 1}, CloudOptions{.k = 16, .threads = 2},
-          CloudOptions{.k = 7, .threads = 3},
-          CloudOptions{.k = 16, .outlier_ratio = 0, .off_surface_ratio = 0, .threads = 2}}) {
-      const std::string what = std::to_string(s.mesh.V.rows()) + " points, k " +
-                               std::to_string(o.k) + ", " + std::to_string(o.threads) +
-                               " threads, tests " + (o.outlier_ratio > 0 ? "on" : "off");
-      const CloudCurvature copy = estimate_cloud_curvature(s.mesh.V, NormalsRef(s.mesh.N), o);
-      CloudCurvature own = plan_cloud_curvature(s.mesh.V, NormalsRef(s.mesh.N), o);
-      fit_cloud_curvature(s.mesh.V, own, o);
-      test::expect_identical(copy.curvature, own.curvature, what);
-      EXPECT_TRUE(same_bits(copy.N, own.N)) << what;
-      EXPECT_EQ(copy.neighbours.offsets, own.neighbours.offsets) << what;
-      EXPECT_EQ(copy.neighbours.indices, own.neighbours.indices) << what;
-      EXPECT_EQ(copy.outlier, own.outlier) << what;
-      EXPECT_EQ(std::memcmp(&copy.spacing, &own.spacing, sizeof(double)), 0) << what;
-      EXPECT_EQ(copy.k, own.k) << what;
-      EXPECT_TRUE(copy.file_normals_used && !copy.normals_estimated) << what;
-      if (o.outlier_ratio > 0) {
-        EXPECT_GT(std::count(copy.outlier.begin(), copy.outlier.end(), 1), 0) << what;
+  CloudSampleOptions bent = pear, noisy = pear;
+  bent.outliers = noisy.outliers = 0.0;
+  bent.normal_noise = 0.3;
+  noisy.position_noise = 0.1;
+  const std::vector<std::pair<std::string, AnalyticSurface>> clouds = {
+      {"lattice", tied_cloud()},
+      {"pear with outliers", sample_cloud(pear)},
+      {"pear with noisy normals", sample_cloud(bent)},
+      {"noisy pear", sample_cloud(noisy)}};
+  const std::vector<CloudOptions> options = {
+      CloudOptions{.threads = 2},
+      CloudOptions{.outlier_ratio = 0, .off_surface_ratio = 0, .threads = 1},
+      CloudOptions{.k = 16, .threads = 1},
+      CloudOptions{.k = 16, .threads = 2},
+      CloudOptions{.k = 7, .threads = 3},
+      CloudOptions{.k = 16, .outlier_ratio = 0, .off_surface_ratio = 0, .threads = 2}};
+  for (const auto& [name, s] : clouds) {
+    for (const bool given : {true, false}) {
+      const std::optional<NormalsRef> N =
+          given ? std::optional<NormalsRef>(s.mesh.N) : std::nullopt;
+      for (const CloudOptions& o : options) {
+        const std::string what = name + (given ? ", normals" : ", no normals") + ", k " +
+                                 std::to_string(o.k) + ", " + std::to_string(o.threads) +
+                                 " threads, tests " + (o.outlier_ratio > 0 ? "on" : "off");
+        const CloudCurvature copy = estimate_cloud_curvature(s.mesh.V, N, o);
+        CloudCurvature own = plan_cloud_curvature(s.mesh.V, N, o);
+        fit_cloud_curvature(s.mesh.V, own, o);
+        test::expect_identical(copy.curvature, own.curvature, what);
+        EXPECT_TRUE(same_bits(copy.N, own.N)) << what;
+        EXPECT_EQ(copy.neighbours.offsets, own.neighbours.offsets) << what;
+        EXPECT_EQ(copy.neighbours.indices, own.neighbours.indices) << what;
+        EXPECT_EQ(copy.outlier, own.outlier) << what;
+        EXPECT_EQ(std::memcmp(&copy.spacing, &own.spacing, sizeof(double)), 0) << what;
+        EXPECT_EQ(std::memcmp(&copy.noise, &own.noise, sizeof(double)), 0) << what;
+        EXPECT_EQ(copy.k, own.k) << what;
+        EXPECT_EQ(copy.file_normals_used, own.file_normals_used) << what;
+        EXPECT_EQ(copy.normals_estimated, own.normals_estimated) << what;
+        EXPECT_EQ(copy.corrected, own.corrected) << what;
+        if (o.outlier_ratio > 0 && name != "noisy pear" && name != "pear with noisy normals") {
+          EXPECT_GT(std::count(copy.outlier.begin(), copy.outlier.end(), 1), 0) << what;
+        }
       }
+      if (!given) continue;
+      // The branches the check is to cover: the file's normals rejected (the MST; the lattice's
+      // tilted normals disagree with its flat planes), 64 neighbours.
+      const CloudCurvature plan = estimate_cloud_curvature(s.mesh.V, N, options[0]);
+      EXPECT_EQ(plan.file_normals_used, name == "pear with outliers" || name == "noisy pear")
+          << name;
+      EXPECT_EQ(plan.k, name == "noisy pear" ? 64 : 16) << name;
     }
   }
 }

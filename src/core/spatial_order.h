@@ -33,6 +33,13 @@ inline constexpr int kPermutationBits = 10;
 /// morton_order(V, threads, kPermutationBits) and its inverse.
 RowPermutation morton_permutation(PositionsRef V, int threads);
 
+/// What work on a cloud's permuted copy needs of the cloud: the permutation (copy row j is row
+/// permutation.order[j] of the cloud) and the cloud's positions in its own order.
+struct CloudCopy {
+  const RowPermutation& permutation;
+  PositionsRef cloud;
+};
+
 /// The rows of M taken in the order `from`: row i of the result is row from[i] of M (a gather:
 /// each output row written once, in parallel). A copy in a permutation's order takes
 /// `order`; the copy's rows back in M's order take `position`.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -195,10 +196,15 @@ RowMatrixX3d with_max_normals(PositionsRef V, RowMatrixX3d jets, const Neighbour
                               double spacing, int threads) {
   std::vector<char> ok, max_ok;
   const RowMatrixX3d J = detail::unit_rows(jets, ok, threads);
-  const detail::NaturalFans fans = detail::natural_fans(V, J, ok, neighbours, threads);
-  const RowMatrixX3d M = detail::unit_rows(
-      detail::vertex_normals_from(V, fans.F, fans.own, NormalWeighting::max, threads), max_ok,
-      threads);
+  RowMatrixX3d max;
+  {
+    // The fans (about 16 bytes a triangle, 9 triangles a point) let go before Max's normals are
+    // made unit: together they were the default's peak of memory.
+    const detail::NaturalFans fans = detail::natural_fans(V, J, ok, neighbours, threads);
+    max = detail::vertex_normals_from(V, fans.F, fans.own, NormalWeighting::max, threads);
+  }
+  const RowMatrixX3d M = detail::unit_rows(max, max_ok, threads);
+  max = RowMatrixX3d();
   CurvatureOptions fit;
   fit.threads = threads;
   const Eigen::VectorXd rj = detail::fit_roughness({V, J, ok, neighbours, spacing}, fit);
@@ -214,33 +220,41 @@ RowMatrixX3d with_max_normals(PositionsRef V, RowMatrixX3d jets, const Neighbour
 }
 
 /// The default's plan (cloud_curvature.h, steps 1-3).
+/// `copy_of`: null, or V and N are a permuted copy of the cloud (in_spatial_order), whose lists
+/// take their ties and the spacing its sum by the cloud's rows, and whose MST runs over the cloud
+/// in its own order.
 CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
-                             const CloudOptions& options) {
+                             const CloudOptions& options,
+                             const detail::CloudCopy* copy_of = nullptr) {
+  static const std::vector<int> own_order;
+  const std::vector<int>& tie_rows = copy_of ? copy_of->permutation.order : own_order;
+  const auto nearest = [&](int k, const std::vector<char>& excluded) {
+    return detail::nearest_neighbours(V, k, excluded, options.threads, tie_rows);
+  };
   CloudCurvature out;
   out.k = default_cloud_neighbours;
   if (tests_on(options)) {
     detail::MeasuredNeighbours nearest16 =
-        detail::measured_nearest_neighbours(V, out.k, {}, options.threads);
-    out.outlier = outlier_flags(V, nearest16, options);
-    out.neighbours = any_flag(out.outlier)
-                         ? nearest_neighbours(V, out.k, out.outlier, options.threads)
-                         : std::move(nearest16.neighbours);
+        detail::measured_nearest_neighbours(V, out.k, {}, options.threads, tie_rows);
+    out.outlier = outlier_flags(V, nearest16, options, tie_rows);
+    out.neighbours =
+        any_flag(out.outlier) ? nearest(out.k, out.outlier) : std::move(nearest16.neighbours);
   } else {
-    out.neighbours = nearest_neighbours(V, out.k, options.threads);
+    out.neighbours = nearest(out.k, {});
   }
-  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads);
+  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads, tie_rows);
   CloudNormalOptions normals = normal_options(options);
   // With the file's normals, the jets start on their side: the noise and the agreement below
   // need no orientation, and the MST (serial) runs only if the file's normals are not used.
   const auto fit_jets = [&] {
-    return N ? detail::cloud_jets_sided(V, out.neighbours, normals, *N)
-             : detail::cloud_jets(V, out.neighbours, normals);
+    return N ? detail::cloud_jets_sided(V, out.neighbours, normals, *N, copy_of)
+             : detail::cloud_jets(V, out.neighbours, normals, copy_of);
   };
   JetNormals jets = fit_jets();
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
   if (out.noise > kNoisyPositions) {
     out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
-    out.neighbours = nearest_neighbours(V, out.k, out.outlier, options.threads);
+    out.neighbours = nearest(out.k, out.outlier);
     normals.jet_degree = 2;
     jets = fit_jets();
   }
@@ -248,9 +262,12 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   // 1e-9 rad: exact normals of an exactly fitted cloud (noise 0) still agree.
   out.file_normals_used = N && (!std::isfinite(out.noise) ||
                                 median_angle(*N, jets.N) <= kFileAgreement * out.noise + 1e-9);
-  if (N && !out.file_normals_used) detail::orient_sided_jets(V, out.neighbours, normals, *N, jets);
+  if (N && !out.file_normals_used) {
+    detail::orient_sided_jets(V, out.neighbours, normals, *N, jets, copy_of);
+  }
   out.normals_estimated = !out.file_normals_used;
   out.N = std::move(jets.N);
+  jets = JetNormals();  // the residuals and degrees let go before Max's normals (the peak)
   if (out.k == default_cloud_neighbours && !out.file_normals_used) {
     out.N = with_max_normals(V, std::move(out.N), out.neighbours, out.spacing, options.threads);
   }
@@ -289,7 +306,11 @@ CloudCurvature plan_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
   return uses_plan(options) ? adaptive_plan(V, N, options) : given_neighbours(V, N, options);
 }
 
-void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions& options) {
+namespace {
+
+/// fit_cloud_curvature; `spatial_rows`: V's rows are in a spatial order already (in_spatial_order's
+/// copy), which the default's later steps then visit them in.
+void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, bool spatial_rows) {
   std::vector<char> ok;
   out.N = detail::unit_rows(out.N, ok, options.threads);
   CurvatureOptions fit;
@@ -309,7 +330,12 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
     // mostly those its predecessors have just read, where a cloud's rows often come in no order
     // (the randomly ordered 1M torus of docs/POINTS.md: their shares of the default's samples
     // 11.6% -> 8.3% and 10.1% -> 8.5%); each point writes its own row only, so no bit changes.
-    const std::vector<int> order = detail::morton_order(V, options.threads);
+    std::vector<int> order(static_cast<std::size_t>(V.rows()));
+    if (spatial_rows) {
+      std::iota(order.begin(), order.end(), 0);
+    } else {
+      order = detail::morton_order(V, options.threads);
+    }
     // The default, as the mesh default on noisy positions: where rays lie far off the fit
     // (a neighbour off the surface, or with a normal bent by one), it is repeated without them
     // (curvature/robust_fit.h; clean fits keep every ray, bit for bit).
@@ -325,12 +351,20 @@ void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions
   }
 }
 
+}  // namespace
+
+void fit_cloud_curvature(PositionsRef V, CloudCurvature& out, const CloudOptions& options) {
+  fit_plan(V, out, options, false);
+}
+
 namespace {
 
-/// The k nearest with the cloud's own normals (`focal curvature --k 16` on a scan with normals):
-/// neither reads anything but each point's and its neighbours' rows.
+/// The default's plan, and the k nearest with the cloud's own normals (`focal curvature --k 16`
+/// on a scan with normals): the steps read each point's and its neighbours' rows, and the one
+/// that does not, the MST, runs over the cloud in its own order. Not the k nearest without
+/// normals (cloud_normals' MST) nor radius neighbourhoods.
 bool runs_in_spatial_order(std::optional<NormalsRef> N, const CloudOptions& o) {
-  return N && o.k > 0 && o.radius == 0.0 && o.adaptive_radius == 0.0;
+  return uses_plan(o) || (N && o.k > 0 && o.radius == 0.0 && o.adaptive_radius == 0.0);
 }
 
 /// M's rows taken in the order `from` (detail::rows_from), in place: one field at a time, so that
@@ -357,13 +391,23 @@ void take_rows(CurvatureResult& r, const std::vector<int>& from, int threads) {
 /// The same bits: every list is that of the cloud's own order renamed, in the
 /// same order (ties by the cloud's rows, detail::nearest_neighbours), and each point's tests
 /// and fit read only its own and its list's rows; mean_spacing sums in the cloud's row order.
-CloudCurvature in_spatial_order(PositionsRef V, NormalsRef N, const CloudOptions& options) {
+CloudCurvature in_spatial_order(PositionsRef V, std::optional<NormalsRef> N,
+                                const CloudOptions& options) {
   const detail::RowPermutation p = detail::morton_permutation(V, options.threads);
   RowMatrixX3d copy = detail::rows_from(V, p.order, options.threads);
-  CloudCurvature c = given_lists(copy, options, p.order);
-  c.file_normals_used = true;
-  c.N = detail::rows_from(N, p.order, options.threads);
-  fit_cloud_curvature(copy, c, options);
+  CloudCurvature c;
+  if (uses_plan(options)) {
+    std::optional<RowMatrixX3d> sided;  // the jets start on the side of N's rows
+    if (N) sided = detail::rows_from(*N, p.order, options.threads);
+    const detail::CloudCopy copy_of{p, V};
+    c = adaptive_plan(copy, sided ? std::optional<NormalsRef>(*sided) : std::nullopt, options,
+                      &copy_of);
+  } else {
+    c = given_lists(copy, options, p.order);
+    c.file_normals_used = true;
+    c.N = detail::rows_from(*N, p.order, options.threads);
+  }
+  fit_plan(copy, c, options, true);
   copy = RowMatrixX3d();
   // Each field's copy is let go as it is taken back: the results are held once, as without the
   // copy, but for the one field in flight (docs/POINTS.md, "Speed and memory").
@@ -384,7 +428,7 @@ CloudCurvature in_spatial_order(PositionsRef V, NormalsRef N, const CloudOptions
 CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef> N,
                                         const CloudOptions& options) {
   validate(V, N, options);
-  if (runs_in_spatial_order(N, options)) return in_spatial_order(V, *N, options);
+  if (runs_in_spatial_order(N, options)) return in_spatial_order(V, N, options);
   CloudCurvature out = plan_cloud_curvature(V, N, options);
   fit_cloud_curvature(V, out, options);
   return out;

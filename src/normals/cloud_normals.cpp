@@ -15,6 +15,7 @@
 #include "focal/normals/jets.h"
 #include "normals/cloud_normals_detail.h"
 #include "normals/jets_detail.h"
+#include "points/neighbours_detail.h"
 
 namespace focal {
 namespace {
@@ -35,20 +36,27 @@ void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* w
 
 /// The neighbour graph made symmetric (j in i's list or i in j's), as CSR, each edge once per
 /// direction, lists sorted. Built in place in one flat array (a vector per point cost 200 bytes
-/// per point more at 1M points); the lists sorted on `threads`.
-Neighbourhoods symmetric(const Neighbourhoods& nb, int threads) {
+/// per point more at 1M points); the lists sorted on `threads`. `rename`: null, or the graph of
+/// the lists with every row and entry r renamed (*rename)[r] (a permuted copy's lists, the
+/// graph of the cloud in its own order, without its own lists held beside the copy's).
+Neighbourhoods symmetric(const Neighbourhoods& nb, int threads,
+                         const std::vector<int>* rename = nullptr) {
   const int n = nb.vertex_count();
+  const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
   std::vector<std::int64_t> start(static_cast<std::size_t>(n) + 1, 0);
-  for (int i = 0; i < n; ++i) {
-    for (const int* j = nb.begin(i); j != nb.end(i); ++j) ++start[i + 1], ++start[*j + 1];
+  for (int r = 0; r < n; ++r) {
+    for (const int* j = nb.begin(r); j != nb.end(r); ++j)
+      ++start[name(r) + 1], ++start[name(*j) + 1];
   }
   for (int i = 0; i < n; ++i) start[i + 1] += start[i];
   std::vector<int> both(static_cast<std::size_t>(start[n]));
   std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-  for (int i = 0; i < n; ++i) {
-    for (const int* j = nb.begin(i); j != nb.end(i); ++j) {
-      both[static_cast<std::size_t>(fill[i]++)] = *j;
-      both[static_cast<std::size_t>(fill[*j]++)] = i;
+  for (int r = 0; r < n; ++r) {
+    const int i = name(r);
+    for (const int* j = nb.begin(r); j != nb.end(r); ++j) {
+      const int k = name(*j);
+      both[static_cast<std::size_t>(fill[i]++)] = k;
+      both[static_cast<std::size_t>(fill[k]++)] = i;
     }
   }
   Neighbourhoods out;
@@ -216,11 +224,10 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
   return detail::orient_normals_mst(V, neighbours, N, 1);
 }
 
-int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                               int threads) {
-  check_sizes(V, neighbours, "orient_normals_mst");
-  if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
-  const Neighbourhoods graph = symmetric(neighbours, threads);
+namespace {
+
+/// orient_normals_mst over the symmetric neighbour graph `graph` of V.
+int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d& N) {
   const auto n = static_cast<int>(V.rows());
   std::vector<char> usable(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) usable[i] = N.row(i).allFinite() && V.row(i).allFinite();
@@ -269,6 +276,25 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   return components;
 }
 
+}  // namespace
+
+int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                               int threads, const CloudCopy* copy_of) {
+  check_sizes(V, neighbours, "orient_normals_mst");
+  if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
+  if (!copy_of) return orient_over_graph(V, symmetric(neighbours, threads), N);
+  // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
+  // from the copy's lists, N taken back (and the copy's N let go meanwhile), the cloud's own
+  // positions.
+  const RowPermutation& p = copy_of->permutation;
+  const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
+  RowMatrixX3d own = detail::rows_from(N, p.position, threads);
+  N = RowMatrixX3d();
+  const int components = orient_over_graph(copy_of->cloud, graph, own);
+  N = detail::rows_from(own, p.order, threads);
+  return components;
+}
+
 void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, RowMatrixX3d& N) {
   if (N.rows() != V.rows()) throw InvalidInput("orient_towards_viewpoint: N does not have #V rows");
   if (!viewpoint.allFinite()) throw InvalidInput("orient_towards_viewpoint: viewpoint not finite");
@@ -294,51 +320,55 @@ bool turned_to_side(const Eigen::RowVector3d& n, NormalsRef side, Eigen::Index i
   return n.dot(side.row(i)) < 0.0;
 }
 
-/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N.
+/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N. `copy_of`
+/// as detail::orient_normals_mst.
 JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
-                           const CloudNormalOptions& options, RowMatrixX3d N) {
+                           const CloudNormalOptions& options, RowMatrixX3d N,
+                           const detail::CloudCopy* copy_of) {
   if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
   const JetOptions jet{
       .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
-  return detail::jet_normals_from(V, neighbours, N, jet);
+  return detail::jet_normals_from(V, neighbours, N, jet, detail::SimdIsa::best,
+                                  copy_of ? &copy_of->permutation.order : nullptr);
 }
 
 }  // namespace
 
 JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                              const CloudNormalOptions& options) {
+                              const CloudNormalOptions& options, const CloudCopy* copy_of) {
   check_jet_options(V, neighbours, options);
   RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
   if (options.viewpoint) {
     orient_towards_viewpoint(V, *options.viewpoint, N);
   } else {
-    detail::orient_normals_mst(V, neighbours, N, options.threads);
+    detail::orient_normals_mst(V, neighbours, N, options.threads, copy_of);
   }
-  return jets_from_start(V, neighbours, options, std::move(N));
+  return jets_from_start(V, neighbours, options, std::move(N), copy_of);
 }
 
 JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
-                                    const CloudNormalOptions& options, NormalsRef side) {
-  if (options.viewpoint) return cloud_jets(V, neighbours, options);
+                                    const CloudNormalOptions& options, NormalsRef side,
+                                    const CloudCopy* copy_of) {
+  if (options.viewpoint) return cloud_jets(V, neighbours, options, copy_of);
   check_jet_options(V, neighbours, options);
   if (side.rows() != V.rows()) throw InvalidInput("cloud_jets_sided: side does not have #V rows");
   RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     if (turned_to_side(N.row(i), side, i)) N.row(i) *= -1.0;
   });
-  return jets_from_start(V, neighbours, options, std::move(N));
+  return jets_from_start(V, neighbours, options, std::move(N), copy_of);
 }
 
 void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                               const CloudNormalOptions& options, NormalsRef side,
-                               JetNormals& jets) {
+                               const CloudNormalOptions& options, NormalsRef side, JetNormals& jets,
+                               const CloudCopy* copy_of) {
   if (options.viewpoint) return;  // cloud_jets_sided was cloud_jets
   // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
   const RowMatrixX3d pca = pca_normals(V, neighbours, options.threads);
   RowMatrixX3d mst = pca;
-  detail::orient_normals_mst(V, neighbours, mst, options.threads);
+  detail::orient_normals_mst(V, neighbours, mst, options.threads, copy_of);
   detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
     // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
     const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();

@@ -2,6 +2,7 @@
 // Internal: cloud_normals with the jets' residuals, for the cloud estimator's plan (the noise of
 // the positions, as the recommended estimator measures it on meshes).
 
+#include "core/spatial_order.h"
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/cloud_normals.h"
@@ -10,26 +11,35 @@
 namespace focal::detail {
 
 /// orient_normals_mst, its neighbour graph built on `threads` (the tree itself is serial).
+/// `copy_of`: null, or V, neighbours and N are a permuted copy of a cloud (copy row j is cloud
+/// row copy_of->order[j]; curvature/cloud_curvature.cpp): the tree is then grown over the cloud
+/// in its own order (taken back for it), whose ties it breaks by row, so that the copy's normals
+/// are turned exactly as the cloud's would be.
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                       int threads);
+                       int threads, const CloudCopy* copy_of = nullptr);
 
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
+/// `copy_of` as orient_normals_mst; each jet's points are then summed in the cloud's order
+/// (jet_normals_from), as they are on the cloud itself.
 /// \throw as cloud_normals.
 JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                      const CloudNormalOptions& options);
+                      const CloudNormalOptions& options, const CloudCopy* copy_of = nullptr);
 
 /// cloud_jets with each starting (PCA) normal turned to the side of its row of `side` instead
 /// of oriented by orient_normals_mst (serial, the plan's one serial step), for a plan that may
 /// only need the jets' residuals and lines: a jet is fitted in the frame of its own start normal,
 /// and a start normal of the other sign gives the same residual and the opposite normal, bit for
-/// bit (docs/POINTS.md, "The default's cost"). With a viewpoint, cloud_jets itself.
+/// bit (docs/POINTS.md, "The default's cost"). With a viewpoint, cloud_jets itself. `copy_of`
+/// as orient_normals_mst (the jets' points summed in the cloud's order: jet_normals_from).
 JetNormals cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
-                            const CloudNormalOptions& options, NormalsRef side);
+                            const CloudNormalOptions& options, NormalsRef side,
+                            const CloudCopy* copy_of = nullptr);
 
 /// Turns the normals of cloud_jets_sided(V, neighbours, options, side) into those of
 /// cloud_jets(V, neighbours, options): runs the orientation it left out and flips the jets
-/// whose start normal it turned the other way.
+/// whose start normal it turned the other way. `copy_of` as orient_normals_mst.
 void orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                       const CloudNormalOptions& options, NormalsRef side, JetNormals& jets);
+                       const CloudNormalOptions& options, NormalsRef side, JetNormals& jets,
+                       const CloudCopy* copy_of = nullptr);
 
 }  // namespace focal::detail

@@ -109,9 +109,11 @@ bool read_marks_in_order(std::vector<int>& ring, std::uint64_t* bits) {
 /// the 1-ring with marks (`in_ring`: one bit per vertex, allocated on first use, #V / 8 bytes: it
 /// stays in cache; set while the vertex is in the neighbourhood being gathered, cleared after
 /// it), then sorted so that the points, and hence the sums of the fit, keep the same order as
-/// when the rings were merged as sorted lists (which cost 3.5 times as much).
+/// when the rings were merged as sorted lists (which cost 3.5 times as much). `sort_rows`: null,
+/// or the vertices are a permuted copy's, sorted by their rows in the cloud (sort_rows[w]) so
+/// that the sums keep the cloud's order (jet_normals_from).
 void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::uint64_t>& in_ring,
-                 std::vector<int>& ring) {
+                 const std::vector<int>* sort_rows, std::vector<int>& ring) {
   if (in_ring.empty()) in_ring.assign(static_cast<std::size_t>(one.vertex_count()) / 64 + 1, 0);
   std::uint64_t* bits = in_ring.data();
   const auto test_and_set = [bits](int w) {
@@ -138,10 +140,16 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::u
     }
     begin = end;
   }
-  if (ring.size() <= cap && read_marks_in_order(ring, bits)) return;
+  if (!sort_rows && ring.size() <= cap && read_marks_in_order(ring, bits)) return;
   for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
   if (ring.size() > cap) ring.resize(1);
-  detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
+  if (sort_rows) {
+    const int* row = sort_rows->data();
+    detail::sort_small(ring.data(), ring.data() + ring.size(),
+                       [row](int a, int b) { return row[a] < row[b]; });
+  } else {
+    detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
+  }
 }
 
 /// A vertex's points: resize() leaves new entries unwritten (gather_points writes them).
@@ -617,7 +625,8 @@ struct JetInput {
   const NormalsRef& start;
   const JetOptions& o;
   TopDegreeKernel kernel;
-  int width;  ///< the kernel's lanes
+  int width;                          ///< the kernel's lanes
+  const std::vector<int>* sort_rows;  ///< gather_ring's
 };
 
 /// b.points of every lane, padded with (0, 0, 0) to b.points_max (JetBatch::points); an idle
@@ -676,7 +685,7 @@ void fit_batch(const JetInput& in, const int* v, int count, JetScratch& s, Local
     if (!lane.alive) continue;
     lane.n = in.start.row(v[l]).transpose();
     lane.alive = lane.n.allFinite();
-    if (lane.alive) gather_ring(in.one, v[l], in.o.rings, s.in_ring, lane.ring);
+    if (lane.alive) gather_ring(in.one, v[l], in.o.rings, s.in_ring, in.sort_rows, lane.ring);
   }
   for (int it = 0; it < in.o.iterations; ++it) {
     for (int l = 0; l < in.width; ++l) {
@@ -743,11 +752,15 @@ void validate_start(PositionsRef V, NormalsRef start) {
 /// lane is computed alone, so neither the batches nor the thread count change a bit.
 template <class Body>
 void for_each_jet(PositionsRef V, const Neighbourhoods& one, NormalsRef start, const JetOptions& o,
-                  const std::vector<int>* vertices, std::optional<SimdIsa> isa, Body&& body) {
+                  const std::vector<int>* vertices, std::optional<SimdIsa> isa, Body&& body,
+                  const std::vector<int>* sort_rows = nullptr) {
   if (one.vertex_count() != V.rows())
     throw InvalidInput("jet_normals: the 1-ring has " + std::to_string(one.vertex_count()) +
                        " vertices, the mesh " + std::to_string(V.rows()));
-  const JetInput in{V, one, start, o, top_degree_kernel(isa, o.degree), batch_width(isa)};
+  if (sort_rows && sort_rows->size() != static_cast<std::size_t>(V.rows()))
+    throw InvalidInput("jet_normals: the rows to sort by are not the mesh's");
+  const JetInput in{V,        one, start, o, top_degree_kernel(isa, o.degree), batch_width(isa),
+                    sort_rows};
   const std::int64_t n = vertices ? static_cast<std::int64_t>(vertices->size()) : V.rows();
   detail::PerThread<JetScratch> scratch(o.threads);
   detail::parallel_for_blocks(
@@ -779,14 +792,16 @@ void store_normal(const LocalJet& jet, Eigen::Index k, JetNormals& out) {
 
 JetNormals collect_normals(PositionsRef V, const Neighbourhoods& one, NormalsRef start,
                            const JetOptions& options, const std::vector<int>* vertices,
-                           std::optional<SimdIsa> isa) {
+                           std::optional<SimdIsa> isa,
+                           const std::vector<int>* sort_rows = nullptr) {
   JetNormals out;
   const Eigen::Index n = vertices ? static_cast<Eigen::Index>(vertices->size()) : V.rows();
   out.N.resize(n, 3);
   out.residual.resize(n);
   out.degree.resize(n);
-  for_each_jet(V, one, start, options, vertices, isa,
-               [&out](std::int64_t k, const LocalJet& jet) { store_normal(jet, k, out); });
+  for_each_jet(
+      V, one, start, options, vertices, isa,
+      [&out](std::int64_t k, const LocalJet& jet) { store_normal(jet, k, out); }, sort_rows);
   return out;
 }
 
@@ -850,9 +865,9 @@ JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_rin
 
 JetNormals detail::jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring,
                                     NormalsRef start, const JetOptions& options,
-                                    std::optional<SimdIsa> isa) {
+                                    std::optional<SimdIsa> isa, const std::vector<int>* sort_rows) {
   validate_options(options);
-  return collect_normals(V, one_ring, start, options, nullptr, isa);
+  return collect_normals(V, one_ring, start, options, nullptr, isa, sort_rows);
 }
 
 Eigen::VectorXd detail::jet_residuals_at(PositionsRef V, const Neighbourhoods& one_ring,

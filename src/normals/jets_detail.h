@@ -15,10 +15,16 @@ namespace focal::detail {
 /// vertex in the frame of `start`, whose rows must be unit or non-finite (not checked: Max's
 /// normals are, by construction). options.threads is used as given. The fits run side by side
 /// in the lanes of `isa`'s kernel (the same bits for every instruction set); std::nullopt: one
-/// vertex at a time, the reference the lanes are tested against.
-/// \throw InvalidInput when an option is out of range or one_ring does not have #V vertices.
+/// vertex at a time, the reference the lanes are tested against. `sort_rows`: null, or V and
+/// one_ring are a permuted copy of a cloud (copy row j is cloud row (*sort_rows)[j]; a cloud's
+/// spatial copy, curvature/cloud_curvature.cpp): each jet's points are then summed in the order
+/// of their rows in the cloud, as the fit of the cloud itself sums them (in ascending index),
+/// so that the copy's jets have the cloud's bits.
+/// \throw InvalidInput when an option is out of range, one_ring does not have #V vertices or
+/// sort_rows does not have #V rows.
 JetNormals jet_normals_from(PositionsRef V, const Neighbourhoods& one_ring, NormalsRef start,
-                            const JetOptions& options, std::optional<SimdIsa> isa = SimdIsa::best);
+                            const JetOptions& options, std::optional<SimdIsa> isa = SimdIsa::best,
+                            const std::vector<int>* sort_rows = nullptr);
 
 /// The residuals (JetNormals::residual) of the jets of the listed vertices only, as
 /// jet_normals_from computes them: for measurements on a sample of the vertices.

@@ -216,6 +216,9 @@ NaturalFans natural_fans(PositionsRef V, const RowMatrixX3d& N, const std::vecto
       }
       out.own.offsets[static_cast<std::size_t>(i) + 1] = static_cast<int>(list.size() - before);
     }
+    // The growth's spare capacity (up to half of all the lists) would be held until F is filled,
+    // at the default's peak of memory.
+    list.shrink_to_fit();
   });
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto v = static_cast<std::size_t>(i);
