@@ -383,6 +383,16 @@ void take_rows(CurvatureResult& r, const std::vector<int>& from, int threads) {
   take_rows(r.rays_excluded, from, threads);
 }
 
+/// adaptive_plan of the cloud V (normals N) run on `copy`, its rows p.order.
+CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, PositionsRef copy,
+                            const detail::RowPermutation& p, const CloudOptions& options) {
+  std::optional<RowMatrixX3d> sided;  // the jets start on the side of N's rows
+  if (N) sided = detail::rows_from(*N, p.order, options.threads);
+  const detail::CloudCopy copy_of{p, V};
+  return adaptive_plan(copy, sided ? std::optional<NormalsRef>(*sided) : std::nullopt, options,
+                       &copy_of);
+}
+
 /// estimate_cloud_curvature on a copy of the cloud in Morton order, its results taken back to the
 /// cloud's rows. The lists, the tests and the fit read each point's neighbours' rows: on a cloud
 /// whose rows come in no spatial order (scanners' and generators' files often do) each read
@@ -397,11 +407,7 @@ CloudCurvature in_spatial_order(PositionsRef V, std::optional<NormalsRef> N,
   RowMatrixX3d copy = detail::rows_from(V, p.order, options.threads);
   CloudCurvature c;
   if (uses_plan(options)) {
-    std::optional<RowMatrixX3d> sided;  // the jets start on the side of N's rows
-    if (N) sided = detail::rows_from(*N, p.order, options.threads);
-    const detail::CloudCopy copy_of{p, V};
-    c = adaptive_plan(copy, sided ? std::optional<NormalsRef>(*sided) : std::nullopt, options,
-                      &copy_of);
+    c = plan_on_copy(V, N, copy, p, options);
   } else {
     c = given_lists(copy, options, p.order);
     c.file_normals_used = true;
@@ -448,14 +454,19 @@ RowMatrixX3d estimate_cloud_normals(PositionsRef V, std::optional<NormalsRef> N,
     }
     return out;
   }
-  CloudCurvature plan = adaptive_plan(V, N, options);
-  if (!plan.file_normals_used) return std::move(plan.N);  // jet normals: unit or NaN rows
+  // The plan on the cloud's copy in Morton order, as estimate_cloud_curvature runs it.
+  const detail::RowPermutation p = detail::morton_permutation(V, options.threads);
+  CloudCurvature plan =
+      plan_on_copy(V, N, detail::rows_from(V, p.order, options.threads), p, options);
+  if (!plan.file_normals_used) {  // jet normals: unit or NaN rows
+    return detail::rows_from(plan.N, p.position, options.threads);
+  }
   std::vector<char> ok;
   RowMatrixX3d out = detail::unit_rows(plan.N, ok, options.threads);
   for (Eigen::Index i = 0; i < out.rows(); ++i) {
     if (!ok[static_cast<std::size_t>(i)]) out.row(i).setConstant(NAN);
   }
-  return out;
+  return detail::rows_from(out, p.position, options.threads);
 }
 
 }  // namespace focal
