@@ -68,11 +68,11 @@ void measure_misfit(const kernels::SlitSolution<double>& w, Rays& s) {
 }  // namespace
 
 bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& tolerances,
-                       CurvatureResult& r) {
+                       CurvatureResult& r, Eigen::Index row) {
   thread_local Rays s;
   const VertexFitInput& f = in.fit;
   if (!f.normal_ok[static_cast<std::size_t>(i)]) {
-    store_undefined(r, i);
+    store_undefined(r, row);
     return false;
   }
   const TangentFrame frame = frame_of(f.unit_normals.row(i).transpose());
@@ -80,7 +80,7 @@ bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& t
   s.weights = s.base;
   kernels::SlitSolution<double> w;
   if (!solve_well_conditioned(accumulate(s.rays, s.weights), w)) {
-    store_undefined(r, i);
+    store_undefined(r, row);
     return false;
   }
   bool rejected = false;
@@ -100,9 +100,9 @@ bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& t
     weight_sum += x;
     used += x > 0.0 ? 1 : 0;
   }
-  r.rays_used[i] = used;
-  r.rays_excluded[i] = f.rings.size(i) - used;
-  store_vertex(r, i, frame, principal_from_symmetric(w.a, w.b, w.c),
+  r.rays_used[row] = used;
+  r.rays_excluded[row] = f.rings.size(i) - used;
+  store_vertex(r, row, frame, principal_from_symmetric(w.a, w.b, w.c),
                std::sqrt(energy_of(s.rays, s.weights, w) / weight_sum), tolerances);
   return rejected;
 }
@@ -110,18 +110,22 @@ bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& t
 void robust_fit_vertices(const RobustFitInput& in, const std::vector<int>& vertices,
                          const ClassTolerances& tolerances, int threads, bool only_rejecting,
                          CurvatureResult& r) {
+  const auto n = static_cast<std::int64_t>(vertices.size());
   if (!only_rejecting) {
-    parallel_for(static_cast<std::int64_t>(vertices.size()), threads, [&](std::int64_t k) {
-      robust_fit_vertex(in, vertices[static_cast<std::size_t>(k)], tolerances, r);
+    parallel_for(n, threads, [&](std::int64_t k) {
+      const int i = vertices[static_cast<std::size_t>(k)];
+      robust_fit_vertex(in, i, tolerances, r, i);
     });
     return;
   }
-  // Fitted into a scratch result; rows copied where rays were rejected.
-  CurvatureResult scratch = unwritten_result(r.k1.size());
-  parallel_for(static_cast<std::int64_t>(vertices.size()), threads, [&](std::int64_t k) {
-    const int i = vertices[static_cast<std::size_t>(k)];
-    if (!robust_fit_vertex(in, i, tolerances, scratch)) return;
-    copy_row(scratch, i, r, i);
+  // Each vertex fitted into a one-row scratch of its block's, the row copied where rays were
+  // rejected (a scratch of every row was a second result's memory, at the cloud default's peak).
+  parallel_for_blocks(n, 256, threads, [&](std::int64_t begin, std::int64_t end) {
+    CurvatureResult one = unwritten_result(1);
+    for (std::int64_t k = begin; k < end; ++k) {
+      const int i = vertices[static_cast<std::size_t>(k)];
+      if (robust_fit_vertex(in, i, tolerances, one, 0)) copy_row(one, 0, r, i);
+    }
   });
 }
 

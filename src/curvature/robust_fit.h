@@ -27,10 +27,10 @@ struct RobustFitInput {
   double gaussian_width;  ///< > 0: Gaussian weights of this width; 0: uniform
 };
 
-/// The robust fit of vertex i into row i of `r` (undefined where no fit is well posed). Returns
-/// whether rays were rejected (otherwise the row is the plain least-squares fit).
+/// The robust fit of vertex i into row `row` of `r` (undefined where no fit is well posed).
+/// Returns whether rays were rejected (otherwise the row is the plain least-squares fit).
 bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& tolerances,
-                       CurvatureResult& r);
+                       CurvatureResult& r, Eigen::Index row);
 
 /// robust_fit_vertex of every listed vertex, in parallel (each row written once); with
 /// `only_rejecting`, rows are written only where rays were rejected (the others keep the fit
