@@ -267,7 +267,7 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   out.normals_estimated = !out.file_normals_used;
   out.N = std::move(jets.N);
-  jets = JetNormals();  // the residuals and degrees let go before Max's normals (the peak)
+  jets = JetNormals();  // the residuals and degrees let go before Max's normals
   if (out.k == default_cloud_neighbours && !out.file_normals_used) {
     out.N = with_max_normals(V, std::move(out.N), out.neighbours, out.spacing, options.threads);
   }
@@ -398,9 +398,11 @@ CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, Positio
 /// whose rows come in no spatial order (scanners' and generators' files often do) each read
 /// is a cache miss, on the copy mostly a hit (the randomly ordered 1M torus of docs/POINTS.md,
 /// `--k 16`, 2 threads: 956-959 ms instead of 1,200-1,206, the copy and the way back included).
-/// The same bits: every list is that of the cloud's own order renamed, in the
-/// same order (ties by the cloud's rows, detail::nearest_neighbours), and each point's tests
-/// and fit read only its own and its list's rows; mean_spacing sums in the cloud's row order.
+/// The same bits (docs/POINTS.md, "The whole cloud in Morton order"): every list is that of the
+/// cloud's own order renamed, in the same order (ties by the cloud's rows,
+/// detail::nearest_neighbours); mean_spacing sums, and the jets sum each neighbourhood, in the
+/// cloud's row order; the MST runs over the cloud in its own order (adaptive_plan's copy_of);
+/// every other step reads a point's own and its list's rows only.
 CloudCurvature in_spatial_order(PositionsRef V, std::optional<NormalsRef> N,
                                 const CloudOptions& options) {
   const detail::RowPermutation p = detail::morton_permutation(V, options.threads);

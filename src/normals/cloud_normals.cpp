@@ -15,7 +15,6 @@
 #include "focal/normals/jets.h"
 #include "normals/cloud_normals_detail.h"
 #include "normals/jets_detail.h"
-#include "points/neighbours_detail.h"
 
 namespace focal {
 namespace {

@@ -12,9 +12,10 @@ namespace focal::detail {
 
 /// orient_normals_mst, its neighbour graph built on `threads` (the tree itself is serial).
 /// `copy_of`: null, or V, neighbours and N are a permuted copy of a cloud (copy row j is cloud
-/// row copy_of->order[j]; curvature/cloud_curvature.cpp): the tree is then grown over the cloud
-/// in its own order (taken back for it), whose ties it breaks by row, so that the copy's normals
-/// are turned exactly as the cloud's would be.
+/// row copy_of->permutation.order[j]; curvature/cloud_curvature.cpp): the tree is then grown over
+/// the cloud in its own order (its positions, its graph renamed from the copy's lists, N taken
+/// back for it), whose ties it breaks by row, so that the copy's normals are turned exactly as
+/// the cloud's would be.
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
                        int threads, const CloudCopy* copy_of = nullptr);
 
