@@ -48,8 +48,6 @@ struct FocalMeshFlags {
 /// A point cloud's fields: the CSV, or the cloud (with the normals used) and its fields as PLY.
 void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
   CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
-  // The lists (64 bytes a point at k = 16) are not written: let go before the writer's buffers.
-  c.neighbours = Neighbourhoods();
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv")
     return write_curvature_csv(f.output, c.curvature, {}, f.csv_options());

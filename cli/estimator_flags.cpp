@@ -374,7 +374,10 @@ TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name
 }
 
 CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags, const Log& log) {
-  const CloudOptions options = flags.cloud_options();
+  CloudOptions options = flags.cloud_options();
+  // No command writes the lists (64 bytes a point at k = 16): not taken back, not held while
+  // the outputs are written.
+  options.keep_neighbours = false;
   CloudCurvature c;
   {
     Stage stage(log, "cloud curvature");

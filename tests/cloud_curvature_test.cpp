@@ -244,6 +244,39 @@ TEST(CloudCurvature, SpatialCopyGivesTheBitsOfTheCloudsOwnOrder) {
   }
 }
 
+// CloudOptions::keep_neighbours = false leaves the lists out and nothing else: on the paths
+// with the spatial copy (the default's plan, k nearest with the cloud's normals) and without it
+// (k nearest without normals, a radius).
+TEST(CloudCurvature, ListsLeftOutChangeNoOtherField) {
+  CloudSampleOptions pear;
+  pear.surface.kind = SurfaceKind::pear;
+  pear.surface.target_vertices = 3000;
+  pear.outliers = 0.02;
+  const AnalyticSurface s = sample_cloud(pear);
+  const std::vector<std::pair<bool, CloudOptions>> cases = {
+      {true, CloudOptions{.threads = 2}},
+      {true, CloudOptions{.k = 16, .threads = 2}},
+      {false, CloudOptions{.k = 7, .threads = 2}},
+      {true, CloudOptions{.radius = 0.2, .threads = 2}}};
+  for (const auto& [given, o] : cases) {
+    const std::optional<NormalsRef> N = given ? std::optional<NormalsRef>(s.mesh.N) : std::nullopt;
+    const std::string what = std::string(given ? "normals" : "no normals") + ", k " +
+                             std::to_string(o.k) + ", radius " + std::to_string(o.radius);
+    const CloudCurvature kept = estimate_cloud_curvature(s.mesh.V, N, o);
+    CloudOptions lean = o;
+    lean.keep_neighbours = false;
+    const CloudCurvature left = estimate_cloud_curvature(s.mesh.V, N, lean);
+    EXPECT_GT(kept.neighbours.indices.size(), 0) << what;
+    EXPECT_EQ(left.neighbours.offsets.size(), 0) << what;
+    EXPECT_EQ(left.neighbours.indices.size(), 0) << what;
+    test::expect_identical(left.curvature, kept.curvature, what);
+    EXPECT_TRUE(same_bits(left.N, kept.N)) << what;
+    EXPECT_EQ(left.outlier, kept.outlier) << what;
+    EXPECT_EQ(std::memcmp(&left.spacing, &kept.spacing, sizeof(double)), 0) << what;
+    EXPECT_EQ(left.k, kept.k) << what;
+  }
+}
+
 TEST(CloudCurvature, UndefinedWhereNoNormalOrNoNeighbours) {
   AnalyticSurface s = test::cloud_of(SurfaceKind::sphere, 500);
   s.mesh.N.row(4).setZero();

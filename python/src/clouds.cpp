@@ -68,6 +68,7 @@ nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N
       cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver, threads);
   o.outlier_ratio = outlier_ratio;
   o.off_surface_ratio = off_surface_ratio;
+  o.keep_neighbours = false;  // not returned
   focal::CloudCurvature c;
   {
     nb::gil_scoped_release release;

@@ -419,7 +419,9 @@ CloudCurvature in_spatial_order(PositionsRef V, std::optional<NormalsRef> N,
   copy = RowMatrixX3d();
   // Each field's copy is let go as it is taken back: the results are held once, as without the
   // copy, but for the one field in flight (docs/POINTS.md, "Speed and memory").
-  c.neighbours = detail::unpermuted_neighbours(c.neighbours, p, options.threads);
+  c.neighbours = options.keep_neighbours
+                     ? detail::unpermuted_neighbours(c.neighbours, p, options.threads)
+                     : Neighbourhoods();
   take_rows(c.curvature, p.position, options.threads);
   take_rows(c.N, p.position, options.threads);
   if (!c.outlier.empty()) {
@@ -439,6 +441,7 @@ CloudCurvature estimate_cloud_curvature(PositionsRef V, std::optional<NormalsRef
   if (runs_in_spatial_order(N, options)) return in_spatial_order(V, N, options);
   CloudCurvature out = plan_cloud_curvature(V, N, options);
   fit_cloud_curvature(V, out, options);
+  if (!options.keep_neighbours) out.neighbours = Neighbourhoods();
   return out;
 }
 

@@ -349,7 +349,9 @@ struct PlaneSums {
   double reach = 0.0;
   int count = 0;
 
-  void add(const Eigen::RowVector3d& q) {
+  void add(const Eigen::RowVector3d& q) { add(q, q.norm()); }
+  /// add(q), with q.norm() computed by the caller (the kNN query needs it too).
+  void add(const Eigen::RowVector3d& q, double norm) {
     sum += q;
     // moment += q^T q, element by element: each element is the same one product and one sum
     // (and q_r q_c = q_c q_r), without the temporary that Eigen stores in halves and reloads
@@ -358,7 +360,7 @@ struct PlaneSums {
     for (int r = 0; r < 3; ++r) {
       for (int c = r; c < 3; ++c) moment(r, c) += q[r] * q[c];
     }
-    reach += q.norm();
+    reach += norm;
     ++count;
   }
   /// The origin's distance to the plane and the points' RMS distance to it; NaN when fewer than
@@ -447,19 +449,17 @@ class NearestQuery {
   void measure(std::size_t p, int self, std::size_t kept, detail::OutlierMeasures& m) const {
     const auto row = static_cast<std::size_t>(self);
     const Eigen::Map<const Eigen::RowVector3d> origin(tree_.point(p));
-    if (kept > 0) {
-      double sum = 0.0;
-      for (std::size_t j = 0; j < kept; ++j) {
-        sum += (Eigen::Map<const Eigen::RowVector3d>(tree_.point(index_[j])) - origin).norm();
-      }
-      m.reach[row] = sum / static_cast<int>(kept);
-    }
+    // Each neighbour's distance once, for both measures (each sums them in list order).
+    double sum = 0.0;
     PlaneSums plane;
     for (std::size_t j = 0; j < kept; ++j) {
       const Eigen::RowVector3d q =
           Eigen::Map<const Eigen::RowVector3d>(tree_.point(index_[j])) - Eigen::RowVector3d(origin);
-      plane.add(q);
+      const double distance = q.norm();
+      sum += distance;
+      plane.add(q, distance);
     }
+    if (kept > 0) m.reach[row] = sum / static_cast<int>(kept);
     const detail::PlaneOffset o = plane.offset();
     m.distance[row] = o.distance;
     m.spread[row] = o.spread;

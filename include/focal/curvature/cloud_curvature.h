@@ -102,6 +102,11 @@ struct CloudOptions {
   /// statistical ones (points/neighbours.h, off_surface_points); 0 = off. See
   /// default_off_surface_ratio.
   double off_surface_ratio = default_off_surface_ratio;
+  /// false: CloudCurvature::neighbours is left empty, for callers that do not read the lists
+  /// (the focal command, Python's cloud_curvature). A cloud fitted on its copy in Morton order
+  /// (above) would otherwise have its lists taken back to its own rows: about 5% of the CPU of
+  /// `--k 16` on a randomly ordered 1M-point cloud (docs/POINTS.md, "Speed and memory").
+  bool keep_neighbours = true;
   int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
 };
 
@@ -110,7 +115,8 @@ struct CloudCurvature {
   CurvatureResult curvature;
   RowMatrixX3d N;                  ///< #V x 3 unit normals used (given or estimated); NaN rows
   bool normals_estimated = false;  ///< true when N was estimated (the cloud had none)
-  Neighbourhoods neighbours;       ///< the neighbourhoods of the fit (and of the normals)
+  Neighbourhoods neighbours;       ///< the neighbourhoods of the fit (and of the normals); empty
+                                   ///< without CloudOptions::keep_neighbours
   double spacing = 0.0;            ///< mean_spacing of the cloud
   /// The default's plan: the median jet residual over the spacing (NaN when not measured), the
   /// neighbours of the fit, and whether the cloud's own normals were used.
