@@ -472,6 +472,21 @@ TEST(MortonOrder, APermutationThatKeepsNeighboursTogether) {
   for (int i = 0; i < V.rows(); ++i) {
     ASSERT_EQ(p.order[static_cast<std::size_t>(p.position[static_cast<std::size_t>(i)])], i);
   }
+  // From 65,536 rows on, each pass of the sort counts and places runs of rows in parallel, one
+  // per thread: the order of one run for any number of them, ties (duplicates far apart in the
+  // rows, so in different runs) by row.
+  RowMatrixX3d big = random_cloud(150000, 5);
+  big.topRows(1000) = big.middleRows(120000, 1000);
+  for (const int bits : {21, 10}) {
+    const std::vector<int> one_run = detail::morton_order(big, 1, bits);
+    for (const int threads : {2, 3, 7}) {
+      EXPECT_EQ(detail::morton_order(big, threads, bits), one_run) << bits << " " << threads;
+    }
+    const auto at = [&](int row) {
+      return std::find(one_run.begin(), one_run.end(), row) - one_run.begin();
+    };
+    EXPECT_EQ(at(120000), at(0) + 1) << bits;
+  }
 }
 
 TEST(Neighbours, RejectInvalidArguments) {
