@@ -45,25 +45,9 @@ struct FocalMeshFlags {
   OutputFlags out;
 };
 
-/// A point cloud's fields: the CSV, or the cloud (with the normals used) and its fields as PLY.
-void run_cloud_curvature(CurvatureFlags& f, Input& input, const Log& log) {
-  CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
-  Stage stage(log, "write");
-  if (lower_extension(f.output) == ".csv")
-    return write_curvature_csv(f.output, c.curvature, {}, f.csv_options());
-  input.mesh.N = std::move(c.N);
-  write_curvature_ply(f.output, input.mesh, c.curvature, f.ply_options());
-}
-
 void run_curvature(CurvatureFlags& f, const Log& log) {
   Input input(f.input, f.estimator, log);
-  if (f.tiles > 0) {
-    const TileEstimate c = run_tiled_estimate(input, f.input, f.estimator, f.tiles, log);
-    Stage stage(log, "write");
-    return write_curvature_csv(f.output, c.curvature, c.crease, f.csv_options());
-  }
-  if (input.cloud) return run_cloud_curvature(f, input, log);
-  Estimate e = run_estimate(input, f.input, f.estimator, log);
+  Estimate e = run_estimate(input, f.estimator, log, f.tiles);
   Stage stage(log, "write");
   if (lower_extension(f.output) == ".csv") {
     write_curvature_csv(f.output, e.curvature, e.crease, f.csv_options());
@@ -80,12 +64,11 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
 FocalMeshes focal_meshes_of(const Input& input, FocalMeshFlags& f, const Log& log) {
   FocalMeshOptions o = f.focal;
   o.threads = f.estimator.threads;
+  const Estimate e = run_estimate(input, f.estimator, log);
   if (input.cloud) {
-    const CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
     Stage stage(log, "focal points");
-    return focal_meshes(input.mesh.V, RowMatrixX3i(0, 3), c.N, c.curvature, o);
+    return focal_meshes(input.mesh.V, RowMatrixX3i(0, 3), *e.N, e.curvature, o);
   }
-  const Estimate e = run_estimate(input, f.input, f.estimator, log);
   Stage stage(log, "focal meshes");
   return focal_meshes(estimated_mesh(input, e), e.curvature, o);
 }

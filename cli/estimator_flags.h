@@ -1,7 +1,7 @@
 #pragma once
-// Options shared by `focal curvature`, `focal focal-mesh` and `focal render`: which estimator runs
-// on which normals (focal/curvature/estimate.h, the library's pipeline), and the stages of a run
-// with their timings and messages.
+// Options shared by `focal curvature`, `focal focal-mesh`, `focal normals` and `focal render`:
+// the flags that choose the estimator and its normals, parsed into the library's EstimateOptions,
+// and the input read and checked once for every stage of a run.
 
 #include <CLI/CLI.hpp>
 #include <optional>
@@ -9,13 +9,13 @@
 #include <vector>
 
 #include "focal/core/mesh.h"
+#include "focal/curvature.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/estimate.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/prepared.h"
-#include "focal/tiles/tiles.h"
 #include "log.h"
 
 namespace focal::cli {
@@ -62,34 +62,23 @@ struct Input {
 
   std::string path;  ///< as given, for messages
   Mesh mesh;
-  /// The file has no faces: a point cloud (`prepared` is then empty; the cloud functions take
-  /// mesh.V and mesh.N).
+  /// The file has no faces: a point cloud.
   bool cloud = false;
-  /// mesh.V, mesh.F and the normals the run uses (the file's, else none).
+  /// mesh.V, mesh.F and the normals the run uses (the file's, else none); a cloud's with its
+  /// normals when it has them.
   std::optional<PreparedMesh> prepared;
   /// check_mesh of `prepared` (also kept in it, where the normals stage reads it again).
   MeshFindings findings;
 };
 
-/// Prepares the normals and runs the estimator the flags select (focal::estimate, in two stages
-/// with their timings and warnings) and with -v prints a summary.
-/// \throw InvalidInput when `--normals file` is asked for and the file has none.
-[[nodiscard]] Estimate run_estimate(const Input& input, const std::string& mesh_name,
-                                    const EstimatorFlags& flags, const Log& log);
-
-/// run_estimate's curvature and crease flags, tile by tile (estimate_tiled, focal/tiles/tiles.h:
-/// the same bits, the memory of the largest tile's estimate in place of the whole mesh's) in
-/// `tiles` tiles of about equal vertex counts; of a point cloud, run_cloud_estimate's curvature
-/// (estimate_cloud_tiled: the plan on the whole cloud, the fit tile by tile). \throw InvalidInput
-/// as run_estimate and run_cloud_estimate.
-[[nodiscard]] TileEstimate run_tiled_estimate(const Input& input, const std::string& mesh_name,
-                                              const EstimatorFlags& flags, int tiles,
-                                              const Log& log);
-
-/// The curvature of a point cloud (cloud_curvature.h) with the flags' options, timed in stages,
-/// with -v a summary. \throw InvalidInput as EstimatorFlags::cloud_options.
-[[nodiscard]] CloudCurvature run_cloud_estimate(const Input& input, const EstimatorFlags& flags,
-                                                const Log& log);
+/// The curvature of the input (a mesh, or a point cloud: EstimatorFlags::cloud_options) with
+/// the estimator the flags select, through focal::curvature (focal/curvature.h): its stages timed
+/// with -v, its warnings on stderr naming the file; in `tiles` tiles of about equal vertex
+/// counts when > 0. With -v a summary of the classes and ranges.
+/// \throw InvalidInput when `--normals file` is asked for and the file has none, or a mesh-only
+/// option is given for a point cloud.
+[[nodiscard]] Estimate run_estimate(const Input& input, const EstimatorFlags& flags, const Log& log,
+                                    int tiles = 0);
 
 /// The mesh the estimate ran on: the input's positions with the estimate's faces and normals.
 /// Views input and e, which must outlive it.

@@ -1,6 +1,8 @@
 #include "log.h"
 
 #include <cstdio>
+#include <memory>
+#include <vector>
 
 namespace focal::cli {
 
@@ -57,6 +59,23 @@ Stage::~Stage() {
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
   std::fprintf(stderr, "  %-22s %9.1f ms\n", (name_ + ":").c_str(), ms);
+}
+
+Execution execution_for(const Log& log, const std::string& name, int threads) {
+  Execution e;
+  e.threads = threads;
+  // Stages begin and end in nesting order, on the calling thread.
+  auto stages = std::make_shared<std::vector<std::unique_ptr<Stage>>>();
+  e.progress = [&log, stages](const Progress& p) {
+    if (p.fraction == 0.0) {
+      stages->push_back(std::make_unique<Stage>(log, std::string(p.stage)));
+    } else if (p.fraction == 1.0 && !stages->empty()) {
+      stages->pop_back();
+    }
+  };
+  e.warning = [&log, name](const std::string& message) { log.warning(name + ": " + message); };
+  e.info = [&log](const std::string& message) { log.info(message); };
+  return e;
 }
 
 }  // namespace focal::cli

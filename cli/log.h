@@ -8,6 +8,8 @@
 #include <string>
 #include <thread>
 
+#include "focal/core/execution.h"
+
 namespace focal::cli {
 
 /// `text` with control characters escaped (a newline as \n, others as \xNN), so that a file name
@@ -49,5 +51,10 @@ class Stage {
   bool done_ = false;
   std::thread watcher_;
 };
+
+/// The library's execution settings that print through `log`: each stage a Stage (timed with
+/// -v), each warning a `Warning: <name>: ...` line, each piece of information a -v line.
+/// The returned callbacks hold a reference to `log`, which must outlive them.
+[[nodiscard]] Execution execution_for(const Log& log, const std::string& name, int threads);
 
 }  // namespace focal::cli

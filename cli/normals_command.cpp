@@ -41,7 +41,7 @@ void run_normals(NormalsFlags& f, const Log& log) {
                   "--off-surface-ratio 0 keep every point) or points without neighbours");
     }
   } else {
-    Estimate e = run_estimate(input, f.input, f.estimator, log);
+    Estimate e = run_estimate(input, f.estimator, log);
     N = e.N ? std::move(*e.N) : input.mesh.N;
     if (e.F) input.mesh.F = std::move(*e.F);
   }

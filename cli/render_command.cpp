@@ -108,7 +108,7 @@ Eigen::VectorXd field_values(const CurvatureResult& c, const std::string& field)
 
 /// The picture of a mesh, with the focal meshes and glyphs the flags ask for.
 Image render_mesh(RenderFlags& f, const Input& input, const Log& log) {
-  const Estimate e = run_estimate(input, f.input, f.estimator, log);
+  const Estimate e = run_estimate(input, f.estimator, log);
   const PreparedMesh mesh = estimated_mesh(input, e);
   const CurvatureResult& fields = e.curvature;
   FieldPictureOptions& p = f.picture;
@@ -128,18 +128,20 @@ Image render_mesh(RenderFlags& f, const Input& input, const Log& log) {
 /// The picture of a point cloud: splats of its points (with the normals used) and, with
 /// --focal-meshes, of its focal points.
 Image render_cloud(RenderFlags& f, const Input& input, const Log& log) {
-  const CloudCurvature c = run_cloud_estimate(input, f.estimator, log);
+  const Estimate e = run_estimate(input, f.estimator, log);
+  const CurvatureResult& fields = e.curvature;
+  const RowMatrixX3d& N = *e.N;
   FieldPictureOptions& p = f.picture;
   const RowMatrixX3i no_faces(0, 3);
   if (f.focal_meshes) {
     Stage stage(log, "focal points");
-    p.focal_meshes = focal_meshes(input.mesh.V, no_faces, c.N, c.curvature,
+    p.focal_meshes = focal_meshes(input.mesh.V, no_faces, N, fields,
                                   {.max_distance = 0.0, .threads = f.estimator.threads});
   }
-  if (f.directions == "d1") p.directions = c.curvature.d1;
-  if (f.directions == "d2") p.directions = c.curvature.d2;
+  if (f.directions == "d1") p.directions = fields.d1;
+  if (f.directions == "d2") p.directions = fields.d2;
   Stage stage(log, "render");
-  return render_field_picture(input.mesh.V, no_faces, c.N, field_values(c.curvature, f.field), p);
+  return render_field_picture(input.mesh.V, no_faces, N, field_values(fields, f.field), p);
 }
 
 void run_render(RenderFlags& f, const Log& log) {

@@ -11,17 +11,21 @@ import sys
 
 # Lowest first: a folder may include itself and the folders before it.
 LAYERS = ["core", "kernels", "io", "mesh", "points", "normals", "curvature", "tiles", "cuda",
-          "image_space", "surfaces", "evaluation", "render"]
+          "image_space", "surfaces", "evaluation", "render", "front"]
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
 include = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 
 def folder_of(path: str):
-    """The layer of an include path ("focal/mesh/check.h", "curvature/detail.h") or a file."""
+    """The layer of an include path ("focal/mesh/check.h", "curvature/detail.h") or a file.
+    The public headers at the top of include/focal (the front door, focal/curvature.h) are the
+    top layer, "front"."""
     parts = pathlib.PurePosixPath(path).parts
     if parts and parts[0] == "focal":
         parts = parts[1:]
+        if len(parts) == 1 and parts[0].endswith(".h"):
+            return "front"
     return parts[0] if parts and parts[0] in LAYERS else None
 
 
@@ -32,7 +36,8 @@ for base in (root / "src", root / "include" / "focal"):
             continue
         if path == root / "include" / "focal" / "focal.h":
             continue  # the one header that includes everything
-        own = folder_of(str(path.relative_to(base)))
+        relative = str(path.relative_to(base))
+        own = folder_of("focal/" + relative if base.name == "focal" else relative)
         if own is None:
             print(f"{path.relative_to(root)}: not in a layer folder")
             upward += 1

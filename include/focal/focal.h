@@ -4,7 +4,9 @@
 
 // In the order of the data flow (README, Layout): the data model, files, the mesh and its
 // normals, curvature, the device backends, the image-space estimator, test surfaces, evaluation.
+#include "focal/curvature.h"  // the front door
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/core/mesh.h"
 #include "focal/core/edge_lengths.h"
 #include "focal/core/fields.h"

@@ -35,4 +35,10 @@ class DeviceError : public Error {
   using Error::Error;
 };
 
+/// The caller asked a call to stop (Execution::cancel); nothing it would have returned exists.
+class Cancelled : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace focal

@@ -24,10 +24,14 @@
 /// Deterministic for any thread count, like the functions it calls.
 
 #include <cmath>
+#include <cstdint>
 #include <optional>
+#include <vector>
 
+#include "focal/core/execution.h"
 #include "focal/core/fields.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/cloud_curvature.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/recommended.h"
 #include "focal/mesh/prepared.h"
@@ -37,6 +41,20 @@ namespace focal {
 enum class Estimator {
   recommended,  ///< estimate_curvature_recommended (recommended.h): what `focal curvature` runs
   paper,        ///< estimate_curvature (curvature.h), the paper's method, per vertex or triangle
+  // The estimators of the literature (baselines.h), for comparison; meshes only, on the CPU,
+  // without tiles. Each reads the tolerances (and CSM03 the rings) of EstimateOptions::paper.
+  meyer_2003,                 ///< MDSB03: cotangent Laplacian and angle defect
+  cohen_steiner_morvan_2003,  ///< CSM03: normal cycle
+  lachaud_2020,               ///< LRTC20: interpolated corrected curvature measures
+  yang_2006,                  ///< YLHP06: integral invariants
+  grinspun_2006,              ///< GGRZ06: mid-edge shape operator
+};
+
+/// Where the estimate runs. The CPU is the reference; the device runs the paper's estimator in
+/// float32 (focal/cuda/curvature.h) and throws DeviceError where there is none.
+enum class Device {
+  cpu,
+  cuda,
 };
 
 /// Where the estimator's normals come from.
@@ -56,10 +74,19 @@ struct EstimateOptions {
   CurvatureOptions paper{};
   /// Estimator::recommended: its options.
   RecommendedOptions recommended{};
+  /// Point clouds (an input without faces): their options (the adaptive default by default).
+  CloudOptions cloud{};
+  Device device = Device::cpu;
+  /// > 0: the estimate in spatial tiles of at most this many owned vertices (or points), one
+  /// after the other (focal/tiles/tiles.h): the same bits, the memory of one tile's estimate.
+  int tile_vertices = 0;
   /// Whether prepare_normals reverses the faces of closed components oriented inward (when the
   /// normals do not come from the mesh). false: the faces are taken as they are, e.g. a tile's,
   /// cut from the faces that MeshWideChoices::F oriented over the whole mesh.
   bool orient_faces = true;
+  /// Threads, progress, messages and cancellation of focal::curvature (focal/curvature.h); its
+  /// threads are those of every step whose own option is 0.
+  Execution execution{};
 };
 
 /// The rings around a vertex whose positions, faces and normals its estimate reads: a part of a
@@ -119,6 +146,17 @@ struct PreparedNormals {
 [[nodiscard]] PreparedNormals prepare_normals(const PreparedMesh& mesh,
                                               const EstimateOptions& options = {});
 
+/// What the estimate of a point cloud chose (cloud_curvature.h, CloudCurvature).
+struct CloudPlan {
+  bool normals_estimated = false;  ///< the cloud had no normals: they were estimated
+  double spacing = 0.0;            ///< mean_spacing of the cloud
+  double noise = NAN;              ///< the default's median jet residual over the spacing
+  int k = 0;                       ///< neighbours of the fit
+  bool corrected = false;          ///< the default's corrected step ran
+  /// #V flags of the points left out as outliers (empty when no outlier test ran).
+  std::vector<char> outlier;
+};
+
 /// The fields and what produced them.
 struct Estimate {
   CurvatureResult curvature;
@@ -138,6 +176,16 @@ struct Estimate {
   /// Estimator::recommended: #V flags, 1 at crease vertices (RecommendedResult::crease; all 0
   /// where it did not look for creases: noisy positions, crease_angle 0). Empty for the paper's.
   VectorXu8 crease;
+  /// Point clouds (focal::curvature on an input without faces): what the cloud estimate chose.
+  std::optional<CloudPlan> cloud;
+  /// Vertices (or points) without an estimate: class undefined, NaN in every field.
+  std::int64_t undefined_count = 0;
+  /// Vertices with more than kMaxNeighbourhoodSize vertices within `crowded_rings` rings (the
+  /// widest neighbourhood the estimate gathered): undefined, or for the recommended estimator on
+  /// clean positions fitted over their 1-ring on Max's normals. Counted by focal::curvature
+  /// where it can matter (some vertex undefined, or the recommended 1-ring path).
+  std::int64_t crowded_count = 0;
+  int crowded_rings = 0;
 };
 
 /// Step 2: the estimator on `normals` (from prepare_normals for the same mesh and options),

@@ -120,9 +120,9 @@ struct RecommendedOptions {
   /// max |curvature|) turn between neighbours on smooth surfaces.
   double crease_angle = 1.0471975511965976;  // 60 degrees
   /// Classes, as CurvatureOptions: |k| x mean edge length <= zero_tolerance is zero ...
-  double zero_tolerance = 1e-3;
+  double zero_tolerance = default_zero_tolerance;
   /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
-  double umbilic_tolerance = 1e-2;
+  double umbilic_tolerance = default_umbilic_tolerance;
   /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
   /// PrepareOptions::threads.
   int threads = 0;
