@@ -14,8 +14,10 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from . import Curvature, InvalidInputError, _as_rows, _shape_error, _threads
 from . import _focal_ext as _ext
+from ._errors import InvalidInputError
+from ._inputs import _as_rows, _shape_error, _threads
+from ._results import Curvature
 
 
 def _cloud_arguments(

@@ -1,17 +1,19 @@
 """Streaming input of a tiled run: a binary PLY mesh read in chunks, so that no process holds
 the whole mesh (docs/SCALE.md, "Streaming input").
 
-The file's vertex and face records are memory-mapped (fixed-size records: triangles only) and
-read a chunk at a time; the operating system's page cache, not the process, holds what is read.
+The file's vertex and face records (fixed-size records: triangles only) are read a chunk or a
+set of ids at a time by the library's reader (focal::PlyTriangleReader, focal/io/mesh_io.h),
+which parses the header as focal.read_mesh does.
 
 - **Plan** (the driver, ``plan``): pass 1 over the vertices finds the box of the finite ones;
-  pass 2 counts the vertices per cell of a coarse Morton grid (``MORTON_BITS`` per axis) and
-  cuts the cells, in Morton order, into runs of about ``tile_vertices`` vertices: a vertex's
-  tile is a function of its position (``TileMap``), nothing per vertex is kept; pass 2 also
-  writes each tile's owned vertex ids to a file. Pass 3 over the faces, in whole blocks of
-  ``_focal_ext.edge_length_block()`` faces, writes each face (its id and corners) to the face file
-  of every tile owning one of its corners, and adds up the edge lengths per block, added in
-  block order as ``mean_edge_length`` does: the whole mesh's mean edge length, bit for bit.
+  pass 2 counts the vertices per cell of the library's coarse Morton grid and cuts the cells,
+  in Morton order, into runs of about ``tile_vertices`` vertices (tiles.h, "Streamed tiles"):
+  a vertex's tile is a function of its position (focal::tile_grid_tiles), nothing per vertex is
+  kept; pass 2 also writes each tile's owned vertex ids to a file. Pass 3 over the faces, in
+  whole blocks of ``_focal_ext.edge_length_block()`` faces, writes each face (its id and
+  corners) to the face file of every tile owning one of its corners, and adds up the edge
+  lengths per block, added in block order as ``mean_edge_length`` does: the whole mesh's mean
+  edge length, bit for bit.
 - **Choices** (the recommended estimator: a task per tile, ``tile_statistics``, then the driver,
   ``choose``): each tile's share of the whole mesh's choices (focal::tile_statistics, a halo of
   ``statistics_reach()`` rings), its per-vertex values in a file; the driver takes the exact
@@ -24,8 +26,8 @@ read a chunk at a time; the operating system's page cache, not the process, hold
   sorted by global id, are read from the file and estimated with the whole mesh's choices; the
   owned rows are written to a part file (.npz, or .csv by focal.write_fields).
 
-Memory: the driver holds the cell counts (8 bytes x 2^(3 x MORTON_BITS) = 16 MB), the cell ->
-tile table and one chunk; a worker holds one tile with its halo, its face files' records and
+Memory: the driver holds the cell counts (8 bytes x 2^21 cells = 16 MB), the cell -> tile table
+and one chunk; a worker holds one tile with its halo, its face files' records and
 one neighbouring tile's face file at a time (16 bytes per face record), and ids_in's bitmap
 (at most vertex count / 8 bytes).
 
@@ -47,174 +49,24 @@ import numpy as np
 import focal
 from focal import _focal_ext as _ext
 
-__all__ = ["PlyMesh", "TileMap", "plan", "estimate_tile", "concatenate"]
-
-#: Bits per axis of the coarse Morton grid of the tiles: 2^21 cells.
-MORTON_BITS = 7
+__all__ = ["plan", "estimate_tile", "concatenate"]
 
 #: Vertices or faces per chunk of a streamed pass.
 CHUNK = 1 << 20
-
-_PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
-    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
-}
 
 #: The per-vertex fields of focal.Curvature that tiles write back.
 FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_used",
           "rays_excluded")
 
 
-class PlyMesh:
-    """A binary PLY triangle mesh, memory-mapped: vertex records (x, y, z, optionally nx, ny, nz)
-    and face records (a list of 3 corners), read by ranges or ids, never all at once."""
-
-    def __init__(self, path: "str | os.PathLike"):
-        self.path = os.fspath(path)
-        try:
-            with open(self.path, "rb") as f:
-                header, offset = _read_header(f, self.path)
-        except focal.FocalIOError:
-            raise
-        except OSError as e:  # not found, not readable
-            raise focal.FocalIOError(f"{self.path}: {e.strerror}") from e
-        fmt, elements = header
-        order = "<" if fmt == "binary_little_endian" else ">"
-        self.vertex_count, self.face_count = 0, 0
-        vdtype = fdtype = None
-        for name, count, props in elements:
-            if name == "vertex":
-                vdtype = self._vertex_dtype(props, order)
-                voffset, self.vertex_count = offset, count
-                offset += count * vdtype.itemsize
-            elif name == "face":
-                fdtype = self._face_dtype(props, order)
-                foffset, self.face_count = offset, count
-                offset += count * fdtype.itemsize
-            elif all(p[0] != "list" for p in props) and vdtype is not None and fdtype is not None:
-                break  # trailing fixed-size elements: not read
-            else:
-                raise focal.FocalIOError(
-                    f"{self.path}: element '{name}' before the faces: streaming reads files "
-                    "with the vertex element, then the face element")
-        if vdtype is None or fdtype is None:
-            raise focal.FocalIOError(f"{self.path}: needs a vertex and a face element")
-        size = os.path.getsize(self.path)
-        if size < offset:
-            raise focal.FocalIOError(
-                f"{self.path}: {size} bytes, the header's elements need {offset} (truncated, "
-                "or faces that are not all triangles)")
-        self._vertex_map = (vdtype, voffset, (self.vertex_count,))
-        self._face_map = (fdtype, foffset, (self.face_count,))
-        self.has_normals = "nx" in vdtype.names
-
-    # Mapped afresh for each read and unmapped after it: the pages read stay in the page cache,
-    # not in this process's resident memory.
-    @property
-    def vertices(self) -> np.memmap:
-        return np.memmap(self.path, self._vertex_map[0], "r", *self._vertex_map[1:])
-
-    @property
-    def faces(self) -> np.memmap:
-        return np.memmap(self.path, self._face_map[0], "r", *self._face_map[1:])
-
-    def _vertex_dtype(self, props, order):
-        fields = []
-        for p in props:
-            if p[0] == "list":
-                raise focal.FocalIOError(f"{self.path}: vertex property '{p[-1]}' is a list")
-            fields.append((p[1], order + p[0]))
-        names = [f[0] for f in fields]
-        for axis in ("x", "y", "z"):
-            if axis not in names:
-                raise focal.FocalIOError(f"{self.path}: the vertex element has no '{axis}'")
-        normals = [n in names for n in ("nx", "ny", "nz")]
-        if any(normals) and not all(normals):
-            raise focal.FocalIOError(f"{self.path}: the vertex normals need nx, ny and nz")
-        return np.dtype(fields)
-
-    def _face_dtype(self, props, order):
-        fields, lists = [], 0
-        for p in props:
-            if p[0] == "list":
-                if p[3] not in ("vertex_indices", "vertex_index"):
-                    raise focal.FocalIOError(f"{self.path}: face list '{p[3]}' is not read")
-                lists += 1
-                fields += [("count", order + p[1]), ("corners", order + p[2], (3,))]
-            else:
-                fields.append((p[1], order + p[0]))
-        if lists != 1:
-            raise focal.FocalIOError(f"{self.path}: the face element needs one vertex_indices")
-        return np.dtype(fields)
-
-    def positions(self, rows: Any) -> np.ndarray:
-        """(n, 3) float64 positions of `rows` (a slice or ascending ids)."""
-        r = self.vertices[rows]
-        return np.column_stack([r["x"], r["y"], r["z"]]).astype(np.float64)
-
-    def normals(self, rows: Any) -> Optional[np.ndarray]:
-        if not self.has_normals:
-            return None
-        r = self.vertices[rows]
-        return np.column_stack([r["nx"], r["ny"], r["nz"]]).astype(np.float64)
-
-    def corners(self, begin: int, end: int) -> np.ndarray:
-        """(end - begin, 3) int32 corners of faces begin .. end - 1, checked: triangles, in
-        range. \\raise FocalIOError naming the first bad face."""
-        r = self.faces[begin:end]
-        bad = np.flatnonzero(r["count"] != 3)
-        if bad.size:
-            f = begin + int(bad[0])
-            raise focal.FocalIOError(
-                f"{self.path}: face {f} has {int(r['count'][bad[0]])} corners: streaming reads "
-                "triangle meshes only (fixed-size face records)")
-        c = np.ascontiguousarray(r["corners"], dtype=np.int64)
-        out_of_range = np.flatnonzero(((c < 0) | (c >= self.vertex_count)).any(axis=1))
-        if out_of_range.size:
-            f = begin + int(out_of_range[0])
-            raise focal.FocalIOError(
-                f"{self.path}: face {f} refers to vertex {c[out_of_range[0]].tolist()}, but "
-                f"there are {self.vertex_count} vertices")
-        return c.astype(np.int32)
+def _open(path: "str | os.PathLike"):
+    """The mesh file's reader (focal::PlyTriangleReader): its header read and checked, the
+    records read by ranges or ids, never all at once."""
+    return _ext.PlyTriangleReader(os.fspath(path))
 
 
-def _read_header(f, path: str):
-    line = f.readline()
-    if line.strip() != b"ply":
-        raise focal.FocalIOError(f"{path}: not a PLY file")
-    fmt, elements = None, []
-    while True:
-        line = f.readline()
-        if not line:
-            raise focal.FocalIOError(f"{path}: the header has no end_header")
-        words = line.decode("ascii", "replace").split()
-        if not words or words[0] in ("comment", "obj_info"):
-            continue
-        if words[0] == "end_header":
-            return (fmt, elements), f.tell()
-        if words[0] == "format":
-            fmt = words[1]
-            if fmt not in ("binary_little_endian", "binary_big_endian"):
-                raise focal.FocalIOError(
-                    f"{path}: format {fmt}: streaming reads binary PLY only (focal.read_mesh "
-                    "reads ascii)")
-        elif words[0] == "element":
-            elements.append((words[1], int(words[2]), []))
-        elif words[0] == "property" and elements:
-            if words[1] == "list":
-                types = [_ply_type(w, path) for w in words[2:4]]
-                elements[-1][2].append(("list", *types, words[4]))
-            else:
-                elements[-1][2].append((_ply_type(words[1], path), words[2]))
-        else:
-            raise focal.FocalIOError(f"{path}: header line not understood: {line!r}")
-
-
-def _ply_type(name: str, path: str) -> str:
-    if name not in _PLY_TYPES:
-        raise focal.FocalIOError(f"{path}: unknown PLY type '{name}'")
-    return _PLY_TYPES[name]
+def _ids(x: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(x, np.int32).reshape(-1)
 
 
 def _ranges(n: int, step: int) -> Iterator[tuple]:
@@ -222,32 +74,18 @@ def _ranges(n: int, step: int) -> Iterator[tuple]:
         yield begin, min(n, begin + step)
 
 
-class TileMap:
-    """Vertex position -> tile: the coarse Morton cell of the position in the box of the finite
-    vertices, then the cell's tile; non-finite positions are in the last cell."""
+class _Grid:
+    """Vertex position -> tile (focal::tile_grid_tiles, tiles.h "Streamed tiles"): the grid over
+    the box of the finite vertices and each cell's tile."""
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, cell_tile: np.ndarray):
-        self.lo, self.hi, self.cell_tile = lo, hi, cell_tile
-
-    @staticmethod
-    def cells(P: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        side = 1 << MORTON_BITS
-        extent = np.where(hi > lo, hi - lo, 1.0)
-        with np.errstate(invalid="ignore"):
-            t = np.clip((P - lo) / extent, 0.0, 1.0)
-        finite = np.isfinite(P).all(axis=1)
-        ijk = np.minimum((np.nan_to_num(t) * side).astype(np.int64), side - 1)
-        spread = np.zeros(side, np.int64)
-        for b in range(MORTON_BITS):
-            spread |= ((np.arange(side) >> b) & 1) << (3 * b)
-        code = spread[ijk[:, 0]] | spread[ijk[:, 1]] << 1 | spread[ijk[:, 2]] << 2
-        return np.where(finite, code, side ** 3)
+    def __init__(self, lo: Any, hi: Any, cell_tile: np.ndarray, threads: int):
+        self.lo, self.hi, self.cell_tile, self.threads = list(lo), list(hi), cell_tile, threads
 
     def tiles(self, P: np.ndarray) -> np.ndarray:
-        return self.cell_tile[self.cells(P, self.lo, self.hi)]
+        return _ext.tile_grid_tiles(P, self.lo, self.hi, self.cell_tile, self.threads)
 
 
-def _uniform_options(options: dict, mesh: PlyMesh) -> None:
+def _uniform_options(options: dict, mesh: Any) -> None:
     if options["normals"] not in ("auto", "file") or not mesh.has_normals:
         raise focal.InvalidInputError(
             f"{mesh.path}: streaming input needs the file's normals (nx, ny, nz): normals "
@@ -259,45 +97,36 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
     """The plan of a streamed tiled run, its files written under `workdir`: see the module's
     docstring. `options` as focal._estimate_options gives them. Returns the plan (a dict that
     the tile tasks take, small)."""
-    mesh = PlyMesh(path)
+    mesh = _open(path)
     _uniform_options(options, mesh)
     if int(tile_vertices) < 1:
         raise focal.InvalidInputError(f"tile_vertices must be >= 1, got {tile_vertices}")
     if mesh.vertex_count == 0:
         raise focal.FocalIOError(f"{mesh.path}: no vertices, nothing to compute")
     os.makedirs(workdir, exist_ok=True)
-    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    threads = options["threads"]
+    lo, hi = [np.inf] * 3, [-np.inf] * 3
     for b, e in _ranges(mesh.vertex_count, CHUNK):
-        P = mesh.positions(slice(b, e))
-        P = P[np.isfinite(P).all(axis=1)]
-        if len(P):
-            lo, hi = np.minimum(lo, P.min(axis=0)), np.maximum(hi, P.max(axis=0))
-    counts = np.zeros((1 << 3 * MORTON_BITS) + 1, np.int64)
+        lo, hi = _ext.tile_grid_box(mesh.positions(b, e), lo, hi)
+    counts = np.zeros(_ext.tile_grid_cell_count(), np.int64)
     for b, e in _ranges(mesh.vertex_count, CHUNK):
-        counts += np.bincount(TileMap.cells(mesh.positions(slice(b, e)), lo, hi),
+        counts += np.bincount(_ext.tile_grid_cells(mesh.positions(b, e), lo, hi, threads),
                               minlength=counts.size)
-    # Cells in Morton order, cut into runs of about tile_vertices vertices (a cell is not cut).
-    # Tiles numbered densely over the cells that hold vertices (an empty cell maps nowhere).
-    before = np.cumsum(counts) - counts
-    full = counts > 0
-    _, dense = np.unique(before[full] // int(tile_vertices), return_inverse=True)
-    cell_tile = np.zeros(counts.size, np.int32)
-    cell_tile[full] = dense
-    tiles = TileMap(lo, hi, cell_tile)
-    tile_count = int(dense.max()) + 1
-    np.save(os.path.join(workdir, "cell_tile.npy"), tiles.cell_tile)
+    cell_tile, tile_count = _ext.cut_tile_grid(counts, int(tile_vertices))
+    tiles = _Grid(lo, hi, cell_tile, threads)
+    np.save(os.path.join(workdir, "cell_tile.npy"), cell_tile)
     for t in range(tile_count):
         for kind in ("vertices", "faces"):
             open(_tile_file(workdir, kind, t), "wb").close()
     for b, e in _ranges(mesh.vertex_count, CHUNK):
-        _append_grouped(workdir, "vertices", tiles.tiles(mesh.positions(slice(b, e))),
+        _append_grouped(workdir, "vertices", tiles.tiles(mesh.positions(b, e)),
                         np.arange(b, e, dtype=np.int32)[:, None])
     block = int(_ext.edge_length_block())
     edge_sum, edge_count = 0.0, 0
     for b, e in _ranges(mesh.face_count, block * max(1, CHUNK // block)):
-        C = mesh.corners(b, e)
+        C = mesh.faces(b, e)
         ids, local = np.unique(C, return_inverse=True)
-        P = mesh.positions(ids)
+        P = mesh.positions(_ids(ids))
         sums, n = _ext.edge_length_sums(P, local.reshape(-1, 3).astype(np.int32), 1)
         for s, k in zip(sums.tolist(), n.tolist()):  # in block order, as mean_edge_length
             edge_sum += s
@@ -313,7 +142,7 @@ def plan(path: "str | os.PathLike", workdir: str, options: dict, tile_vertices: 
     out = {
         "path": os.path.abspath(mesh.path), "workdir": os.path.abspath(workdir),
         "vertex_count": mesh.vertex_count, "face_count": mesh.face_count,
-        "tile_count": tile_count, "lo": lo.tolist(), "hi": hi.tolist(),
+        "tile_count": tile_count, "lo": list(lo), "hi": list(hi),
         "choices": {"mean_edge_length": mean_edge}, "options": options,
         # The recommended estimator's reach depends on its whole-mesh choices (choose()).
         "halo_rings": (None if options["estimator"] == "recommended"
@@ -465,9 +294,9 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     within one ring less, sorted by global id (as partition_mesh and extract_tile give them)."""
     halo_rings = p["halo_rings"] if halo_rings is None else halo_rings
     threads = p["options"]["threads"]
-    mesh = PlyMesh(p["path"])
-    tiles = TileMap(np.array(p["lo"]), np.array(p["hi"]),
-                    np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"))
+    mesh = _open(p["path"])
+    tiles = _Grid(p["lo"], p["hi"],
+                  np.load(os.path.join(p["workdir"], "cell_tile.npy"), mmap_mode="r"), threads)
     owned = np.sort(_tile_records(p["workdir"], "vertices", t, 1)[:, 0])
     reached, frontier = owned, owned
     taken = [np.empty((0, 4), np.int32)]
@@ -476,7 +305,7 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
         if frontier.size == 0:
             break
         found = []
-        for u in _distinct(tiles.tiles(mesh.positions(frontier))):
+        for u in _distinct(tiles.tiles(mesh.positions(_ids(frontier)))):
             r = _tile_records(p["workdir"], "faces", int(u), 4)
             if u != t or taken_ids.size:  # else: every face of t's file has an owned corner
                 m = _member(r[:, 1:], frontier, threads)
@@ -494,7 +323,8 @@ def tile_arrays(p: dict, t: int, halo_rings: Optional[int] = None) -> dict:
     faces = np.concatenate(taken)
     faces = faces[np.argsort(faces[:, 0], kind="stable")]
     return {
-        "V": mesh.positions(reached), "N": mesh.normals(reached),
+        "V": mesh.positions(_ids(reached)),
+        "N": mesh.normals(_ids(reached)) if mesh.has_normals else None,
         "F": np.searchsorted(reached, faces[:, 1:]).astype(np.int32),
         "vertices": np.ascontiguousarray(reached, np.int32), "faces": faces[:, 0],
         "owned": np.searchsorted(reached, owned).astype(np.int32),

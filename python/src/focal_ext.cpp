@@ -9,7 +9,7 @@
 //
 // One file per area, each with one bind_* function called here: meshes.cpp (curvature, focal
 // meshes, checks, normals, files, analytic surfaces), render.cpp, image_space.cpp, tiles.cpp
-// (focal/tiles for focal.distributed).
+// (focal/tiles for focal.distributed), streaming.cpp (focal.stream's PLY reader and tile grid).
 // Nothing in src/ includes these files: the bindings are the top layer.
 
 #include <nanobind/nanobind.h>
@@ -24,6 +24,7 @@ void bind_render(nb::module_& m);
 void bind_image_space(nb::module_& m);
 void bind_tiles(nb::module_& m);
 void bind_clouds(nb::module_& m);
+void bind_streaming(nb::module_& m);
 }  // namespace focal_python
 
 namespace {
@@ -68,4 +69,5 @@ NB_MODULE(_focal_ext, m) {
   focal_python::bind_image_space(m);
   focal_python::bind_tiles(m);
   focal_python::bind_clouds(m);
+  focal_python::bind_streaming(m);
 }

@@ -22,7 +22,9 @@
 /// Numbers are written in the shortest form that reads back exactly (doubles round-trip bit for
 /// bit through PLY, OBJ and OFF), or, with Precision::float32, as floats.
 
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -66,6 +68,51 @@ struct ReadOptions {
 /// socket) or an unreadable path; InvalidInput for negative threads or a negative or non-finite
 /// weld_tolerance.
 [[nodiscard]] Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
+
+/// A binary PLY triangle mesh read a range or a set of records at a time, never whole: the input
+/// of a tiled run on a mesh larger than memory (python/focal/stream.py). The values are those
+/// read_mesh reads (x y z, and nx ny nz or PCL's normal_x normal_y normal_z, as doubles). Each
+/// read opens the file, reads what it asks for in blocks of at most a megabyte and closes it: the
+/// reader holds the header's layout only.
+/// \pre A binary PLY file (either byte order) whose vertex and face records have a fixed size: the
+/// vertex element has no list property, the face element one, its vertex_indices, of 3 items in
+/// every face. Other elements before those two have a fixed size; a `tristrips` element is not
+/// read, so it is refused.
+class PlyTriangleReader {
+ public:
+  /// Reads and checks the header and the file's size.
+  /// \throw IoError naming the file: missing or not a regular file, not PLY, ascii, no vertex or
+  /// face element, records of varying size, more than 2^31 - 1 vertices or faces, or fewer bytes
+  /// than the header's records need.
+  explicit PlyTriangleReader(const std::filesystem::path& path);
+
+  [[nodiscard]] const std::filesystem::path& path() const;
+  [[nodiscard]] std::int64_t vertex_count() const;
+  [[nodiscard]] std::int64_t face_count() const;
+  /// Whether the vertex records hold normals (all three components).
+  [[nodiscard]] bool has_normals() const;
+
+  /// Positions of vertices begin .. end - 1, (end - begin) x 3.
+  /// \throw InvalidInput unless 0 <= begin <= end <= vertex_count(); IoError when the file
+  /// cannot be read (it changed since the header was read).
+  [[nodiscard]] RowMatrixX3d positions(std::int64_t begin, std::int64_t end) const;
+  /// Positions of vertices `ids` (#ids x 3), in any order; runs of ascending, close ids are read
+  /// together. \throw InvalidInput for an id outside [0, vertex_count()); IoError as above.
+  [[nodiscard]] RowMatrixX3d positions(std::span<const int> ids) const;
+  /// The normals of the same rows. \throw InvalidInput also when the file has none.
+  [[nodiscard]] RowMatrixX3d normals(std::int64_t begin, std::int64_t end) const;
+  [[nodiscard]] RowMatrixX3d normals(std::span<const int> ids) const;
+
+  /// Corners of faces begin .. end - 1, (end - begin) x 3.
+  /// \throw InvalidInput unless 0 <= begin <= end <= face_count(); IoError naming the first face
+  /// that is not a triangle or has a corner outside [0, vertex_count()).
+  [[nodiscard]] RowMatrixX3i faces(std::int64_t begin, std::int64_t end) const;
+
+  struct Layout;  ///< where the records' fields are (io/ply_records.cpp)
+
+ private:
+  std::shared_ptr<const Layout> layout_;
+};
 
 /// Precision of the real numbers a writer puts in a file.
 enum class Precision {

@@ -13,6 +13,8 @@
 /// and file-normal choices, the orientation of closed components) is measured once by
 /// mesh_wide_choices and given to every tile.
 
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -167,5 +169,54 @@ void require_tileable(const CloudOptions& options);
 [[nodiscard]] TileEstimate estimate_cloud_tiled(PositionsRef V, std::optional<NormalsRef> N,
                                                 const CloudOptions& options = {},
                                                 const TileOptions& tiles = {});
+
+// ---- Streamed tiles ------------------------------------------------------------------------
+//
+// A mesh that no process holds whole is tiled in passes over its vertices (PlyTriangleReader,
+// python/focal/stream.py): the cells of a coarse Morton grid over the box of the finite vertices,
+// taken in Morton order, are cut into runs of about tile_vertices vertices (a cell is never cut),
+// so that a vertex's tile is a function of its position and nothing per vertex is kept. The
+// tiles' halos are then gathered as partition_mesh gathers them, from files of the tiles' faces.
+
+/// Bits per axis of the grid of streamed tiles: 2^21 cells, whose counts take 16 MB.
+inline constexpr int kTileGridBits = 7;
+/// Cells of the grid: 2^(3 x kTileGridBits) in Morton order, then one for non-finite positions.
+inline constexpr std::int64_t kTileGridCells = (std::int64_t{1} << (3 * kTileGridBits)) + 1;
+
+/// The box the grid spans: per axis the least and the greatest finite coordinate (lo > hi while
+/// no row with all coordinates finite has been seen).
+struct TileGridBox {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+};
+
+/// `box` grown by the rows of P whose coordinates are all finite (one chunk of a pass).
+[[nodiscard]] TileGridBox grow_tile_grid_box(const TileGridBox& box, PositionsRef P);
+
+/// The grid cell of each row of P: each axis of `box` cut into 2^kTileGridBits equal parts (an
+/// axis of zero extent: part 0; positions outside the box: the nearest part), the cell the Morton
+/// code of the parts (x in bit 0, y in bit 1, z in bit 2 of each triple); a row with a non-finite
+/// coordinate: the last cell, kTileGridCells - 1.
+[[nodiscard]] std::vector<std::int32_t> tile_grid_cells(PositionsRef P, const TileGridBox& box,
+                                                        int threads = 0);
+
+/// The tiles of the grid's cells.
+struct TileGrid {
+  std::vector<std::int32_t> cell_tile;  ///< per cell (kTileGridCells): its tile, 0 when empty
+  int tile_count = 0;
+};
+
+/// Cuts the cells, in Morton order, into tiles: a cell with vertices goes to the tile numbered
+/// floor(vertices in the cells before it / tile_vertices), the tiles then renumbered densely in
+/// that order (no tile is empty; a tile may hold more than tile_vertices when one cell does).
+/// `counts`: vertices per cell (kTileGridCells).
+/// \throw InvalidInput for counts of another size or negative, or tile_vertices < 1.
+[[nodiscard]] TileGrid cut_tile_grid(std::span<const std::int64_t> counts, int tile_vertices);
+
+/// The tile of each row of P: cell_tile[tile_grid_cells(P, box)].
+/// \throw InvalidInput when cell_tile has not kTileGridCells entries.
+[[nodiscard]] std::vector<std::int32_t> tile_grid_tiles(PositionsRef P, const TileGridBox& box,
+                                                        std::span<const std::int32_t> cell_tile,
+                                                        int threads = 0);
 
 }  // namespace focal
