@@ -481,6 +481,11 @@ libraries' own functions with their defaults.
 
 HEAD
   echo "$main_table"
+  if ((!have_peers)); then
+    echo
+    echo "(bench/peers/.venv not found: the peers' columns are left out; bench/peers/setup.sh"
+    echo "installs them.)"
+  fi
   cat <<'SUMMARY'
 
 ## By category
