@@ -13,7 +13,7 @@ WERROR ?= OFF
 VENV := build/venv
 PYTHON := $(VENV)/bin/python
 
-.PHONY: all deps deps-demo venv configure build test demo bench install clean format
+.PHONY: all deps deps-demo venv configure build test demo bench docs install clean format
 
 all: build
 
@@ -54,6 +54,13 @@ bench:
 	  --benchmark_report_aggregates_only=true --benchmark_out=build/bench/kernels.json
 	@bash bench/run_bench.sh build/bench | tee build/bench/whole-runs.md
 	@bash bench/threads_under_load.sh build/bench | tee build/bench/threads-under-load.md
+
+# The API reference from the headers (Doxyfile: include/focal, warnings on stderr), in
+# build/docs/html. Needs no build of the library.
+docs:
+	@bash scripts/install-deps.sh docs
+	@mkdir -p build/docs
+	@doxygen Doxyfile
 
 install: build
 	@cmake --install $(BUILD_DIR) --prefix $(or $(PREFIX),/usr/local)

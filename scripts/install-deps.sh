@@ -5,6 +5,7 @@
 #   scripts/install-deps.sh bench    also Google Benchmark, GNU time and the bunny (`make bench`),
 #                                    CGAL and PCL (point-cloud peers, bench/points/)
 #   scripts/install-deps.sh fuzz     also clang with libFuzzer and its OpenMP (scripts/fuzz.sh)
+#   scripts/install-deps.sh docs     also Doxygen and Graphviz (`make docs`: the API reference)
 set -euo pipefail
 
 # python3-venv and python3-dev: the venv of the Python bindings' build and tests (`make test`
@@ -24,6 +25,9 @@ elif [[ "${1:-}" == "fuzz" ]]; then
   # libFuzzer and the sanitizer runtimes of clang are in libclang-rt-14-dev, which clang only
   # recommends; libomp-dev is clang's OpenMP (the library links it).
   packages+=(clang libclang-rt-14-dev libomp-dev)
+elif [[ "${1:-}" == "docs" ]]; then
+  # Doxygen reads include/focal (Doxyfile); Graphviz's dot draws its include graphs.
+  packages+=(doxygen graphviz)
 fi
 
 missing=()
