@@ -4,7 +4,8 @@ and analytic test surfaces."""
 from __future__ import annotations
 
 import os
-from typing import Any, Optional
+import warnings
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -107,10 +108,28 @@ _RECOMMENDED_OPTIONS = {
 _COMMON_OPTIONS = {"normals": "auto", "zero_tolerance": 1e-3, "umbilic_tolerance": 1e-2}
 
 
+#: The estimators of the literature (include/focal/curvature/baselines.h), for comparison.
+_BASELINES = ("meyer_2003", "cohen_steiner_morvan_2003", "lachaud_2020", "yang_2006",
+              "grinspun_2006")
+_ESTIMATORS = ("recommended", "paper") + _BASELINES
+#: Point clouds (an input without faces): include/focal/curvature/cloud_curvature.h, CloudOptions.
+_CLOUD_OPTIONS = {
+    "k": 0,
+    "radius": None,
+    "adaptive_radius": None,
+    "normal_method": "jet",
+    "viewpoint": None,
+    "outlier_ratio": 3.0,
+    "off_surface_ratio": 10.0,
+}
+#: Options that only meshes have (the solver applies to clouds too).
+_MESH_ONLY = ("normals", "method", "rings", "ray_weighting", "gaussian_width")
+
+
 def _estimate_options(estimator: str, threads: Optional[int], options: dict) -> dict:
-    if estimator not in ("recommended", "paper"):
+    if estimator not in _ESTIMATORS:
         raise InvalidInputError(
-            f"estimator: unknown value {estimator!r} (expected 'recommended' or 'paper')"
+            f"estimator: unknown value {estimator!r} (expected one of {', '.join(_ESTIMATORS)})"
         )
     other = _PAPER_OPTIONS if estimator == "recommended" else _RECOMMENDED_OPTIONS
     given = sorted(k for k, default in other.items() if options[k] != default)
@@ -126,13 +145,38 @@ def _estimate_options(estimator: str, threads: Optional[int], options: dict) -> 
     return o
 
 
+def _cloud_options(cloud: dict, solver: str, threads: int) -> dict:
+    """The cloud keywords of curvature() as the extension reads them."""
+    radius, adaptive = cloud["radius"], cloud["adaptive_radius"]
+    if int(cloud["k"]) < 0:
+        raise InvalidInputError(f"k must be >= 0 (0: the adaptive default), got {cloud['k']}")
+    if radius is not None and not float(radius) > 0.0:
+        raise InvalidInputError(f"radius must be None or > 0, got {radius}")
+    if adaptive is not None and not (float(adaptive) > 0.0 and np.isfinite(float(adaptive))):
+        raise InvalidInputError(f"adaptive_radius must be None or finite and > 0, got {adaptive}")
+    viewpoint = cloud["viewpoint"]
+    return {
+        "k": int(cloud["k"]),
+        "radius": 0.0 if radius is None else float(radius),
+        "adaptive_radius": 0.0 if adaptive is None else float(adaptive),
+        "normal_method": str(cloud["normal_method"]),
+        "viewpoint": None if viewpoint is None else [float(x) for x in viewpoint],
+        "solver": solver,
+        "outlier_ratio": float(cloud["outlier_ratio"]),
+        "off_surface_ratio": float(cloud["off_surface_ratio"]),
+        "threads": threads,
+    }
+
+
 def curvature(
     V: Any,
-    F: Any,
+    F: Any = None,
     N: Any = None,
     *,
     estimator: str = "recommended",
     normals: str = "auto",
+    device: str = "cpu",
+    tile_vertices: int = 0,
     threads: Optional[int] = None,
     zero_tolerance: float = 1e-3,
     umbilic_tolerance: float = 1e-2,
@@ -150,21 +194,36 @@ def curvature(
     noise_for_three_rings: float = 0.035,
     file_agreement: float = 2.0,
     outlier_disagreement: float = 10.0,
+    # point clouds, F None (include/focal/curvature/cloud_curvature.h, CloudOptions)
+    k: int = 0,
+    radius: Optional[float] = None,
+    adaptive_radius: Optional[float] = None,
+    normal_method: str = "jet",
+    viewpoint: Optional[Sequence[float]] = None,
+    outlier_ratio: float = 3.0,
+    off_surface_ratio: float = 10.0,
 ) -> Curvature:
-    """Per-vertex principal curvatures and directions, H and K: what ``focal curvature`` computes
-    (the same library call, so the same numbers).
+    """Per-vertex principal curvatures and directions, H and K of a mesh or, with ``F=None``, of
+    a point cloud: what ``focal curvature`` computes (the same library call, focal::curvature in
+    include/focal/curvature.h, so the same numbers).
 
     Parameters
     ----------
-    V : (n, 3) positions. F : (m, 3) triangles, counter-clockwise seen from outside.
-    N : (n, 3) outward vertex normals (need not be unit), or None.
+    V : (n, 3) positions. F : (m, 3) triangles, counter-clockwise seen from outside, or None for
+        a point cloud. N : (n, 3) outward vertex normals (need not be unit), or None.
     estimator : ``"recommended"`` (default: jets judge and improve the normals, a wider Gaussian
-        neighbourhood on noisy positions; docs/ESTIMATOR.md) or ``"paper"`` (the paper's
-        method: the 1-ring two-slit fit of the normals). Options of the other estimator must
-        keep their defaults (InvalidInputError otherwise).
+        neighbourhood on noisy positions; docs/METHOD.md), ``"paper"`` (the paper's method: the
+        1-ring two-slit fit of the normals), or a baseline of the literature for comparison
+        (meshes only): ``"meyer_2003"``, ``"cohen_steiner_morvan_2003"``, ``"lachaud_2020"``,
+        ``"yang_2006"``, ``"grinspun_2006"``. Options of another estimator must keep their
+        defaults (InvalidInputError otherwise).
     normals : ``"auto"`` (N when given; else Max's normals from the faces for the paper's
         estimator, jets for the recommended one), ``"file"`` (N, required), or ``"area"``,
         ``"angle"``, ``"max"``: from the faces (paper's estimator only).
+    device : ``"cpu"`` or ``"cuda"`` (the paper's per-vertex fit on an NVIDIA GPU, float32;
+        DeviceError without one).
+    tile_vertices : > 0: estimated tile by tile (at most this many owned vertices a tile): the
+        same numbers, the memory of one tile.
     threads : worker threads; None: FOCAL_NUM_THREADS if set, else all. Results do not depend
         on it.
     zero_tolerance, umbilic_tolerance : the classes (|k| x mean edge length <= zero_tolerance is
@@ -175,14 +234,21 @@ def curvature(
         (width gaussian_width; 0: mean edge length x rings). lm_* : Levenberg-Marquardt.
     noise_for_two_rings, noise_for_three_rings, file_agreement, outlier_disagreement : the
         recommended estimator's thresholds (recommended.h).
+    k, radius, adaptive_radius, normal_method, viewpoint, outlier_ratio, off_surface_ratio :
+        point clouds only, as ``focal curvature``'s --k, --radius, --adaptive-radius,
+        --cloud-normals, --viewpoint, --outlier-ratio, --off-surface-ratio; ``k=0`` (with no
+        radius) is the adaptive default of the command line (docs/POINTS.md).
 
     Returns
     -------
     Curvature with k1, k2, H, K (n,), d1, d2 (n, 3), residual, point_class (PointClass codes),
-    ``.undefined`` and what the estimator decided. A sphere of radius r with outward normals has
-    k1 = k2 = +1/r.
+    ``.undefined`` and what the estimator decided (for a cloud ``cloud``: its plan, and ``N`` the
+    normals used). A sphere of radius r with outward normals has k1 = k2 = +1/r. The
+    estimator's warnings (inward components reversed, file normals ignored...) are issued as
+    Python warnings with the command line's text.
 
-    Raises InvalidInputError for wrong shapes, indices outside V or options out of range.
+    Raises InvalidInputError for wrong shapes, indices outside V or options out of range or
+    that do not apply to the input.
     """
     options = {
         "normals": normals,
@@ -201,9 +267,35 @@ def curvature(
         "file_agreement": file_agreement,
         "outlier_disagreement": outlier_disagreement,
     }
+    cloud = {
+        "k": k,
+        "radius": radius,
+        "adaptive_radius": adaptive_radius,
+        "normal_method": normal_method,
+        "viewpoint": viewpoint,
+        "outlier_ratio": outlier_ratio,
+        "off_surface_ratio": off_surface_ratio,
+    }
     o = _estimate_options(estimator, threads, options)
+    o["device"] = str(device)
+    o["tile_vertices"] = int(tile_vertices)
+    if F is None:
+        defaults = {**_PAPER_OPTIONS, **_COMMON_OPTIONS}
+        given = [name for name in _MESH_ONLY if options[name] != defaults[name]]
+        if given:
+            raise InvalidInputError(
+                f"{', '.join(given)}: option(s) of meshes, but F is None (a point cloud)"
+            )
+        o["cloud"] = _cloud_options(cloud, solver, o["threads"])
+        F = np.zeros((0, 3), dtype=np.int32)
+    else:
+        given = sorted(name for name, default in _CLOUD_OPTIONS.items() if cloud[name] != default)
+        if given:
+            raise InvalidInputError(f"{', '.join(given)}: option(s) of point clouds (F=None)")
     Va, Fa, Na = _mesh_arrays(V, F, N)
     d = _ext.curvature(Va, Fa, Na, o)
+    for message in d.pop("warnings"):
+        warnings.warn(message, stacklevel=2)
     return Curvature(**d)
 
 

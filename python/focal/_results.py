@@ -74,6 +74,12 @@ class Curvature:
     #: vertex; the curvature does not exist there), all 0 where it did not look (noisy
     #: positions); None for the paper's estimator.
     crease: Optional[np.ndarray] = None
+    #: Vertices with more than 1024 vertices within the rings the estimate gathered (a polygon
+    #: of thousands of corners): undefined, or fitted on their 1-ring (see the warning).
+    crowded_count: int = 0
+    #: Point clouds (focal.curvature with F=None): the plan: normals_estimated, spacing (the mean
+    #: spacing), noise, k (neighbours of the fit), corrected, outlier_count. None for meshes.
+    cloud: Optional[dict] = None
 
     @property
     def undefined(self) -> np.ndarray:

@@ -92,6 +92,11 @@ nb::dict curvature_dict(focal::CurvatureResult&& r);
 /// The options of focal::estimate from the keywords of focal.curvature (meshes.cpp).
 focal::EstimateOptions estimate_options(const nb::dict& o);
 
+/// A cloud's options from the dict of focal.curvature's (and cloud tiles') cloud keywords: k,
+/// radius, adaptive_radius, normal_method, viewpoint, solver, outlier_ratio, off_surface_ratio,
+/// threads (clouds.cpp).
+focal::CloudOptions cloud_options_from(const nb::dict& d);
+
 inline std::optional<focal::NormalsRef> normals_ref(const std::optional<DoubleRows>& N) {
   if (!N) return std::nullopt;
   return focal::NormalsRef(view(*N));

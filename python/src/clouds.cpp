@@ -97,8 +97,9 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adapt
 
 // ---- A cloud in tiles (focal/tiles/tiles.h), for python/focal/distributed.py ----------------
 
-/// cloud_curvature's arguments as one dict (what a tile task carries).
-focal::CloudOptions cloud_options_of(const nb::dict& d) {
+}  // namespace
+
+focal::CloudOptions cloud_options_from(const nb::dict& d) {
   const auto viewpoint = d["viewpoint"].is_none() ? std::optional<std::vector<double>>()
                                                   : nb::cast<std::vector<double>>(d["viewpoint"]);
   const double adaptive_radius =
@@ -109,6 +110,14 @@ focal::CloudOptions cloud_options_of(const nb::dict& d) {
                     nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
   o.off_surface_ratio = nb::cast<double>(d["off_surface_ratio"]);
+  return o;
+}
+
+namespace {
+
+/// cloud_curvature's arguments as one dict (what a tile task carries).
+focal::CloudOptions cloud_options_of(const nb::dict& d) {
+  focal::CloudOptions o = cloud_options_from(d);
   focal::require_tileable(o);
   return o;
 }

@@ -5,11 +5,13 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
 #include "bindings.h"
 #include "focal/core/fields.h"
+#include "focal/curvature.h"
 #include "focal/curvature/estimate.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/io/fields_io.h"
@@ -40,7 +42,15 @@ nb::dict curvature_dict(focal::CurvatureResult&& r) {
 /// documents them and checks which estimator they belong to).
 focal::EstimateOptions estimate_options(const nb::dict& o) {
   static const std::pair<const char*, focal::Estimator> estimators[] = {
-      {"recommended", focal::Estimator::recommended}, {"paper", focal::Estimator::paper}};
+      {"recommended", focal::Estimator::recommended},
+      {"paper", focal::Estimator::paper},
+      {"meyer_2003", focal::Estimator::meyer_2003},
+      {"cohen_steiner_morvan_2003", focal::Estimator::cohen_steiner_morvan_2003},
+      {"lachaud_2020", focal::Estimator::lachaud_2020},
+      {"yang_2006", focal::Estimator::yang_2006},
+      {"grinspun_2006", focal::Estimator::grinspun_2006}};
+  static const std::pair<const char*, focal::Device> devices[] = {{"cpu", focal::Device::cpu},
+                                                                  {"cuda", focal::Device::cuda}};
   static const std::pair<const char*, focal::NormalsSource> sources[] = {
       {"auto", focal::NormalsSource::automatic},
       {"file", focal::NormalsSource::file},
@@ -79,6 +89,16 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   r.zero_tolerance = p.zero_tolerance;
   r.umbilic_tolerance = p.umbilic_tolerance;
   r.threads = threads;
+  e.execution.threads = threads;
+  if (o.contains("device")) {
+    e.device = parse_enum(nb::cast<std::string>(o["device"]), "device", devices);
+  }
+  if (o.contains("tile_vertices")) e.tile_vertices = nb::cast<int>(o["tile_vertices"]);
+  if (o.contains("cloud")) {
+    e.cloud = cloud_options_from(nb::cast<nb::dict>(o["cloud"]));
+    e.cloud.zero_tolerance = p.zero_tolerance;
+    e.cloud.umbilic_tolerance = p.umbilic_tolerance;
+  }
   return e;
 }
 
@@ -125,8 +145,8 @@ nb::dict default_options() {
   return d;
 }
 
-/// The estimate of focal.curvature: the CLI's pipeline (focal::estimate on a PreparedMesh of the
-/// arrays as given).
+/// The estimate of focal.curvature's timing helper: the mesh pipeline (focal::estimate on a
+/// PreparedMesh of the arrays as given).
 focal::Estimate run_estimate(const DoubleRows& V, const IntRows& F,
                              const std::optional<DoubleRows>& N, const focal::EstimateOptions& o,
                              int threads) {
@@ -134,16 +154,35 @@ focal::Estimate run_estimate(const DoubleRows& V, const IntRows& F,
   return focal::estimate(mesh, o);
 }
 
+nb::dict cloud_plan_dict(const focal::CloudPlan& c) {
+  nb::dict d;
+  d["normals_estimated"] = c.normals_estimated;
+  d["spacing"] = c.spacing;
+  d["noise"] = c.noise;
+  d["k"] = c.k;
+  d["corrected"] = c.corrected;
+  d["outlier_count"] = std::count(c.outlier.begin(), c.outlier.end(), char{1});
+  return d;
+}
+
+/// focal.curvature: the front door (focal::curvature) on the arrays, a cloud when F has no rows;
+/// its warnings collected for Python's warnings module.
 nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                    const nb::dict& options) {
-  const focal::EstimateOptions o = estimate_options(options);
+  focal::EstimateOptions o = estimate_options(options);
   const int threads = nb::cast<int>(options["threads"]);
+  std::vector<std::string> warnings;
+  o.execution.warning = [&warnings](const std::string& w) { warnings.push_back(w); };
   focal::Estimate e;
   {
     nb::gil_scoped_release release;
-    e = run_estimate(V, F, N, o, threads);
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+    e = focal::curvature(mesh, o);
   }
   nb::dict d = curvature_dict(std::move(e.curvature));
+  d["warnings"] = warnings;
+  d["crowded_count"] = e.crowded_count;
+  d["cloud"] = e.cloud ? nb::object(cloud_plan_dict(*e.cloud)) : nb::none();
   d["N"] = optional_to_numpy(std::move(e.N));
   d["F"] = optional_to_numpy(std::move(e.F));
   nb::dict report;
