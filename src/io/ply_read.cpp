@@ -11,8 +11,10 @@
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
+#include "io/format_readers.h"
 #include "io/ply.h"
+#include "io/text_scan.h"
 
 namespace focal {
 namespace {
