@@ -10,8 +10,8 @@
 #include <functional>
 
 #include "bench_meshes.h"
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/focal_mesh.h"
@@ -20,7 +20,8 @@
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/mesh/orientation.h"
+#include "focal/normals/vertex_normals.h"
 
 namespace focal::bench {
 namespace {

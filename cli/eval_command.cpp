@@ -17,7 +17,7 @@
 #include "focal/curvature/recommended.h"
 #include "focal/evaluation/evaluation.h"
 #include "focal/io/mesh_io.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "paths.h"
 
 namespace focal::cli {

@@ -6,7 +6,7 @@
 #include "estimator_flags.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/mesh/orientation.h"
 #include "focal/points/neighbours.h"
 
 namespace focal::cli {

@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
 
 namespace focal::fuzz {
 

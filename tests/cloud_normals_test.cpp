@@ -10,7 +10,7 @@
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
 #include "focal/surfaces/cloud_samples.h"
-#include "normals/cloud_normals_detail.h"
+#include "normals/cloud_jets.h"
 #include "test_clouds.h"
 
 namespace focal {

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/fields_detail.h"
+#include "core/result_rows.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/recommended.h"
 #include "focal/evaluation/evaluation.h"

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "focal/core/error.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 

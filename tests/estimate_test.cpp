@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "focal/core/error.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "test_meshes.h"
 
 namespace focal {

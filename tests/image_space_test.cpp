@@ -25,7 +25,7 @@
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/surfaces/geometry_image.h"
 #include "gpu_required.h"
-#include "image_space/detail.h"
+#include "image_space/host_side.h"
 #include "kernels/pixel.h"
 #include "kernels/triplet.h"
 #include "test_meshes.h"

@@ -12,7 +12,7 @@
 
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 
 namespace focal {

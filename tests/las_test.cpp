@@ -14,7 +14,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
 
 namespace focal {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "core/spatial_order.h"
 #include "focal/core/error.h"
-#include "points/neighbours_detail.h"
+#include "points/measured_neighbours.h"
 
 namespace focal {
 namespace {

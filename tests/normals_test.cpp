@@ -1,5 +1,3 @@
-#include "focal/mesh/normals.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -14,6 +12,8 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/mesh/orientation.h"
+#include "focal/normals/vertex_normals.h"
 #include "test_meshes.h"
 
 namespace focal {

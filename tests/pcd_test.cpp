@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
 
 namespace focal {
 namespace {

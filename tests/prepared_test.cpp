@@ -15,8 +15,9 @@
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/mesh/orientation.h"
 #include "focal/normals/jets.h"
+#include "focal/normals/vertex_normals.h"
 #include "test_meshes.h"
 
 namespace focal {

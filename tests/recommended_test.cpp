@@ -16,7 +16,7 @@
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/estimate.h"
 #include "focal/evaluation/evaluation.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 
 namespace focal {

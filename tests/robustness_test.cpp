@@ -25,8 +25,9 @@
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/mesh/orientation.h"
 #include "focal/mesh/prepared.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 

@@ -14,18 +14,18 @@
 #include <vector>
 
 #include "core/simd_lanes.h"
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
-#include "curvature/triangle_curvature_detail.h"
+#include "curvature/triangle_fit.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/curvature/two_slit_fit.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
-#include "mesh/normals_detail.h"
 #include "mesh/topology.h"
-#include "normals/jets_detail.h"
+#include "normals/jet_normals_from.h"
+#include "normals/vertex_normals_from.h"
 #include "test_meshes.h"
 
 namespace focal {

@@ -16,7 +16,8 @@
 #include <vector>
 
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
+#include "io/text_scan.h"
 
 namespace focal {
 namespace {

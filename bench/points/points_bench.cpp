@@ -13,11 +13,11 @@
 #include <numbers>
 #include <random>
 
-#include "curvature/curvature_detail.h"
+#include "curvature/vertex_fit.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/normals/cloud_normals.h"
 #include "focal/points/neighbours.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 
 namespace {
 

@@ -17,8 +17,8 @@
 #include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
 #include "focal/mesh/check.h"
-#include "focal/mesh/normals.h"
 #include "focal/mesh/prepared.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 
 namespace focal_python {

@@ -67,7 +67,7 @@ template <class T>
 }
 
 /// Writes vertex i's unit normal (NaN where N's row is zero or not finite: its vertex is
-/// `undefined`, as curvature/detail.h's unit_rows) into its record as hi + lo pairs.
+/// `undefined`, as mesh/prepared_access.h's unit_rows) into its record as hi + lo pairs.
 template <class T>
 inline void set_record_normal(NormalsRef N, Eigen::Index i, VertexRecord<T>& r) {
   const double length = N.row(i).norm();

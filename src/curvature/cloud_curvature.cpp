@@ -10,17 +10,18 @@
 #include "core/parallel.h"
 #include "core/spatial_order.h"
 #include "curvature/corrected_step.h"
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
+#include "curvature/normal_choice.h"
 #include "curvature/robust_fit.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/points/neighbours.h"
-#include "mesh/normals_detail.h"
-#include "mesh/prepared_detail.h"
-#include "normals/cloud_normals_detail.h"
+#include "mesh/prepared_access.h"
+#include "normals/cloud_jets.h"
+#include "normals/vertex_normals_from.h"
+#include "points/measured_neighbours.h"
 #include "points/natural_ring.h"
-#include "points/neighbours_detail.h"
 
 namespace focal {
 namespace {
@@ -94,7 +95,7 @@ bool any_flag(const std::vector<char>& flags) {
 bool tests_on(const CloudOptions& o) { return o.outlier_ratio > 0.0 || o.off_surface_ratio > 0.0; }
 
 /// The outlier tests of the options over `nearest16`, the 16 nearest of every point (with their
-/// measures, points/neighbours_detail.h): statistical outliers, then points off the surface of
+/// measures, points/measured_neighbours.h): statistical outliers, then points off the surface of
 /// their 16 nearest among the rest. Empty when both tests are off. `tie_rows` as
 /// neighbourhoods_without.
 std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours& nearest16,

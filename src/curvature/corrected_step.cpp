@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdint>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
-#include "curvature/baselines/lachaud_2020_detail.h"
+#include "core/result_rows.h"
+#include "curvature/baselines/corrected_curvature.h"
 #include "curvature/normal_rays_detail.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "points/natural_ring.h"
 
 namespace focal::detail {

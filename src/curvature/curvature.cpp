@@ -11,18 +11,18 @@
 
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
 #include "curvature/normal_rays_detail.h"
-#include "curvature/triangle_curvature_detail.h"
+#include "curvature/triangle_fit.h"
 #include "curvature/two_slit_detail.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
 #include "kernels/local_shape.h"
 #include "kernels/two_slit.h"
 #include "kernels/vec3.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 
 namespace focal {
 

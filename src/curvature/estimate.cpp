@@ -9,12 +9,13 @@
 #include <utility>
 #include <vector>
 
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
 #include "focal/mesh/check.h"
-#include "focal/mesh/normals.h"
-#include "mesh/prepared_detail.h"
+#include "focal/mesh/orientation.h"
+#include "focal/normals/vertex_normals.h"
+#include "mesh/prepared_access.h"
 
 namespace focal {
 namespace {

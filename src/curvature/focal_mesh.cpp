@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 
 namespace focal {
 namespace {

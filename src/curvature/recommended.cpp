@@ -11,21 +11,22 @@
 #include <utility>
 #include <vector>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/result_rows.h"
 #include "curvature/corrected_step.h"
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
+#include "curvature/normal_choice.h"
 #include "curvature/robust_fit.h"
 #include "curvature/spike_repair.h"
-#include "curvature/triangle_curvature_detail.h"
+#include "curvature/triangle_fit.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
 #include "focal/normals/jets.h"
-#include "mesh/normals_detail.h"
-#include "mesh/prepared_detail.h"
-#include "normals/jets_detail.h"
+#include "focal/normals/vertex_normals.h"
+#include "mesh/prepared_access.h"
+#include "normals/jet_normals_from.h"
+#include "normals/vertex_normals_from.h"
 
 namespace focal {
 namespace {

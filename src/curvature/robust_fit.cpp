@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/result_rows.h"
 #include "curvature/normal_rays_detail.h"
 #include "curvature/two_slit_detail.h"
 

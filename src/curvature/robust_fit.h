@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "curvature/curvature_detail.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_fit.h"
+#include "curvature/vertex_rows.h"
 
 namespace focal::detail {
 

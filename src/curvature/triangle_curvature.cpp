@@ -13,14 +13,14 @@
 
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
-#include "curvature/detail.h"
 #include "curvature/normal_rays_detail.h"
-#include "curvature/triangle_curvature_detail.h"
+#include "curvature/triangle_fit.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
 #include "kernels/local_shape.h"
 #include "kernels/vec3.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 
 namespace focal {

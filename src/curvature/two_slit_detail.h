@@ -8,7 +8,7 @@
 #include <limits>
 #include <span>
 
-#include "curvature/detail.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/two_slit_fit.h"
 #include "kernels/two_slit.h"
 

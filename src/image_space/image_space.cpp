@@ -11,7 +11,7 @@
 #include "cuda/launch.h"
 #include "focal/core/error.h"
 #include "focal/cuda/device.h"
-#include "image_space/detail.h"
+#include "image_space/host_side.h"
 
 namespace focal {
 namespace detail {

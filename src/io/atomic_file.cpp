@@ -11,7 +11,7 @@
 
 #include "core/parallel.h"
 #include "focal/io/mesh_io.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
 
 namespace focal {
 namespace io_detail {

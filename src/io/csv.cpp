@@ -9,7 +9,7 @@
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
 #include "io/atomic_file.h"
-#include "io/detail.h"
+#include "io/number_text.h"
 
 namespace focal {
 namespace {

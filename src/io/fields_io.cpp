@@ -6,8 +6,8 @@
 
 #include "focal/core/error.h"
 #include "io/atomic_file.h"
-#include "io/detail.h"
 #include "io/ply.h"
+#include "io/text_scan.h"
 
 namespace focal {
 namespace {

@@ -5,7 +5,8 @@
 #include <cmath>
 
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
+#include "io/format_readers.h"
 
 namespace focal {
 

@@ -13,7 +13,10 @@
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
 #include "io/atomic_file.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
+#include "io/format_readers.h"
+#include "io/number_text.h"
+#include "io/text_scan.h"
 
 namespace focal {
 namespace {

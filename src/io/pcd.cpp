@@ -21,7 +21,9 @@
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
 #include "io/bytes.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
+#include "io/format_readers.h"
+#include "io/text_scan.h"
 
 namespace focal {
 namespace {

@@ -8,9 +8,10 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
 #include "io/ply.h"
 #include "io/ply_read.h"
+#include "io/text_scan.h"
 
 namespace focal::io_detail::ply {
 namespace {

@@ -8,7 +8,9 @@
 #include <utility>
 
 #include "focal/io/mesh_io.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
+#include "io/format_readers.h"
+#include "io/text_scan.h"
 
 namespace focal::io_detail {
 

@@ -19,8 +19,9 @@
 
 #include "focal/core/mesh.h"
 #include "io/bytes.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
 #include "io/ply.h"
+#include "io/text_scan.h"
 
 namespace focal::io_detail::ply {
 

@@ -15,7 +15,7 @@
 
 #include "focal/core/error.h"
 #include "focal/io/mesh_io.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
 #include "io/ply.h"
 #include "io/ply_read.h"
 

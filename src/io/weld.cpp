@@ -11,7 +11,7 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
-#include "io/detail.h"
+#include "io/format_readers.h"
 
 namespace focal::io_detail {
 namespace {

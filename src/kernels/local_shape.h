@@ -4,7 +4,7 @@
 // a symmetric 2x2 shape operator and the point's class from its principal curvatures.
 //
 // Templates on the element type (kernels/vec3.h): float in the CUDA kernels and the image-space
-// estimator, double in the CPU paths (through the Eigen adapters of curvature/detail.h and
+// estimator, double in the CPU paths (through the Eigen adapters of curvature/vertex_rows.h and
 // curvature/normal_rays_detail.h, and in normals/jets.cpp), GCC vector types in the CPU lane
 // kernels (curvature.cpp: the closed-form per-vertex fit; triangle_curvature.cpp: the per-face
 // solve). Plain data, no Eigen: nvcc compiles this header.

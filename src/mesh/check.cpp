@@ -11,11 +11,13 @@
 #include <vector>
 
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
-#include "mesh/normals_detail.h"
-#include "mesh/prepared_detail.h"
+#include "focal/mesh/orientation.h"
+#include "focal/normals/vertex_normals.h"
+#include "mesh/orientation_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
+#include "normals/vertex_normals_from.h"
 
 namespace focal {
 namespace {

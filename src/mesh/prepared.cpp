@@ -7,7 +7,7 @@
 
 #include "focal/core/error.h"
 #include "mesh/neighbourhood_detail.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 
 namespace focal {

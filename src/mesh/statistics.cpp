@@ -7,7 +7,7 @@
 #include "core/parallel.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/prepared.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/statistics_detail.h"
 #include "mesh/topology.h"
 

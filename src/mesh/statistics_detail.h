@@ -1,6 +1,6 @@
 #pragma once
-// Internal: the connectivity pass of statistics.cpp, shared with normals.cpp (orientation_report)
-// and check.cpp (check_mesh).
+// Internal: the connectivity pass of statistics.cpp, shared with orientation.cpp
+// (orientation_report) and check.cpp (check_mesh).
 
 #include <cstdint>
 #include <vector>

@@ -1,8 +1,8 @@
 #pragma once
-// Internal, header-only: the vertex->face incidence that normals.cpp, neighbourhood.cpp and
-// statistics.cpp gather over. Every per-vertex loop built on it reads the faces of its own
-// vertex in ascending face order and writes only that vertex's slot, so results are identical for
-// any thread count (no scatter-adds, no atomics, no hash maps per edge).
+// Internal, header-only: the vertex->face incidence that normals/vertex_normals.cpp,
+// neighbourhood.cpp and statistics.cpp gather over. Every per-vertex loop built on it reads the
+// faces of its own vertex in ascending face order and writes only that vertex's slot, so results
+// are identical for any thread count (no scatter-adds, no atomics, no hash maps per edge).
 //
 // Edge conventions shared by those files: an edge {a, b} is a pair of distinct vertices that are
 // corners of a common face; its incident faces are the faces having both as corners (each face

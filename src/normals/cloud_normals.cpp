@@ -13,8 +13,8 @@
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/normals/jets.h"
-#include "normals/cloud_normals_detail.h"
-#include "normals/jets_detail.h"
+#include "normals/cloud_jets.h"
+#include "normals/jet_normals_from.h"
 
 namespace focal {
 namespace {

@@ -15,20 +15,20 @@
 #include <utility>
 #include <vector>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/result_rows.h"
 #include "core/simd_lanes.h"
 #include "focal/core/error.h"
 #include "focal/core/point_class.h"
 #include "focal/mesh/neighbourhood.h"
-#include "focal/mesh/normals.h"
+#include "focal/normals/vertex_normals.h"
 #include "kernels/eigen.h"
 #include "kernels/local_shape.h"
 #include "kernels/vec3.h"
-#include "mesh/normals_detail.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
-#include "normals/jets_detail.h"
+#include "normals/jet_normals_from.h"
+#include "normals/vertex_normals_from.h"
 
 namespace focal {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "focal/render/render.h"
 #include "io/atomic_file.h"
-#include "io/detail.h"
+#include "io/file_bytes.h"
 
 namespace focal {
 

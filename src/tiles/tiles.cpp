@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/result_rows.h"
 #include "core/spatial_order.h"
 #include "focal/core/error.h"
 #include "mesh/topology.h"

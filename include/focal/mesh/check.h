@@ -6,7 +6,7 @@
 /// Nothing here repairs anything. The estimators accept every finding: vertices a problem
 /// touches come out `undefined` with NaN fields where no estimate exists (see curvature.h), the
 /// others are computed normally. Conventions (edges, degenerate faces, components, orientation)
-/// are those of neighbourhood.h and normals.h, whose counts are reused.
+/// are those of neighbourhood.h, orientation.h and vertex_normals.h, whose counts are reused.
 
 #include <optional>
 #include <string>
@@ -24,7 +24,8 @@ struct MeshFindings {
   int non_finite_vertex_count = 0;       ///< vertices with a NaN or infinite coordinate
   int repeated_index_face_count = 0;     ///< faces such as (a, a, b)
   int degenerate_face_count = 0;         ///< other faces of numerically zero area (collinear or
-                                         ///< coincident corners; see normals.h for the threshold)
+                                         ///< coincident corners; the threshold is
+                                         ///< vertex_normals.h's)
   int duplicate_face_count = 0;          ///< same vertex set as an earlier face (any order)
   int unreferenced_vertex_count = 0;     ///< vertices in no face (they get class `undefined`)
   int non_manifold_edge_count = 0;       ///< edges with three or more incident faces

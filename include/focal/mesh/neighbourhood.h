@@ -3,7 +3,7 @@
 /// Vertex neighbourhoods in compressed sparse row (CSR) form: the neighbours of vertex i are
 /// `indices[offsets[i] .. offsets[i+1])`. Manifold connectivity is not required.
 ///
-/// Edge conventions (shared with normals.h): an edge is a pair of distinct vertices that are
+/// Edge conventions (shared with orientation.h): an edge is a pair of distinct vertices that are
 /// corners of a common face; its incident faces are the faces having both as corners, each once
 /// (also a face with a repeated index, such as (a, a, b) for the edge {a, b}).
 ///

@@ -4,8 +4,8 @@
 /// jets" (Cazals and Pouget, "Estimating differential quantities using polynomial fitting of
 /// osculating jets", SGP 2003).
 ///
-/// Why: normals averaged from face normals (normals.h: area, angle, Max weights) are exact on
-/// spheres and second-order accurate on symmetric (regular) stencils, but only first-order
+/// Why: normals averaged from face normals (vertex_normals.h: area, angle, Max weights) are exact
+/// on spheres and second-order accurate on symmetric (regular) stencils, but only first-order
 /// accurate on irregular meshes, and the focal-surface fit differentiates the normal field, so a
 /// first-order normal error becomes an O(1) curvature error that does not shrink with refinement.
 /// A least-squares polynomial of degree d fitted to the heights of the k-ring over the tangent

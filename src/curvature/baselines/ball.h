@@ -10,7 +10,7 @@
 #include "focal/curvature/baselines.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/prepared.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines::ball {

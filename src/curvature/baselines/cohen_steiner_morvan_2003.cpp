@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "core/parallel.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/error.h"
 #include "focal/curvature/baselines.h"
 #include "focal/mesh/neighbourhood.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines {

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "core/parallel.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/baselines.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 
 namespace focal::baselines {

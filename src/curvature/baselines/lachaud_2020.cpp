@@ -28,11 +28,11 @@
 
 #include "core/parallel.h"
 #include "curvature/baselines/ball.h"
-#include "curvature/baselines/lachaud_2020_detail.h"
-#include "curvature/detail.h"
+#include "curvature/baselines/corrected_curvature.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/baselines.h"
-#include "focal/mesh/normals.h"
-#include "mesh/prepared_detail.h"
+#include "focal/normals/vertex_normals.h"
+#include "mesh/prepared_access.h"
 
 namespace focal::baselines {
 namespace {

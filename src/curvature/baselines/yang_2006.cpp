@@ -22,9 +22,9 @@
 
 #include "core/parallel.h"
 #include "curvature/baselines/ball.h"
-#include "curvature/detail.h"
+#include "curvature/vertex_rows.h"
 #include "focal/curvature/baselines.h"
-#include "mesh/prepared_detail.h"
+#include "mesh/prepared_access.h"
 
 namespace focal::baselines {
 namespace {

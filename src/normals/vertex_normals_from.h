@@ -1,20 +1,16 @@
 #pragma once
-// Internal: the parts of normals.cpp that check.cpp and statistics.cpp reuse with a connectivity
-// they have already computed.
+// vertex_normals on an incidence already at hand (a PreparedMesh's, check_mesh's, a cloud
+// point's local fan), with the lane instruction set to use: for the mesh check, the estimators'
+// normals and the tests of the lanes.
 
 #include <optional>
 
 #include "core/simd_lanes.h"
 #include "focal/core/mesh.h"
-#include "focal/mesh/normals.h"
-#include "mesh/statistics_detail.h"
+#include "focal/normals/vertex_normals.h"
 #include "mesh/topology.h"
 
 namespace focal::detail {
-
-/// orientation_report from a topology already computed for (V, F).
-OrientationReport orientation_report_from(PositionsRef V, FacesRef F, const MeshTopology& t,
-                                          int threads);
 
 /// vertex_normals from an incidence already computed for F. The area and Max weightings run
 /// several vertices side by side in the lanes of `isa` (the same bits for every instruction set);

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "curvature/detail.h"
+#include "curvature/vertex_rows.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/prepared.h"

@@ -1,5 +1,7 @@
 #pragma once
-// Pieces shared by the per-vertex and per-triangle estimators.
+// A vertex's row of a CurvatureResult from its fit, as every estimator writes it: the principal
+// curvatures and directions of the fitted operator, classified with the mesh's tolerances, and
+// the rows left undefined where estimated normals say nothing (isolated triangles).
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -8,14 +10,14 @@
 #include <utility>
 #include <vector>
 
-#include "core/fields_detail.h"
 #include "core/parallel.h"
+#include "core/result_rows.h"
 #include "core/simd_lanes.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
 #include "kernels/local_shape.h"
-#include "mesh/prepared_detail.h"  // unit_rows
+#include "mesh/prepared_access.h"  // unit_rows
 
 namespace focal::detail {
 
@@ -78,27 +80,6 @@ inline void undefine_isolated_triangles(FacesRef F, CurvatureResult& r) {
     if (!isolated) continue;
     for (int c = 0; c < 3; ++c) detail::store_undefined(r, F(f, c));
   }
-}
-
-/// select_normal: how much smoother (two-slit residual) the secondary normal must be.
-constexpr double kSmootherRatio = 0.5;
-
-/// A vertex's normal: the primary `a` unless the secondary `b` is clearly smoother there: its
-/// two-slit residual `rb` (RMS misfit of the rays, slope units, over the neighbourhood of the
-/// fit: a mesh vertex's 1-ring, a cloud point's nearest) below kSmootherRatio times the
-/// primary's `ra`. On clean data the two residuals measure the same truncation error
-/// and the primary is kept; 10% vertex noise makes jets 5 to 10 times rougher than exact
-/// normals. Only where `may_replace` holds is the secondary considered. Returns the chosen unit
-/// normal and its residual.
-[[gnu::always_inline]] inline std::pair<Eigen::Vector3d, double> select_normal(
-    const Eigen::Vector3d& primary, double ra, const Eigen::Vector3d& secondary, double rb,
-    bool may_replace) {
-  const Eigen::Vector3d a = primary.normalized(), b = secondary.normalized();
-  // A field without a fit at i (too few rays, invalid normal) never wins over one with a fit.
-  const bool b_fits = std::isfinite(rb), a_fits = std::isfinite(ra);
-  const bool smoother = b_fits && (!a_fits || rb < kSmootherRatio * ra);
-  const bool take_b = b.allFinite() && (!a.allFinite() || (smoother && may_replace));
-  return take_b ? std::pair{b, rb} : std::pair{a, ra};
 }
 
 }  // namespace focal::detail
