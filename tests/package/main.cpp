@@ -46,7 +46,7 @@ int main() {
     if (!ok) ++failures;
   }
 
-  // A mesh prepared once for several calls (README, C++ API): the same bits as on the arrays.
+  // A mesh prepared once for several calls (docs/GUIDE.md): the same bits as on the arrays.
   const focal::PreparedMesh prepared(mesh);
   const auto check = [&failures](bool ok, const char* what) {
     if (!ok) {
@@ -56,6 +56,9 @@ int main() {
   };
   check(!focal::check_mesh(prepared).has_problems(), "check_mesh found problems");
   check(focal::estimate_curvature(prepared).k1 == c.k1, "prepared: other k1");
+  // The front door (README, C++): the paper's method on the file's normals is the same fit.
+  const focal::Estimate door = focal::curvature(mesh, {.estimator = focal::Estimator::paper});
+  check(door.curvature.k1 == c.k1 && door.undefined_count == 0, "curvature(paper): other k1");
   const focal::Estimate e = focal::estimate(prepared, {.estimator = focal::Estimator::paper});
   check(!e.N.has_value() && e.curvature.k1 == c.k1, "estimate(paper): other k1 or normals");
   const focal::RecommendedResult r =
