@@ -516,11 +516,13 @@ triplet::TripletSolution<double> solve_face_double(const Mesh& m, int f) {
 Eigen::Vector3d vec(const triplet::Vec3<double>& v) { return {v.x, v.y, v.z}; }
 
 TEST(ImageSpaceTripletKernel, InDoubleItIsTriangleCurvature) {
-  // The same formula in the same frame; only the scaling by the triplet's size and the
-  // discriminant's form differ, so agreement is to double rounding: 1e-9 relative to the face's
-  // largest |k| for H, K and M; for k1, k2 = H +- sqrt(H^2 - K) near umbilics the CPU's
-  // H^2 - K, from A / C and B / (2 C), carries an absolute rounding error of some eps H^2 (up
-  // to ~16 eps), whose square root is sqrt(16 eps) |H| = 6e-8 |H| (measured at most 3.2e-8).
+  // The same formula (kernels/triplet.h; tests/triangle_curvature_test.cpp checks that
+  // triangle_curvature has its bits on the same unit normals). solve_triplet normalises the
+  // normals itself (kernels::length, as the float kernels need), which moves them by an ulp or
+  // so; that perturbation is what is bounded here: 1e-9 relative to the face's largest |k| for
+  // H, K and M; for k1, k2 = H +- sqrt(H^2 - K) near umbilics H^2 - K, from A / C and B / (2 C),
+  // carries an absolute rounding error of some eps H^2 (up to ~16 eps), whose square root is
+  // sqrt(16 eps) |H| = 6e-8 |H|.
   for (const AnalyticSurface& s : mesh_cases()) {
     const TriangleCurvatureResult t = triangle_curvature(s.mesh.V, s.mesh.F, s.mesh.N);
     for (int f = 0; f < s.mesh.F.rows(); ++f) {

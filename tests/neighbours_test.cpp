@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <nanoflann.hpp>
 #include <random>
 #include <utility>
 #include <vector>
@@ -84,6 +86,60 @@ TEST(NearestNeighbours, MatchBruteForceOnALargeCloudBuiltInParallel) {
       ASSERT_EQ(got, brute_force(V, i, 16, 0.0)) << "point " << i << ", threads " << threads;
     }
   }
+}
+
+/// V as nanoflann's dataset adaptor reads it.
+struct CloudAdaptor {
+  const RowMatrixX3d& V;
+  [[nodiscard]] std::size_t kdtree_get_point_count() const {
+    return static_cast<std::size_t>(V.rows());
+  }
+  [[nodiscard]] double kdtree_get_pt(std::size_t i, std::size_t d) const {
+    return V(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(d));
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box& /*box*/) const {
+    return false;
+  }
+};
+
+// The library builds nanoflann's tree itself, its subtrees in parallel (src/points/); nanoflann's
+// own serial build and queries are the plain reference: on a random cloud (no ties) large enough
+// for the parallel build, every kNN list and every radius list is the one nanoflann's tree gives
+// (its radius test is strict, the library's is <=; no distance equals the radius here).
+TEST(NearestNeighbours, EqualNanoflannsOwnTree) {
+  const RowMatrixX3d V = random_cloud(20000, 11);
+  using Tree =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>,
+                                          CloudAdaptor, 3, std::uint32_t>;
+  const CloudAdaptor cloud{V};
+  Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  constexpr int k = 16;
+  constexpr double radius = 0.12;
+  const Neighbourhoods knn = nearest_neighbours(V, k, 2);
+  const Neighbourhoods within = radius_neighbours(V, radius, 0, 2);
+  std::size_t radius_total = 0;
+  for (int i = 0; i < V.rows(); ++i) {
+    const double* q = V.row(i).data();
+    std::uint32_t index[k + 1];
+    double d2[k + 1];
+    ASSERT_EQ(tree.knnSearch(q, k + 1, index, d2), static_cast<std::size_t>(k + 1));
+    ASSERT_EQ(index[0], static_cast<std::uint32_t>(i));  // itself, at distance 0
+    const std::vector<int> expected(index + 1, index + k + 1);
+    ASSERT_EQ(std::vector<int>(knn.begin(i), knn.end(i)), expected) << "point " << i;
+    std::vector<std::pair<std::uint32_t, double>> matches;
+    tree.radiusSearch(q, radius * radius, matches, nanoflann::SearchParams());
+    std::vector<std::pair<double, int>> by_distance;
+    for (const auto& [j, d] : matches) {
+      if (j != static_cast<std::uint32_t>(i)) by_distance.emplace_back(d, static_cast<int>(j));
+    }
+    std::sort(by_distance.begin(), by_distance.end());
+    std::vector<int> listed;
+    for (const auto& [d, j] : by_distance) listed.push_back(j);
+    ASSERT_EQ(std::vector<int>(within.begin(i), within.end(i)), listed) << "point " << i;
+    radius_total += listed.size();
+  }
+  EXPECT_GT(radius_total, 10u * static_cast<std::size_t>(V.rows()));  // lists of some length
 }
 
 TEST(NearestNeighbours, SameForAnyThreadCount) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <random>
 #include <span>
@@ -15,6 +16,7 @@
 
 #include "core/simd_lanes.h"
 #include "curvature/triangle_fit.h"
+#include "curvature/two_slit_detail.h"
 #include "curvature/vertex_fit.h"
 #include "curvature/vertex_rows.h"
 #include "focal/curvature/normal_rays.h"
@@ -23,6 +25,8 @@
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "kernels/local_shape.h"
+#include "kernels/two_slit.h"
 #include "mesh/topology.h"
 #include "normals/jet_normals_from.h"
 #include "normals/vertex_normals_from.h"
@@ -188,6 +192,111 @@ TEST(SimdKernels, FitMatchesTheScalarClosedFormVertexByVertex) {
                 1e-9 * scale);
   }
   EXPECT_GE(undefined, 3);  // vertices 3, 17 (invalid normals) and 40 (one ray)
+}
+
+/// Bitwise equality, NaN included.
+bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
+
+/// The closed-form fit of vertex i with the shared formulas (kernels/local_shape.h,
+/// kernels/two_slit.h) on plain doubles, one neighbour after the other, as the lane kernel's
+/// contract states it: frame_of, normal_ray and principal_axes with reciprocal quotients,
+/// add_ray in neighbour order, solve_slits, slit_misfit.
+struct ScalarFit {
+  bool valid = false;
+  double k1, k2, residual;
+  kernels::Vec3<double> d1, d2;
+  int used = 0, excluded = 0;
+};
+
+ScalarFit scalar_fit(const Mesh& m, const RowMatrixX3d& unit, const std::vector<char>& ok,
+                     const Neighbourhoods& rings, int i, double inverse_two_width_squared) {
+  using kernels::Quotient;
+  ScalarFit out;
+  if (!ok[static_cast<std::size_t>(i)]) return out;
+  const auto vec = [](const auto& row) { return kernels::Vec3<double>{row(0), row(1), row(2)}; };
+  const kernels::Frame<double> frame = kernels::frame_of(vec(unit.row(i)));
+  const kernels::Vec3<double> p = vec(m.V.row(i));
+  kernels::SlitSums<double> sums;
+  std::vector<kernels::NormalRay<double>> rays;
+  std::vector<double> weights;
+  double weight_sum = 0.0;
+  int positive = 0;
+  for (const int* j = rings.begin(i); j != rings.end(i); ++j) {
+    const kernels::Vec3<double> d = vec(m.V.row(*j)) - p;
+    const kernels::Vec3<double> n = vec(unit.row(*j));
+    kernels::NormalRay<double> ray;
+    if (!ok[static_cast<std::size_t>(*j)] ||
+        !kernels::normal_ray<Quotient::reciprocal>(frame, d, n, n, ray)) {
+      ++out.excluded;
+      continue;
+    }
+    const double w =
+        inverse_two_width_squared > 0.0
+            ? std::exp(-(d.x * d.x + d.y * d.y + d.z * d.z) * inverse_two_width_squared)
+            : 1.0;
+    kernels::add_ray(sums, w, ray.u, ray.v, ray.sigma, ray.tau);
+    weight_sum += w;
+    positive += w > 0.0;
+    rays.push_back(ray);
+    weights.push_back(w);
+  }
+  out.used = static_cast<int>(rays.size());
+  const kernels::SlitSolution<double> w =
+      kernels::solve_slits(sums, detail::kMinRelativeDeterminant);
+  if (positive < 2 || !w.valid) return out;
+  double energy = 0.0;
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    const kernels::NormalRay<double>& r = rays[k];
+    energy += weights[k] * kernels::slit_misfit(w, r.u, r.v, r.sigma, r.tau);
+  }
+  const kernels::Principal<double> e =
+      kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(w.a, w.b, w.c);
+  out.valid = true;
+  out.k1 = e.k1, out.k2 = e.k2;
+  out.residual = std::sqrt(energy / (inverse_two_width_squared > 0.0 ? weight_sum : out.used));
+  out.d1 = frame.from_plane(e.d1x, e.d1y), out.d2 = frame.from_plane(-e.d1y, e.d1x);
+  return out;
+}
+
+// The lane kernel's contract (curvature.cpp): every lane has the bits of the shared formulas run
+// on plain doubles one vertex at a time, on the awkward mesh's every kind of vertex (invalid
+// normals, excluded rays, too few rays), with uniform and Gaussian weights.
+TEST(SimdKernels, FitIsTheSharedFormulaOnScalarsBitForBit) {
+  const Mesh m = awkward_mesh();
+  std::vector<char> ok;
+  const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  const double h = mean_edge_length(m.V, m.F);
+  for (const FitCase c : {FitCase{1, RayWeighting::uniform}, FitCase{2, RayWeighting::gaussian}}) {
+    const Neighbourhoods rings = c.rings == 1 ? one : k_ring(one, c.rings);
+    const double width = h * c.rings;  // the default Gaussian width
+    const double inverse = c.weighting == RayWeighting::gaussian ? 0.5 / (width * width) : 0.0;
+    for (SimdIsa isa : available_isas()) {
+      const CurvatureResult r = fit(m, c, 0, isa);
+      int undefined = 0;
+      for (int i = 0; i < m.V.rows(); ++i) {
+        const ScalarFit s = scalar_fit(m, unit, ok, rings, i, inverse);
+        ASSERT_EQ(r.rays_used[i], s.used) << i;
+        ASSERT_EQ(r.rays_excluded[i], s.excluded) << i;
+        if (!s.valid) {
+          ++undefined;
+          ASSERT_EQ(r.class_of(i), PointClass::undefined) << i;
+          ASSERT_TRUE(std::isnan(r.k1[i]) && std::isnan(r.d2(i, 2)) && std::isnan(r.residual[i]));
+          continue;
+        }
+        ASSERT_TRUE(same_bits(r.k1[i], s.k1) && same_bits(r.k2[i], s.k2)) << i;
+        ASSERT_TRUE(same_bits(r.H[i], 0.5 * (s.k1 + s.k2)) && same_bits(r.K[i], s.k1 * s.k2)) << i;
+        ASSERT_TRUE(same_bits(r.residual[i], s.residual)) << i;
+        ASSERT_TRUE(same_bits(r.d1(i, 0), s.d1.x) && same_bits(r.d1(i, 1), s.d1.y) &&
+                    same_bits(r.d1(i, 2), s.d1.z))
+            << i;
+        ASSERT_TRUE(same_bits(r.d2(i, 0), s.d2.x) && same_bits(r.d2(i, 1), s.d2.y) &&
+                    same_bits(r.d2(i, 2), s.d2.z))
+            << i;
+      }
+      EXPECT_GE(undefined, 3) << "vertices 3, 17 (invalid normals) and 40 (one ray)";
+    }
+  }
 }
 
 TEST(SimdKernels, TriangleIsBitIdenticalForEveryInstructionSetAndThreadCount) {

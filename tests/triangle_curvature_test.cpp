@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <utility>
@@ -11,6 +12,8 @@
 
 #include "focal/core/error.h"
 #include "focal/surfaces/surfaces.h"
+#include "kernels/triplet.h"
+#include "mesh/prepared_access.h"
 #include "test_meshes.h"
 
 namespace focal {
@@ -134,6 +137,81 @@ TEST(TriangleCurvature, DegenerateFacesAreUndefined) {
   EXPECT_EQ(static_cast<PointClass>(t.point_class[1]), PointClass::undefined);
   EXPECT_EQ(static_cast<PointClass>(t.point_class[2]), PointClass::flat);
   EXPECT_EQ(t.K[2], 0.0);
+}
+
+/// x and y have the same bits (NaN included).
+bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
+
+bool same_row(const RowMatrixX3d& m, Eigen::Index f, const kernels::Vec3<double>& v) {
+  return same_bits(m(f, 0), v.x) && same_bits(m(f, 1), v.y) && same_bits(m(f, 2), v.z);
+}
+
+// The per-face lane kernel is kernels/triplet.h's characteristic equation, the formula the
+// device's per-triangle and image-space kernels run in float: run on plain doubles, one face at
+// a time, it gives every field's bits, for clean and noisy normals and for the faces the lanes
+// handle by select (a zero normal, a collinear face, a repeated corner).
+TEST(TriangleCurvature, TheLaneKernelIsTheSharedFormulaOnScalarsBitForBit) {
+  std::vector<Mesh> meshes;
+  meshes.push_back(surface(SurfaceKind::saddle, Triangulation::irregular, 1500).mesh);
+  meshes.push_back(surface(SurfaceKind::torus, Triangulation::regular, 1500).mesh);
+  Mesh noisy = surface(SurfaceKind::ellipsoid, Triangulation::irregular, 1500).mesh;
+  std::mt19937 random(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (Eigen::Index i = 0; i < noisy.N.rows(); ++i) {
+    noisy.N.row(i) += Eigen::RowVector3d(noise(random), noise(random), noise(random));
+  }
+  noisy.N.row(7).setZero();
+  const Eigen::RowVector3i corners = noisy.F.row(11);
+  noisy.F.row(11) << corners(0), corners(0), corners(1);  // a repeated corner
+  meshes.push_back(noisy);
+  for (const Mesh& m : meshes) {
+    const TriangleCurvatureResult t = triangle_curvature(m.V, m.F, m.N);
+    std::vector<char> ok;
+    const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+    const double zero = CurvatureOptions{}.zero_tolerance / mean_edge_length(m.V, m.F);
+    int undefined = 0;
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+      kernels::Vec3<double> p[3], n[3];
+      bool valid = true;
+      for (int c = 0; c < 3; ++c) {
+        const int v = m.F(f, c);
+        p[c] = {m.V(v, 0), m.V(v, 1), m.V(v, 2)};
+        n[c] = {unit(v, 0), unit(v, 1), unit(v, 2)};
+        valid = valid && ok[static_cast<std::size_t>(v)];
+      }
+      const triplet::Equation<double> e = triplet::characteristic_equation(p, n, valid);
+      if (!e.valid) {
+        ++undefined;
+        ASSERT_EQ(static_cast<PointClass>(t.point_class[f]), PointClass::undefined) << f;
+        ASSERT_TRUE(std::isnan(t.K[f]) && std::isnan(t.d1(f, 0)) && std::isnan(t.slit2(f, 2)));
+        continue;
+      }
+      ASSERT_TRUE(same_bits(t.A[f], e.A) && same_bits(t.B[f], e.B) && same_bits(t.C[f], e.C)) << f;
+      ASSERT_TRUE(same_bits(t.K[f], e.K) && same_bits(t.H[f], e.H)) << f;
+      ASSERT_TRUE(same_bits(t.k1[f], e.k1) && same_bits(t.k2[f], e.k2)) << f;
+      ASSERT_TRUE(same_bits(t.lambda1[f], e.lambda1) && same_bits(t.lambda2[f], e.lambda2)) << f;
+      ASSERT_TRUE(
+          same_bits(t.shape_operator(f, 0), e.M.a) && same_bits(t.shape_operator(f, 1), e.M.b) &&
+          same_bits(t.shape_operator(f, 2), e.M.c) && same_bits(t.shape_operator(f, 3), e.M.d))
+          << f;
+      const triplet::Directions<double> d = triplet::directions_of(e);
+      ASSERT_TRUE(same_row(t.d1, f, d.d1) && same_row(t.d2, f, d.d2)) << f;
+      ASSERT_TRUE(same_row(t.slit1, f, d.slit1) && same_row(t.slit2, f, d.slit2)) << f;
+      ASSERT_TRUE(same_row(t.face_normal, f, e.frame.n)) << f;
+      ASSERT_EQ(t.point_class[f],
+                kernels::classify(e.k1, e.k2, zero, CurvatureOptions{}.umbilic_tolerance))
+          << f;
+    }
+    EXPECT_LT(undefined, m.F.rows() / 10);
+    if (&m == &meshes.back()) {  // at least the faces at vertex 7 and face 11
+      int expected = 0;
+      for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+        expected += f == 11 || (m.F.row(f).array() == 7).any();
+      }
+      EXPECT_GE(undefined, expected);
+      EXPECT_GE(expected, 4);
+    }
+  }
 }
 
 TEST(TriangleCurvature, InvalidArgumentsThrow) {

@@ -48,53 +48,18 @@ struct FitContext {
   const int* vertices = nullptr;
 };
 
-/// One vertex's rays and weights. Owned by a block of vertices, so that the loop over vertices
-/// never touches the heap once the vectors have grown to the largest ring.
-struct RayScratch {
-  std::vector<NormalRay> rays;
-  std::vector<double> weights;  // empty for uniform weights
-};
-
-SlitFit run_solver(const CurvatureOptions& o, std::span<const NormalRay> rays,
-                   std::span<const double> weights) {
-  return o.solver == Solver::closed_form
-             ? detail::closed_form_fit(rays, weights)
-             : fit_two_slits_levenberg_marquardt(rays, weights, o.levenberg_marquardt);
-}
-
-/// The rays of vertex i's neighbours in its tangent frame (paper 4.1); returns how many
-/// neighbours had none (normal outside the hemisphere, or invalid).
-int gather_rays(const FitContext& c, int i, const TangentFrame& frame, RayScratch& s) {
-  const detail::VertexFitInput& in = c.in;
-  const Eigen::Vector3d p = in.V.row(i).transpose();
-  int excluded = 0;
-  for (const int* j = in.rings.begin(i); j != in.rings.end(i); ++j) {
-    const Eigen::Vector3d q = in.V.row(*j).transpose();
-    // The ray is made in its slot: copying a just-written NormalRay into the vector stalled on
-    // store forwarding (a fifth of the fit's time).
-    NormalRay& ray = s.rays.emplace_back();
-    if (!in.normal_ok[static_cast<std::size_t>(*j)] ||
-        !detail::ray_of(frame, p, q, in.unit_normals.row(*j).transpose(), ray)) {
-      s.rays.pop_back();
-      ++excluded;
-      continue;
-    }
-    if (c.options.weighting == RayWeighting::gaussian) {
-      s.weights.push_back(std::exp(-(q - p).squaredNorm() * c.inverse_two_width_squared));
-    }
-  }
-  return excluded;
-}
-
-void fit_vertex(const FitContext& c, int i, RayScratch& s, CurvatureResult& r) {
-  s.rays.clear();
-  s.weights.clear();
+/// The Levenberg-Marquardt fit of vertex i (the closed form of every vertex runs in the lane
+/// kernel below), on two_slit_detail.h's gather.
+void fit_vertex(const FitContext& c, int i, detail::VertexRays& s, CurvatureResult& r) {
   r.rays_used[i] = r.rays_excluded[i] = 0;
   if (!c.in.normal_ok[static_cast<std::size_t>(i)]) return detail::store_undefined(r, i);
   const TangentFrame frame = detail::frame_of(c.in.unit_normals.row(i).transpose());
-  r.rays_excluded[i] = gather_rays(c, i, frame, s);
+  const double inverse =
+      c.options.weighting == RayWeighting::gaussian ? c.inverse_two_width_squared : 0.0;
+  r.rays_excluded[i] = detail::gather_rays(c.in, i, frame, inverse, {}, s);
   r.rays_used[i] = static_cast<int>(s.rays.size());
-  const SlitFit fit = run_solver(c.options, s.rays, s.weights);
+  const SlitFit fit =
+      fit_two_slits_levenberg_marquardt(s.rays, s.weights, c.options.levenberg_marquardt);
   if (!fit.valid) return detail::store_undefined(r, i);
   double weight_sum = static_cast<double>(s.rays.size());
   if (!s.weights.empty()) {
@@ -115,6 +80,13 @@ void fit_vertex(const FitContext& c, int i, RayScratch& s, CurvatureResult& r) {
 // depend on its group: every instruction set, group width and thread count gives the same bits.
 // Lanes with a degenerate fit (too few rays, singular system, invalid normal) get NaN and
 // `undefined` by select, as store_undefined gives them in the scalar path.
+//
+// A tuned driver of kernels/two_slit.h (the plain one is two_slit_detail.h's). What it must
+// match: each lane has the bits of the same formulas run on plain doubles one vertex at a time
+// (kernels::frame_of, kernels::normal_ray and principal_axes with reciprocal quotients,
+// add_ray in neighbour order, solve_slits, slit_misfit; tests/simd_kernels_test.cpp), and agrees
+// with the scalar closed form (fit_two_slits_closed_form, whose ray slopes and direction are
+// divided exactly) to rounding.
 
 using detail::broadcast;
 using detail::lane_count;
@@ -421,7 +393,7 @@ CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& o
   // groups of any lane width, so a group never straddles two threads' output.
   parallel_for_blocks(in.V.rows(), 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
     if (options.solver == Solver::closed_form) return fit_block(context, begin, end, result);
-    RayScratch scratch;
+    detail::VertexRays scratch;
     for (auto i = begin; i < end; ++i) fit_vertex(context, static_cast<int>(i), scratch, result);
   });
   return result;

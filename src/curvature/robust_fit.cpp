@@ -12,28 +12,22 @@ namespace focal::detail {
 namespace {
 
 struct Rays {
-  std::vector<NormalRay> rays;
+  VertexRays gathered;          ///< the rays (its weights: scratch of gather)
   std::vector<double> base;     ///< Gaussian (or 1) weight of each ray
   std::vector<double> weights;  ///< base x robust weight
   std::vector<double> misfit;   ///< |W x - g| at the current solution
   std::vector<double> sorted;
 };
 
-/// The rays of i's neighbours (not skipped, normal in i's hemisphere) in i's frame.
+/// The rays of i's neighbours (not skipped, normal in i's hemisphere) in i's frame
+/// (gather_rays), and their base weights.
 void gather(const RobustFitInput& in, int i, const TangentFrame& frame, Rays& s) {
-  const VertexFitInput& f = in.fit;
-  const Eigen::Vector3d p = f.V.row(i).transpose();
   const double inverse = in.gaussian_width > 0 ? 0.5 / (in.gaussian_width * in.gaussian_width) : 0;
-  s.rays.clear();
-  s.base.clear();
-  for (const int* j = f.rings.begin(i); j != f.rings.end(i); ++j) {
-    if (!f.normal_ok[static_cast<std::size_t>(*j)]) continue;
-    if (!in.skip.empty() && in.skip[static_cast<std::size_t>(*j)]) continue;
-    const Eigen::Vector3d q = f.V.row(*j).transpose();
-    NormalRay ray;
-    if (!ray_of(frame, p, q, f.unit_normals.row(*j).transpose(), ray)) continue;
-    s.rays.push_back(ray);
-    s.base.push_back(std::exp(-(q - p).squaredNorm() * inverse));
+  gather_rays(in.fit, i, frame, inverse, in.skip, s.gathered);
+  if (s.gathered.weights.empty()) {
+    s.base.assign(s.gathered.rays.size(), 1.0);
+  } else {
+    s.base.swap(s.gathered.weights);
   }
 }
 
@@ -49,7 +43,7 @@ int reject(Rays& s) {
   s.sorted = s.misfit;
   const double cut = kRejectionScales * 1.4826 * median_of(s.sorted);
   int rejected = 0;
-  for (std::size_t k = 0; k < s.rays.size(); ++k) {
+  for (std::size_t k = 0; k < s.gathered.rays.size(); ++k) {
     const bool keep = !(s.misfit[k] > cut) || !(cut > 0.0);
     s.weights[k] = keep ? s.base[k] : 0.0;
     rejected += keep ? 0 : 1;
@@ -58,9 +52,9 @@ int reject(Rays& s) {
 }
 
 void measure_misfit(const kernels::SlitSolution<double>& w, Rays& s) {
-  s.misfit.resize(s.rays.size());
-  for (std::size_t k = 0; k < s.rays.size(); ++k) {
-    const NormalRay& r = s.rays[k];
+  s.misfit.resize(s.gathered.rays.size());
+  for (std::size_t k = 0; k < s.gathered.rays.size(); ++k) {
+    const NormalRay& r = s.gathered.rays[k];
     s.misfit[k] = std::sqrt(kernels::slit_misfit(w, r.u, r.v, r.sigma, r.tau));
   }
 }
@@ -79,17 +73,17 @@ bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& t
   gather(in, i, frame, s);
   s.weights = s.base;
   kernels::SlitSolution<double> w;
-  if (!solve_well_conditioned(accumulate(s.rays, s.weights), w)) {
+  if (!solve_well_conditioned(accumulate(s.gathered.rays, s.weights), w)) {
     store_undefined(r, row);
     return false;
   }
   bool rejected = false;
-  for (int round = 0; round < kRejectionRounds && !s.rays.empty(); ++round) {
+  for (int round = 0; round < kRejectionRounds && !s.gathered.rays.empty(); ++round) {
     measure_misfit(w, s);
     if (reject(s) == 0) break;
     kernels::SlitSolution<double> next;
     // Too few rays left (a vertex whose neighbours mostly disagree): keep the last fit.
-    if (!solve_well_conditioned(accumulate(s.rays, s.weights), next)) break;
+    if (!solve_well_conditioned(accumulate(s.gathered.rays, s.weights), next)) break;
     w = next;
     rejected = true;
   }
@@ -103,7 +97,7 @@ bool robust_fit_vertex(const RobustFitInput& in, int i, const ClassTolerances& t
   r.rays_used[row] = used;
   r.rays_excluded[row] = f.rings.size(i) - used;
   store_vertex(r, row, frame, principal_from_symmetric(w.a, w.b, w.c),
-               std::sqrt(energy_of(s.rays, s.weights, w) / weight_sum), tolerances);
+               std::sqrt(energy_of(s.gathered.rays, s.weights, w) / weight_sum), tolerances);
   return rejected;
 }
 

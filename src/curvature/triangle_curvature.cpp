@@ -19,6 +19,7 @@
 #include "focal/core/error.h"
 #include "focal/curvature/normal_rays.h"
 #include "kernels/local_shape.h"
+#include "kernels/triplet.h"
 #include "kernels/vec3.h"
 #include "mesh/prepared_access.h"
 #include "mesh/topology.h"
@@ -60,20 +61,18 @@ TriangleCurvatureResult unwritten_faces(Eigen::Index m, const TriangleFields& wa
 
 // ---- The per-face solve, one face per lane.
 //
-// Faces in groups of the lane width (simd_lanes.h): the three vertex rays in the frame of the
-// face's mean normal (kernels::frame_of and normal_ray), the characteristic
-// equation with the sagitta shift, the curvatures and, where asked, directions, slits and the
-// shape operator, all as selects per lane; faces without a solution get NaN and `undefined`. No
-// lane reads another, so every instruction set and thread count gives the same bits.
+// Faces in groups of the lane width (simd_lanes.h), each lane running the characteristic
+// equation of kernels/triplet.h (the formula the device's per-triangle and image-space kernels
+// run in float): the three vertex rays in the frame of the face's mean normal, the sagitta
+// shift, the curvatures and, where asked, directions, slits and the shape operator, all as
+// selects per lane; faces without a solution get NaN and `undefined`. No lane reads another, so
+// every instruction set and thread count gives the same bits, those of the formula on scalar
+// doubles (tests/triangle_curvature_test.cpp compares the two).
 
 using detail::broadcast;
-using detail::lane_abs;
 using detail::lane_count;
-using detail::lane_sqrt;
 using detail::lanes_of;
 using detail::MaskOf;
-using kernels::is_finite;
-using kernels::Quotient;
 using kernels::Vec3;
 
 /// What the per-vertex averaging reads of a solved face, written once per face by the face
@@ -98,45 +97,6 @@ struct FaceInput {
   FaceRecord* records = nullptr;  ///< where set, row f of F's record is written there too
 };
 
-/// A 2x2 matrix per lane, as in the file's scalar formulas: columns are the edges 0->1, 0->2.
-template <class L>
-struct alignas(sizeof(L)) Lanes2x2 {
-  L m00, m01, m10, m11;
-  [[nodiscard]] L determinant() const { return m00 * m11 - m10 * m01; }
-  [[nodiscard]] L squared_norm() const { return (m00 * m00 + m10 * m10) + (m01 * m01 + m11 * m11); }
-};
-
-/// G X^-1 (Eigen's 2x2 inverse: one reciprocal of the determinant).
-template <class L>
-FOCAL_LANE_INLINE Lanes2x2<L> times_inverse(const Lanes2x2<L>& G, const Lanes2x2<L>& X) {
-  const L inv = 1.0 / X.determinant();
-  const L i00 = X.m11 * inv, i01 = -X.m01 * inv, i10 = -X.m10 * inv, i11 = X.m00 * inv;
-  return {G.m00 * i00 + G.m01 * i10, G.m00 * i01 + G.m01 * i11, G.m10 * i00 + G.m11 * i10,
-          G.m10 * i01 + G.m11 * i11};
-}
-
-/// slit_direction per lane: the unit slit in the face plane at depth lambda, zero where both
-/// candidate vectors vanish.
-template <class L>
-FOCAL_LANE_INLINE void slit_lanes(const Lanes2x2<L>& X, const Lanes2x2<L>& G, L lambda, L& sx,
-                                  L& sy) {
-  const auto infinite = lane_abs(lambda) == std::numeric_limits<double>::infinity();
-  const L ax = infinite ? G.m00 : X.m00 + lambda * G.m00;
-  const L ay = infinite ? G.m10 : X.m10 + lambda * G.m10;
-  const L bx = infinite ? G.m01 : X.m01 + lambda * G.m01;
-  const L by = infinite ? G.m11 : X.m11 + lambda * G.m11;
-  const L a2 = ax * ax + ay * ay, b2 = bx * bx + by * by;
-  const auto a_longer = a2 >= b2;
-  const L lx = a_longer ? ax : bx, ly = a_longer ? ay : by, l2 = a_longer ? a2 : b2;
-  const L g = lane_sqrt(G.squared_norm());
-  const L scale = lane_sqrt(X.squared_norm()) + (infinite ? g : lane_abs(lambda) * g);
-  const L length = lane_sqrt(l2);
-  const auto nonzero = length > 1e-9 * scale;
-  const L zero{};
-  sx = nonzero ? lx / length : zero;
-  sy = nonzero ? ly / length : zero;
-}
-
 /// Stores lanes [0, active) of x at rows first... of v (one vector store for a whole group).
 template <class L>
 FOCAL_LANE_INLINE void store_scalars(Eigen::VectorXd& v, std::int64_t first, int active, L x) {
@@ -154,23 +114,23 @@ FOCAL_LANE_INLINE void store_rows(RowMatrixX3d& m, std::int64_t first, int activ
 /// `0.5 * (b - a).cross(c - a).norm()` (kernels/vec3.h keeps Eigen's order), which the averaging
 /// computed at each of the face's corners before, so the area keeps its bits.
 template <class L>
-FOCAL_LANE_INLINE L face_area_of(const L (&px)[3], const L (&py)[3], const L (&pz)[3]) {
-  const Vec3<L> a{px[0], py[0], pz[0]}, b{px[1], py[1], pz[1]}, c{px[2], py[2], pz[2]};
-  return 0.5 * kernels::norm(kernels::cross(b - a, c - a));
+FOCAL_LANE_INLINE L face_area_of(const Vec3<L> (&p)[3]) {
+  return 0.5 * kernels::norm(kernels::cross(p[1] - p[0], p[2] - p[0]));
 }
 
 /// The records (FaceRecord) of faces [first, first + active) from their frame, shape operator M
 /// and area.
 template <class L>
 FOCAL_LANE_INLINE void store_records(FaceRecord* records, int active,
-                                     const kernels::Frame<L>& frame, const Lanes2x2<L>& M, L area) {
-  const L s01 = 0.5 * (M.m01 + M.m10);
+                                     const kernels::Frame<L>& frame, const triplet::Mat2<L>& M,
+                                     L area) {
+  const L s01 = 0.5 * (M.b + M.c);
   for (int l = 0; l < active; ++l) {
     FaceRecord& r = records[l];
     r.n[0] = frame.n.x[l], r.n[1] = frame.n.y[l], r.n[2] = frame.n.z[l];
     r.x[0] = frame.x.x[l], r.x[1] = frame.x.y[l], r.x[2] = frame.x.z[l];
     r.y[0] = frame.y.x[l], r.y[1] = frame.y.y[l], r.y[2] = frame.y.z[l];
-    r.s00 = M.m00[l], r.s01 = s01[l], r.s11 = M.m11[l];
+    r.s00 = M.a[l], r.s01 = s01[l], r.s11 = M.d[l];
     r.area = area[l];
   }
 }
@@ -188,120 +148,64 @@ FOCAL_LANE_INLINE void solve_face_group(const FaceInput& in, std::int64_t first,
   const auto column = [&](const auto& matrix, int c, int col) FOCAL_LANE_LAMBDA {
     return lanes_of<L>([&](int l) { return matrix(corner[c][l], col); });
   };
-  L px[3], py[3], pz[3], mx[3], my[3], mz[3];
+  Vec3<L> p[3], n[3];
   auto valid = lanes_of<L>([](int l) { return static_cast<double>(l); }) < active;
   for (int c = 0; c < 3; ++c) {
-    px[c] = column(in.V, c, 0), py[c] = column(in.V, c, 1), pz[c] = column(in.V, c, 2);
-    mx[c] = column(in.N, c, 0), my[c] = column(in.N, c, 1), mz[c] = column(in.N, c, 2);
+    p[c] = {column(in.V, c, 0), column(in.V, c, 1), column(in.V, c, 2)};
+    n[c] = {column(in.N, c, 0), column(in.N, c, 1), column(in.N, c, 2)};
     valid &= lanes_of<MaskOf<L>>([&](int l) {
       return in.ok[static_cast<std::size_t>(corner[c][l])] ? std::int64_t{-1} : std::int64_t{0};
     });
   }
-  // The frame of the mean normal; the centroid as origin.
-  const L sx = mx[0] + mx[1] + mx[2], sy = my[0] + my[1] + my[2], sz = mz[0] + mz[1] + mz[2];
-  const L length = lane_sqrt(sx * sx + sy * sy + sz * sz);
-  valid &= (length > 0.0) & is_finite(length);
-  const L one = broadcast<L>(1.0), zero{};
-  // Reciprocals times, not divisions: the divider is the kernel's narrowest port (17 divisions
-  // per group became 7; each result moves by at most an ulp).
-  const L inv_length = 1.0 / length;
-  const kernels::Frame<L> frame =
-      kernels::frame_of(Vec3<L>{valid ? sx * inv_length : zero, valid ? sy * inv_length : zero,
-                                valid ? sz * inv_length : one});
-  const double third = 1.0 / 3.0;
-  const Vec3<L> centroid{(px[0] + px[1] + px[2]) * third, (py[0] + py[1] + py[2]) * third,
-                         (pz[0] + pz[1] + pz[2]) * third};
-  L u[3], v[3], sigma[3], tau[3], ox[3], oy[3];
-  for (int c = 0; c < 3; ++c) {  // the vertex's ray (slopes by a reciprocal) and tangential offset
-    const Vec3<L> q = Vec3<L>{px[c], py[c], pz[c]} - centroid;
-    kernels::NormalRay<L> ray;
-    valid &= kernels::normal_ray<Quotient::reciprocal>(frame, q, Vec3<L>{mx[c], my[c], mz[c]},
-                                                       Vec3<L>{mx[c], my[c], mz[c]}, ray);
-    sigma[c] = ray.sigma, tau[c] = ray.tau, u[c] = ray.u, v[c] = ray.v;
-    ox[c] = kernels::dot(frame.x, q);
-    oy[c] = kernels::dot(frame.y, q);
-  }
-  Lanes2x2<L> X{u[1] - u[0], u[2] - u[0], v[1] - v[0], v[2] - v[0]};
-  const Lanes2x2<L> G{sigma[1] - sigma[0], sigma[2] - sigma[0], tau[1] - tau[0], tau[2] - tau[0]};
-  valid &= lane_abs(X.determinant()) > 1e-14 * X.squared_norm();  // area in the ray frame
-  // The centroid lies below the surface by the sagitta s = (1/6) sum x^T M x (second order,
-  // x the vertices' tangential offsets). Depths measured from the centroid's plane would carry
-  // that O(h^2) bias into K and H, so the rays are re-parametrised on the plane z = s, the
-  // tangent plane at the surface point above the centroid: (u, v) += s (sigma, tau).
-  const Lanes2x2<L> M0 = times_inverse(G, X);
-  const L s01 = 0.5 * (M0.m01 + M0.m10);
-  L sagitta{};
-  for (int c = 0; c < 3; ++c) {
-    sagitta += ox[c] * (M0.m00 * ox[c] + s01 * oy[c]) + oy[c] * (s01 * ox[c] + M0.m11 * oy[c]);
-  }
-  sagitta *= 1.0 / 6.0;
-  X.m00 += sagitta * G.m00, X.m01 += sagitta * G.m01;
-  X.m10 += sagitta * G.m10, X.m11 += sagitta * G.m11;
-  const L A = G.determinant();
-  const L B = G.m00 * X.m11 - G.m01 * X.m10 - G.m10 * X.m01 + G.m11 * X.m00;
-  const L C = X.determinant();
-  valid &= lane_abs(C) > 1e-14 * X.squared_norm();
-  const L inv_C = 1.0 / C;
-  const L K = A * inv_C, H = 0.5 * (B * inv_C);
-  // H^2 < K only through rounding or a non-symmetric M (noise): the double root H.
-  const L root = lane_sqrt(kernels::max_of(H * H - K, zero));
-  const L k1 = H + root, k2 = H - root;
+  const triplet::Equation<L> e = triplet::characteristic_equation(p, n, valid);
+  const kernels::Frame<L>& frame = e.frame;
   const L nan = broadcast<L>(std::numeric_limits<double>::quiet_NaN());
-  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return valid ? x : nan; };
+  const auto or_nan = [&](L x) FOCAL_LANE_LAMBDA { return e.valid ? x : nan; };
   const TriangleFields& want = in.want;
   if (want.coefficients) {
-    store_scalars(r.A, first, active, or_nan(A)), store_scalars(r.B, first, active, or_nan(B));
-    store_scalars(r.C, first, active, or_nan(C));
+    store_scalars(r.A, first, active, or_nan(e.A)), store_scalars(r.B, first, active, or_nan(e.B));
+    store_scalars(r.C, first, active, or_nan(e.C));
   }
   if (want.curvatures) {
-    store_scalars(r.K, first, active, or_nan(K)), store_scalars(r.H, first, active, or_nan(H));
-    store_scalars(r.k1, first, active, or_nan(k1)), store_scalars(r.k2, first, active, or_nan(k2));
+    store_scalars(r.K, first, active, or_nan(e.K)), store_scalars(r.H, first, active, or_nan(e.H));
+    store_scalars(r.k1, first, active, or_nan(e.k1));
+    store_scalars(r.k2, first, active, or_nan(e.k2));
   }
-  const L lambda1 = -1.0 / k1, lambda2 = -1.0 / k2;
   if (want.focal_depths) {
-    store_scalars(r.lambda1, first, active, or_nan(lambda1));
-    store_scalars(r.lambda2, first, active, or_nan(lambda2));
+    store_scalars(r.lambda1, first, active, or_nan(e.lambda1));
+    store_scalars(r.lambda2, first, active, or_nan(e.lambda2));
   }
-  if (in.records) {
-    store_records(in.records + first, active, frame, times_inverse(G, X), face_area_of(px, py, pz));
-  }
-  if (want.directions || want.slits || want.shape_operator) {
-    const Lanes2x2<L> M = times_inverse(G, X);  // M on the shifted X
-    if (want.shape_operator) {
-      double* row = r.shape_operator.data() + 4 * first;
-      const L m00 = or_nan(M.m00), m01 = or_nan(M.m01), m10 = or_nan(M.m10), m11 = or_nan(M.m11);
-      for (int l = 0; l < active; ++l) {
-        row[4 * l] = m00[l], row[4 * l + 1] = m01[l], row[4 * l + 2] = m10[l];
-        row[4 * l + 3] = m11[l];
-      }
+  // In double the equation is solved in world units (triplet::Precision): e.M is the shape
+  // operator itself.
+  static_assert(!triplet::Precision<double>::scaled);
+  if (in.records) store_records(in.records + first, active, frame, e.M, face_area_of(p));
+  if (want.shape_operator) {
+    double* row = r.shape_operator.data() + 4 * first;
+    const L m00 = or_nan(e.M.a), m01 = or_nan(e.M.b), m10 = or_nan(e.M.c), m11 = or_nan(e.M.d);
+    for (int l = 0; l < active; ++l) {
+      row[4 * l] = m00[l], row[4 * l + 1] = m01[l], row[4 * l + 2] = m10[l];
+      row[4 * l + 3] = m11[l];
     }
-    if (want.directions || want.slits) {
-      const kernels::Principal<L> p =
-          kernels::principal_axes<Quotient::reciprocal, Quotient::reciprocal>(
-              M.m00, 0.5 * (M.m01 + M.m10), M.m11);
-      // frame.from_plane of d1 and of d2 = d1 turned by +90 degrees.
-      const auto to_3d = [&](L a, L b, RowMatrixX3d& m) FOCAL_LANE_LAMBDA {
-        const Vec3<L> w = frame.from_plane(a, b);
-        store_rows(m, first, active, or_nan(w.x), or_nan(w.y), or_nan(w.z));
-      };
-      if (want.directions) to_3d(p.d1x, p.d1y, r.d1), to_3d(-p.d1y, p.d1x, r.d2);
-      if (want.slits) {
-        // Where eq. 18 is degenerate (umbilic) the slits are the principal lines: slit1 along d2.
-        L s1x, s1y, s2x, s2y;
-        slit_lanes(X, G, lambda1, s1x, s1y);
-        slit_lanes(X, G, lambda2, s2x, s2y);
-        const auto empty1 = s1x * s1x + s1y * s1y == 0.0, empty2 = s2x * s2x + s2y * s2y == 0.0;
-        to_3d(empty1 ? -p.d1y : s1x, empty1 ? p.d1x : s1y, r.slit1);
-        to_3d(empty2 ? p.d1x : s2x, empty2 ? p.d1y : s2y, r.slit2);
-      }
+  }
+  if (want.directions || want.slits) {
+    const kernels::Principal<L> d = triplet::principal_directions(e);
+    const auto to_3d = [&](L a, L b, RowMatrixX3d& m) FOCAL_LANE_LAMBDA {
+      const Vec3<L> w = frame.from_plane(a, b);
+      store_rows(m, first, active, or_nan(w.x), or_nan(w.y), or_nan(w.z));
+    };
+    if (want.directions) to_3d(d.d1x, d.d1y, r.d1), to_3d(-d.d1y, d.d1x, r.d2);
+    if (want.slits) {
+      L s1x, s1y, s2x, s2y;
+      triplet::slits_in_plane(e, d, s1x, s1y, s2x, s2y);
+      to_3d(s1x, s1y, r.slit1), to_3d(s2x, s2y, r.slit2);
     }
   }
   if (want.face_normal) {
     store_rows(r.face_normal, first, active, or_nan(frame.n.x), or_nan(frame.n.y),
                or_nan(frame.n.z));
   }
-  const auto point_class = valid ? kernels::classify(k1, k2, in.tol.zero, in.tol.umbilic)
-                                 : kernels::class_code<L>(PointClass::undefined);
+  const auto point_class = e.valid ? kernels::classify(e.k1, e.k2, in.tol.zero, in.tol.umbilic)
+                                   : kernels::class_code<L>(PointClass::undefined);
   for (int l = 0; l < active; ++l) {
     r.point_class[first + l] = static_cast<std::uint8_t>(point_class[l]);
   }

@@ -1,18 +1,63 @@
 #pragma once
-// The closed-form two-slit fit of one ray set in double, inline, on kernels/two_slit.h's
-// arithmetic (the per-vertex estimator's lane kernel runs the same): two_slit_fit.cpp wraps it as
-// fit_two_slits_closed_form and shares the well-posedness test with the Levenberg-Marquardt
-// solver.
+// The scalar driver of the two-slit fit (kernels/two_slit.h's arithmetic) in double, inline: the
+// rays of one vertex's neighbours (gather_rays), the normal equations over them, their solve and
+// the closed-form fit of one ray set. two_slit_fit.cpp wraps it as fit_two_slits_closed_form and
+// shares the well-posedness test with the Levenberg-Marquardt solver; curvature.cpp's
+// Levenberg-Marquardt path and robust_fit.cpp fit vertex by vertex on it. The closed form of
+// every vertex runs in curvature.cpp's lane kernel instead, a tuned driver of the same formula
+// (see there for what it must match).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <span>
+#include <vector>
 
+#include "curvature/normal_rays_detail.h"
+#include "curvature/vertex_fit.h"
 #include "curvature/vertex_rows.h"
 #include "focal/curvature/two_slit_fit.h"
 #include "kernels/two_slit.h"
 
 namespace focal::detail {
+
+/// One vertex's rays and weights. Owned by a block of vertices (or a thread), so that the loop
+/// over vertices never touches the heap once the vectors have grown to the largest ring.
+struct VertexRays {
+  std::vector<NormalRay> rays;
+  std::vector<double> weights;  ///< empty for uniform weights
+};
+
+/// The rays of vertex i's neighbours in i's tangent frame (paper 4.1) into `out` (cleared
+/// first), with the weights exp(-|q - p|^2 inverse_two_width_squared) where that factor is > 0
+/// and none (uniform weights) where it is 0. A neighbour with an invalid normal, one flagged in
+/// `skip` (#V flags, or empty) and one whose ray does not exist (ray_of) gives no ray; returns
+/// how many gave none.
+inline int gather_rays(const VertexFitInput& in, int i, const TangentFrame& frame,
+                       double inverse_two_width_squared, std::span<const char> skip,
+                       VertexRays& out) {
+  out.rays.clear();
+  out.weights.clear();
+  const Eigen::Vector3d p = in.V.row(i).transpose();
+  int excluded = 0;
+  for (const int* j = in.rings.begin(i); j != in.rings.end(i); ++j) {
+    const auto k = static_cast<std::size_t>(*j);
+    const Eigen::Vector3d q = in.V.row(*j).transpose();
+    // The ray is made in its slot: copying a just-written NormalRay into the vector stalls on
+    // store forwarding.
+    NormalRay& ray = out.rays.emplace_back();
+    if (!in.normal_ok[k] || (!skip.empty() && skip[k]) ||
+        !ray_of(frame, p, q, in.unit_normals.row(*j).transpose(), ray)) {
+      out.rays.pop_back();
+      ++excluded;
+      continue;
+    }
+    if (inverse_two_width_squared > 0.0) {
+      out.weights.push_back(std::exp(-(q - p).squaredNorm() * inverse_two_width_squared));
+    }
+  }
+  return excluded;
+}
 
 inline double weight_at(std::span<const double> weights, std::size_t i) {
   return weights.empty() ? 1.0 : weights[i];

@@ -11,10 +11,11 @@
 //
 // Rounding. Where a formula divides two numerators by one denominator the estimators made
 // different choices before this header held the formula once, and each keeps its own so that its
-// results stay bit for bit (Quotient): the lane kernels and the CUDA per-vertex fit multiply by
-// one reciprocal (the divider is the lane kernels' narrowest port), the Eigen path divides the
-// ray's slopes and the principal direction, the triplet (image space, CUDA per-triangle) divides
-// everywhere. The choices move a result by an ulp at most.
+// results stay bit for bit (Quotient): the lane kernels, the CUDA per-vertex fit and the
+// characteristic equation of kernels/triplet.h (the per-triangle solve on the CPU and the device,
+// image space) multiply by one reciprocal (the divider is the lane kernels' narrowest port), the
+// Eigen path divides the ray's slopes and the principal direction, the image-space window divides
+// both of its principal axes' quotients. The choices move a result by an ulp at most.
 
 #include "focal/core/point_class.h"
 #include "kernels/host_device.h"

@@ -1,7 +1,8 @@
 #pragma once
 // The per-face body of the CUDA per-triangle estimator (src/cuda/triangle_fit.cu) in plain data,
 // so that the CPU runs exactly the same code (cuda/triangle_fit.cpp: triangle_curvature_float) and
-// tests compare it with triangle_curvature in double.
+// tests compare it with triangle_curvature in double: the characteristic equation of
+// kernels/triplet.h, the one triangle_curvature runs, in float.
 
 #include <cstdint>
 

@@ -4,12 +4,14 @@
 // minimise E = sum_i w_i |W x_i - g_i|^2, a linear least-squares problem in (a, b, c). The
 // eigenvalues of W are k1, k2 (kernels/local_shape.h's principal_axes).
 //
-// The one copy of the fit's arithmetic, for every path: the CPU lane kernel of the per-vertex
-// estimator (curvature/curvature.cpp, GCC vector types), the scalar closed form and the
-// Levenberg-Marquardt solver's well-posedness test (curvature/two_slit_detail.h, double) and
-// the CUDA per-vertex kernel (kernels/vertex_fit.h, float). Templates on the element type of
-// kernels/vec3.h; no branches on values, so lanes run the same source. Plain data: nvcc
-// compiles this header.
+// The one copy of the fit's arithmetic, with three drivers: the scalar one in double
+// (curvature/two_slit_detail.h: a vertex's rays, the closed form on them, the
+// Levenberg-Marquardt solver's well-posedness test; the Levenberg-Marquardt and robust per-vertex
+// fits), the CPU lane kernel of the closed-form per-vertex estimator (curvature/curvature.cpp,
+// GCC vector types; tuned, with the bits of these formulas on scalar doubles) and the CUDA
+// per-vertex kernel (kernels/vertex_fit.h, float, its data as float pairs). Templates on the
+// element type of kernels/vec3.h; no branches on values, so lanes run the same source. Plain
+// data: nvcc compiles this header.
 
 #include "kernels/host_device.h"
 #include "kernels/vec3.h"
