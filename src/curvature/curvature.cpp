@@ -70,8 +70,8 @@ int gather_rays(const FitContext& c, int i, const TangentFrame& frame, RayScratc
   int excluded = 0;
   for (const int* j = in.rings.begin(i); j != in.rings.end(i); ++j) {
     const Eigen::Vector3d q = in.V.row(*j).transpose();
-    // The ray is made in its slot: copying a just-written NormalRay into the vector stalled on
-    // store forwarding (a fifth of the fit's time).
+    // The ray is made in its slot: a just-written NormalRay copied into the vector would stall
+    // on store forwarding.
     NormalRay& ray = s.rays.emplace_back();
     if (!in.normal_ok[static_cast<std::size_t>(*j)] ||
         !detail::ray_of(frame, p, q, in.unit_normals.row(*j).transpose(), ray)) {
