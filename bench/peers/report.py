@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 
 from peers import PEERS, read_ply, slug  # noqa: E402
 
-# As `at_most` in cli/eval_command.cpp: within 0.1% (the 4 digits the tables show) or both below
+# As `at_most` in cli/eval_tables.cpp: within 0.1% (the 4 digits the tables show) or both below
 # 1e-12 (exact up to rounding).
 TIE = 1e-3
 
@@ -312,7 +312,7 @@ def lowest(row, methods, key="rel_H"):
 
 
 def median(xs):
-    """As median_of in cli/eval_command.cpp: the element at n / 2 of the sorted values."""
+    """As median_of in cli/eval_tables.cpp: the element at n / 2 of the sorted values."""
     xs = sorted(xs)
     return xs[len(xs) // 2] if xs else math.nan
 

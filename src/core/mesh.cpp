@@ -21,8 +21,8 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
   const std::int64_t faces = F.rows();
   std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
   detail::parallel_for_blocks(faces, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
-    // One unsigned comparison per index (a negative one wraps above n), without branches: the
-    // short-circuit form cost 50 instructions per face.
+    // One unsigned comparison per index (a negative one wraps above n), without branches, so
+    // that the loop over the faces has no branch per index.
     const auto count = static_cast<std::uint64_t>(n);
     bool ok = true;
     for (std::int64_t f = begin; f < end; ++f) {

@@ -3,11 +3,11 @@
 // per-block) output slots (no scatter, no atomics), and the chunks of work have fixed boundaries
 // whatever the thread count, so results are identical for any thread count.
 //
-// Why not `#pragma omp parallel for schedule(static)` (issue 20): a static split waits at the
-// end of every loop for the thread the OS descheduled, and GOMP's waiting threads spin on the
-// core that thread needs (GOMP reads OMP_WAIT_POLICY / GOMP_SPINCOUNT only at process start, so
-// a library cannot turn the spin off). With one core of two busy, 2 threads ran 1.7x slower
-// than 1. Here instead:
+// Why not `#pragma omp parallel for schedule(static)`: a static split waits at the end of every
+// loop for the thread the OS descheduled, and GOMP's waiting threads spin on the core that
+// thread needs (GOMP reads OMP_WAIT_POLICY / GOMP_SPINCOUNT only at process start, so a library
+// cannot turn the spin off): on a loaded machine more threads could take longer than one. Here
+// instead:
 // - work is cut into many small chunks taken on demand, so a descheduled thread holds up at most
 //   one chunk and the others take the rest;
 // - every wait sleeps in the kernel (a condition variable), never spins: idle workers between
@@ -83,8 +83,8 @@ void parallel_for_blocks(std::int64_t n, std::int64_t block, int threads, Body&&
 }
 
 /// Asks Linux for transparent huge pages under [p, p + bytes) before it is first written: a
-/// freshly allocated result is otherwise faulted in 4 KiB at a time (at 1M vertices the fit's
-/// 97 MB cost ~24K page faults, a fifth of its time). Only the whole 2 MiB pages inside the range
+/// freshly allocated result is otherwise faulted in 4 KiB at a time (one page fault per 4 KiB
+/// of the result). Only the whole 2 MiB pages inside the range
 /// are advised; elsewhere, or where the kernel declines, nothing changes. Never affects results.
 inline void advise_huge_pages([[maybe_unused]] const void* p, [[maybe_unused]] std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)

@@ -1,7 +1,7 @@
 #pragma once
 // Internal: an order of a mesh's or a cloud's rows that keeps near points near, for the tiles
 // (tiles/tiles.cpp: consecutive runs of it) and for the work that reads neighbours' rows
-// (points/neighbours.cpp: the kd-tree's build; curvature/cloud_curvature.cpp), and copies of
+// (points/point_tree.cpp: the kd-tree's build; curvature/cloud_curvature.cpp), and copies of
 // rows in such an order (curvature/cloud_curvature.cpp: a cloud's whole fit on a copy).
 
 #include <cstdint>
@@ -26,8 +26,7 @@ struct RowPermutation {
 
 /// Bits per axis of morton_permutation: cells of 2^-10 of the box, 2^30 of them, far more than
 /// the points of any cloud whose reads they are to keep near (1M points on a torus: a cell holds
-/// one or none), sorted in two passes of morton_order's counting sort instead of four (the
-/// permutation of the 1M torus of docs/POINTS.md: 33-35 ms instead of 56-58, 2 threads).
+/// one or none), sorted in two passes of morton_order's counting sort instead of four.
 inline constexpr int kPermutationBits = 10;
 
 /// morton_order(V, threads, kPermutationBits) and its inverse.

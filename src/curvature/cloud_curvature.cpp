@@ -328,9 +328,8 @@ void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, 
   out.curvature = detail::fit_vertices(input, fit);
   if (uses_plan(options)) {
     // Both steps below visit the points along a spatial order: each reads its neighbours' rows,
-    // mostly those its predecessors have just read, where a cloud's rows often come in no order
-    // (the randomly ordered 1M torus of docs/POINTS.md: their shares of the default's samples
-    // 11.6% -> 8.3% and 10.1% -> 8.5%); each point writes its own row only, so no bit changes.
+    // mostly those its predecessors have just read, where a cloud's rows often come in no order;
+    // each point writes its own row only, so no bit changes.
     std::vector<int> order(static_cast<std::size_t>(V.rows()));
     if (spatial_rows) {
       std::iota(order.begin(), order.end(), 0);
@@ -397,8 +396,7 @@ CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, Positio
 /// estimate_cloud_curvature on a copy of the cloud in Morton order, its results taken back to the
 /// cloud's rows. The lists, the tests and the fit read each point's neighbours' rows: on a cloud
 /// whose rows come in no spatial order (scanners' and generators' files often do) each read
-/// is a cache miss, on the copy mostly a hit (the randomly ordered 1M torus of docs/POINTS.md,
-/// `--k 16`, 2 threads: 956-959 ms instead of 1,200-1,206, the copy and the way back included).
+/// is a cache miss, on the copy mostly a hit.
 /// The same bits (docs/POINTS.md, "The whole cloud in Morton order"): every list is that of the
 /// cloud's own order renamed, in the same order (ties by the cloud's rows,
 /// detail::nearest_neighbours); mean_spacing sums, and the jets sum each neighbourhood, in the

@@ -1,8 +1,8 @@
 #pragma once
 // tangent_frame() and normal_ray() inline, as Eigen adapters of kernels/local_shape.h's frame_of
 // and normal_ray (the formulas every estimator shares): the per-vertex fit calls them once per
-// vertex and once per neighbour, and out of line (with std::optional in between) they were a
-// fifth of its time. normal_rays.cpp wraps them as the public functions.
+// vertex and once per neighbour, so they are inlined there, without a std::optional in between.
+// normal_rays.cpp wraps them as the public functions.
 
 #include <Eigen/Core>
 

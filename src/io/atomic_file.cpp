@@ -180,7 +180,7 @@ void write_lines(OutputSink& sink, std::int64_t count, int threads,
     const std::int64_t n = std::min<std::int64_t>(kBlock * kBlocksPerBatch, count - first);
     detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
       // Formatted into a string object of this thread's own: the texts' objects share cache
-      // lines, and a length updated there on every append made two threads slower than one.
+      // lines, and a length updated there on every append would bounce them between threads.
       std::string text = std::move(texts[static_cast<std::size_t>(begin / kBlock)]);
       text.clear();
       for (auto i = begin; i < end; ++i) append_line(text, first + i);

@@ -128,8 +128,8 @@ MeshFindings find_problems(const PreparedMesh& mesh) {
   const int threads = mesh.threads();
   const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
   // One topology pass serves the statistics and the orientation report (each computed its own).
-  // It also builds the 1-ring from its sorted edge sides, which the estimators ask for next
-  // (building it again took a tenth of a `--paper` run).
+  // It also builds the 1-ring from its sorted edge sides, which the estimators ask for next:
+  // kept on the mesh, it is not built a second time.
   Neighbourhoods one_ring;
   const detail::MeshTopology topology =
       detail::mesh_topology(*incidence, F, detail::TopologyDetail::statistics, threads, &one_ring);

@@ -2,9 +2,7 @@
 // Internal: the kNN query and the outlier tests of points/neighbours.h in one pass, for the cloud
 // estimators (curvature/cloud_curvature.cpp). The query has just read each neighbour's position
 // (the tree's leaf-ordered copy, in cache); the tests over V's rows read them again, scattered
-// over all of V on a randomly ordered cloud. Measured on the 997,026-point torus of
-// docs/POINTS.md ("Speed and memory"): the same tests over a spatially sorted copy of it took
-// 0.7-0.9 s instead of 1.0-1.4 s on one thread.
+// over all of V on a randomly ordered cloud.
 
 #include <cmath>
 #include <vector>

@@ -30,7 +30,7 @@ struct PlanarRing {
 PlanarRing natural_neighbours_of_origin(const std::vector<Eigen::Vector2d>& p);
 
 /// The working memory of natural_neighbours_of_origin: one per thread, reused from point to
-/// point (fresh vectors per call cost about a third of the ring's time in malloc and free).
+/// point, so that no call allocates once the vectors have grown.
 struct RingScratch {
   std::vector<Eigen::Vector2d> vertex, clipped_vertex;  ///< the cell, and its next clipping
   std::vector<int> label, clipped_label;                ///< each vertex's outgoing edge's point

@@ -1,13 +1,9 @@
 #include "focal/points/neighbours.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <deque>
 #include <limits>
-#include <memory>
-#include <nanoflann.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,266 +11,18 @@
 #include "core/parallel.h"
 #include "core/spatial_order.h"
 #include "focal/core/error.h"
+#include "points/argument_checks.h"
 #include "points/measured_neighbours.h"
+#include "points/plane_sums.h"
+#include "points/point_tree.h"
 
 namespace focal {
 namespace {
 
-/// (squared distance, row): ordered by distance, then index, so that ties do not depend on the
-/// tree's traversal.
-using Candidate = std::pair<double, int>;
-
-/// The finite rows of V copied into one contiguous array, as nanoflann's dataset adaptor reads
-/// them. After the tree is built they are permuted into the tree's leaf order (PointTree), so a
-/// leaf's points are adjacent in memory and tree index j is simply the j-th point.
-struct FinitePoints {
-  std::vector<double> xyz;  ///< 3 per point
-  std::vector<int> rows;    ///< tree index -> row of V
-
-  [[nodiscard]] std::size_t kdtree_get_point_count() const { return rows.size(); }
-  [[nodiscard]] double kdtree_get_pt(std::size_t i, std::size_t dim) const {
-    return xyz[3 * i + dim];
-  }
-  [[nodiscard]] const double* point(std::size_t i) const { return xyz.data() + 3 * i; }
-  template <class Box>
-  bool kdtree_get_bbox(Box& /*box*/) const {
-    return false;
-  }
-};
-
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, FinitePoints>,
-                                                 FinitePoints, 3, std::uint32_t>;
-
-/// A tree over the finite points of V, their copies stored in the tree's leaf order. Queries
-/// made in that order (tree index 0, 1, ...) walk the leaves their neighbours walked, which stay
-/// in cache, and read the points contiguously: on a randomly ordered 1M-point torus (k = 16),
-/// the permuted copy (with the CSR written by the queries) took the kNN from 2.2 s to 1.8 s CPU,
-/// and querying in leaf order rather than input order had already given 3.1x (docs/POINTS.md).
-/// Leaves of 6 to 32 points gave the same time within noise; 16 kept.
-class PointTree {
- public:
-  /// `excluded`: empty, or #V flags of points to leave out as the non-finite ones are.
-  /// `spatial`: V's rows are in a spatial order already (a copy of a cloud in Morton order), so
-  /// they are taken as they come.
-  PointTree(PositionsRef V, const std::vector<char>& excluded, int threads, bool spatial = false) {
-    if (!excluded.empty() && excluded.size() != static_cast<std::size_t>(V.rows())) {
-      throw InvalidInput("neighbours: " + std::to_string(excluded.size()) +
-                         " exclusion flags for " + std::to_string(V.rows()) + " points");
-    }
-    points_.rows.reserve(static_cast<std::size_t>(V.rows()));
-    // In a spatial order rather than by row: the build's partitions then move points that are
-    // near in memory too (on the randomly ordered 1M torus its splits took 2.4 times less CPU,
-    // the whole `--k 16` run 3-4% less). The lists do not depend on the tree's shape: they are
-    // the nearest by distance, ties broken by row.
-    const auto add = [&](int i) {
-      const bool out = !excluded.empty() && excluded[static_cast<std::size_t>(i)] != 0;
-      if (!out && V.row(i).allFinite()) points_.rows.push_back(i);
-    };
-    if (spatial) {
-      for (int i = 0; i < V.rows(); ++i) add(i);
-    } else {
-      for (const int i : detail::morton_order(V, threads)) add(i);
-    }
-    points_.xyz.resize(3 * points_.rows.size());
-    for (std::size_t j = 0; j < points_.rows.size(); ++j) {
-      for (int d = 0; d < 3; ++d) points_.xyz[3 * j + d] = V(points_.rows[j], d);
-    }
-    tree_ = std::make_unique<Tree>(
-        3, points_,
-        nanoflann::KDTreeSingleIndexAdaptorParams(
-            16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
-    build(threads);
-    to_leaf_order(threads);
-  }
-  [[nodiscard]] const Tree& tree() const { return *tree_; }
-  [[nodiscard]] int row(std::uint32_t index) const { return points_.rows[index]; }
-  [[nodiscard]] std::size_t size() const { return points_.rows.size(); }
-  [[nodiscard]] const double* point(std::size_t index) const { return points_.point(index); }
-
-  /// Every point at squared distance <= d2 from q (nanoflann's radius test is strict: d2 is
-  /// raised to the next double), appended to `out`.
-  void within(const double* q, double d2, std::vector<Candidate>& out) const {
-    within(q, d2,
-           [&](double distance, std::uint32_t index) { out.emplace_back(distance, row(index)); });
-  }
-  /// The same, each as emit(squared distance, tree index).
-  template <class Emit>
-  void within(const double* q, double d2, const Emit& emit) const {
-    std::vector<std::pair<std::uint32_t, double>> matches;
-    nanoflann::SearchParams params;
-    params.sorted = false;
-    tree_->radiusSearch(q, std::nextafter(d2, INFINITY), matches, params);
-    for (const auto& [index, distance] : matches) {
-      if (distance <= d2) emit(distance, index);
-    }
-  }
-
- private:
-  using Node = Tree::Node;
-  using Box = Tree::BoundingBox;
-
-  /// A subtree still to build: points [left, right) of the index array, the box its splits
-  /// start from, where its root goes.
-  struct Pending {
-    std::size_t left, right;
-    Box box;
-    Node** slot;
-    Box* built;  ///< the box of its points, set when built
-  };
-
-  /// nanoflann's buildIndex (the same splits: middleSplit_, leaves of at most 16 points, so the
-  /// same tree), the top kLevels levels one level at a time and the subtrees below them in
-  /// parallel, each into nodes of its own (nanoflann's node pool is not thread-safe). Splits
-  /// depend on the points and the boxes handed down only, so the tree is the same for any
-  /// thread count. The serial build was about 15% of the kNN's CPU on 1M points.
-  void build(int threads) {
-    Tree& t = *tree_;
-    const std::size_t n = points_.rows.size();
-    t.m_size = n;
-    t.m_size_at_index_build = n;
-    t.vAcc.resize(n);
-    for (std::size_t i = 0; i < n; ++i) t.vAcc[i] = static_cast<std::uint32_t>(i);
-    if (n == 0) return;
-    Box box;
-    for (int d = 0; d < 3; ++d) box[d].low = box[d].high = points_.xyz[static_cast<std::size_t>(d)];
-    for (std::size_t i = 1; i < n; ++i) {
-      for (int d = 0; d < 3; ++d) {
-        const double x = points_.xyz[3 * i + static_cast<std::size_t>(d)];
-        if (x < box[d].low) box[d].low = x;
-        if (x > box[d].high) box[d].high = x;
-      }
-    }
-    // The top levels, one level at a time: inner nodes whose boxes are finished bottom-up.
-    struct Inner {
-      Node* node = nullptr;  ///< null where the entry was a leaf already
-      int cutfeat = 0;
-      Box* built = nullptr;  ///< where its points' box goes
-      Box left_box, right_box;
-    };
-    constexpr int kLevels = 8;  // up to 256 subtrees of about 4000 points at 1M
-    std::vector<Pending> level{{0, n, box, &t.root_node, &t.root_bbox}};
-    std::vector<std::vector<Inner>> inners;  // per level
-    std::vector<Pending> subtrees;
-    for (int depth = 0; depth < kLevels && !level.empty(); ++depth) {
-      std::vector<Pending> next(2 * level.size());
-      std::vector<Inner>& inner = inners.emplace_back(level.size());
-      detail::parallel_chunks(
-          static_cast<std::int64_t>(level.size()), threads, [&](std::int64_t c) {
-            const auto j = static_cast<std::size_t>(c);
-            const Pending& at = level[j];
-            if (at.right - at.left <= t.m_leaf_max_size) return;
-            std::size_t index = 0;
-            int cutfeat = 0;
-            double cutval = 0.0;
-            t.middleSplit_(t, at.left, at.right - at.left, index, cutfeat, cutval, at.box);
-            Inner& in = inner[j];
-            in.cutfeat = cutfeat;
-            in.left_box = in.right_box = at.box;
-            in.left_box[cutfeat].high = cutval;
-            in.right_box[cutfeat].low = cutval;
-            next[2 * j] = {at.left, at.left + index, in.left_box, nullptr, &in.left_box};
-            next[2 * j + 1] = {at.left + index, at.right, in.right_box, nullptr, &in.right_box};
-          });
-      std::vector<Pending> kept;
-      for (std::size_t j = 0; j < level.size(); ++j) {
-        if (level[j].right - level[j].left <= t.m_leaf_max_size) {
-          subtrees.push_back(level[j]);  // a leaf already
-          continue;
-        }
-        Inner& in = inner[j];
-        in.node = &top_.emplace_back();
-        in.built = level[j].built;
-        *level[j].slot = in.node;
-        next[2 * j].slot = &in.node->child1;
-        next[2 * j + 1].slot = &in.node->child2;
-        kept.push_back(next[2 * j]);
-        kept.push_back(next[2 * j + 1]);
-      }
-      level.swap(kept);
-    }
-    subtrees.insert(subtrees.end(), level.begin(), level.end());
-    nodes_.resize(subtrees.size());
-    detail::parallel_chunks(
-        static_cast<std::int64_t>(subtrees.size()), threads, [&](std::int64_t c) {
-          const Pending& at = subtrees[static_cast<std::size_t>(c)];
-          Box b = at.box;
-          *at.slot = divide(nodes_[static_cast<std::size_t>(c)], at.left, at.right, b);
-          *at.built = b;
-        });
-    // Bottom-up, as divideTree after its two recursive calls.
-    for (auto at = inners.rbegin(); at != inners.rend(); ++at) {
-      for (const Inner& in : *at) {
-        if (in.node == nullptr) continue;
-        in.node->node_type.sub.divfeat = in.cutfeat;
-        in.node->node_type.sub.divlow = in.left_box[in.cutfeat].high;
-        in.node->node_type.sub.divhigh = in.right_box[in.cutfeat].low;
-        for (int d = 0; d < 3; ++d) {
-          (*in.built)[d].low = std::min(in.left_box[d].low, in.right_box[d].low);
-          (*in.built)[d].high = std::max(in.left_box[d].high, in.right_box[d].high);
-        }
-      }
-    }
-  }
-
-  /// nanoflann's divideTree, its nodes from `nodes`.
-  Node* divide(std::deque<Node>& nodes, std::size_t left, std::size_t right, Box& box) {
-    Tree& t = *tree_;
-    Node* node = &nodes.emplace_back();
-    if (right - left <= t.m_leaf_max_size) {
-      node->child1 = node->child2 = nullptr;
-      node->node_type.lr.left = left;
-      node->node_type.lr.right = right;
-      for (int d = 0; d < 3; ++d) box[d].low = box[d].high = points_.xyz[3 * t.vAcc[left] + d];
-      for (std::size_t k = left + 1; k < right; ++k) {
-        for (int d = 0; d < 3; ++d) {
-          const double x = points_.xyz[3 * t.vAcc[k] + d];
-          if (box[d].low > x) box[d].low = x;
-          if (box[d].high < x) box[d].high = x;
-        }
-      }
-      return node;
-    }
-    std::size_t index = 0;
-    int cutfeat = 0;
-    double cutval = 0.0;
-    t.middleSplit_(t, left, right - left, index, cutfeat, cutval, box);
-    node->node_type.sub.divfeat = cutfeat;
-    Box left_box(box);
-    left_box[cutfeat].high = cutval;
-    node->child1 = divide(nodes, left, left + index, left_box);
-    Box right_box(box);
-    right_box[cutfeat].low = cutval;
-    node->child2 = divide(nodes, left + index, right, right_box);
-    node->node_type.sub.divlow = left_box[cutfeat].high;
-    node->node_type.sub.divhigh = right_box[cutfeat].low;
-    for (int d = 0; d < 3; ++d) {
-      box[d].low = std::min(left_box[d].low, right_box[d].low);
-      box[d].high = std::max(left_box[d].high, right_box[d].high);
-    }
-    return node;
-  }
-
-  /// The points permuted so that the tree's index array becomes the identity: the tree (split
-  /// values, bounding boxes, index ranges of the leaves) is unchanged, its point j is now ours.
-  void to_leaf_order(int threads) {
-    std::vector<std::uint32_t>& order = tree_->vAcc;
-    std::vector<double> xyz(points_.xyz.size());
-    std::vector<int> rows(points_.rows.size());
-    detail::parallel_for(static_cast<std::int64_t>(order.size()), threads, [&](std::int64_t i) {
-      const auto j = static_cast<std::size_t>(i);
-      std::copy_n(points_.point(order[j]), 3, xyz.data() + 3 * j);
-      rows[j] = points_.rows[order[j]];
-      order[j] = static_cast<std::uint32_t>(j);
-    });
-    points_.xyz.swap(xyz);
-    points_.rows.swap(rows);
-  }
-
-  FinitePoints points_;
-  std::unique_ptr<Tree> tree_;
-  std::deque<Node> top_;                 ///< the nodes of the top levels
-  std::vector<std::deque<Node>> nodes_;  ///< each subtree's
-};
+using detail::Candidate;
+using detail::check_threads;
+using detail::PlaneSums;
+using detail::PointTree;
 
 /// One point's list (candidates sorted, the point itself removed, at most `limit`) appended.
 void keep_sorted(std::vector<Candidate>& candidates, int self, std::size_t limit,
@@ -334,55 +82,6 @@ Neighbourhoods gather(Eigen::Index n, const PointTree& tree, int threads, const 
   });
   return out;
 }
-
-void check_threads(int threads) {
-  if (threads < 0) throw InvalidInput("neighbours: threads must be >= 0");
-}
-
-/// The sums of a least-squares plane through points q given as offsets from the point whose
-/// offset from the plane is wanted (offsets keep the plane accurate far from the origin): one
-/// arithmetic for plane_offset over V's rows and for the kNN query over the tree's copies (the
-/// same doubles), so both give the same bits.
-struct PlaneSums {
-  Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
-  double reach = 0.0;
-  int count = 0;
-
-  void add(const Eigen::RowVector3d& q) { add(q, q.norm()); }
-  /// add(q), with q.norm() computed by the caller (the kNN query needs it too).
-  void add(const Eigen::RowVector3d& q, double norm) {
-    sum += q;
-    // moment += q^T q, element by element: each element is the same one product and one sum
-    // (and q_r q_c = q_c q_r), without the temporary that Eigen stores in halves and reloads
-    // whole (a failed store forwarding per point and neighbour: 43% of the perf samples of the
-    // kNN loop outside nanoflann on the 1M torus).
-    for (int r = 0; r < 3; ++r) {
-      for (int c = r; c < 3; ++c) moment(r, c) += q[r] * q[c];
-    }
-    reach += norm;
-    ++count;
-  }
-  /// The origin's distance to the plane and the points' RMS distance to it; NaN when fewer than
-  /// 3 points or the plane is undefined.
-  [[nodiscard]] detail::PlaneOffset offset() const {
-    if (count < 3) return {};
-    Eigen::Matrix3d full = moment;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < r; ++c) full(r, c) = full(c, r);
-    }
-    const Eigen::RowVector3d centroid = sum / count;
-    const Eigen::Matrix3d covariance = full / count - centroid.transpose() * centroid;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(covariance);
-    const Eigen::RowVector3d normal = eig.eigenvectors().col(0).transpose();
-    if (!normal.allFinite()) return {};
-    // A floor far below any sampling's scale: on exactly flat neighbours (spread 0) only a
-    // distance above rounding counts.
-    return {std::abs(centroid.dot(normal)),
-            std::max(std::sqrt(std::max(eig.eigenvalues()[0], 0.0)), 1e-9 * reach / count)};
-  }
-};
 
 /// The k nearest of the tree's point p (not itself), sorted by (distance, row), into `out`.
 /// k + 1 for the point itself, and one more to see whether the k-th distance is tied with a
@@ -496,6 +195,10 @@ Neighbourhoods within_radii(PositionsRef V, const std::vector<char>& excluded, i
 
 }  // namespace
 
+void detail::check_threads(int threads) {
+  if (threads < 0) throw InvalidInput("neighbours: threads must be >= 0");
+}
+
 Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
   return nearest_neighbours(V, k, {}, threads);
 }
@@ -536,7 +239,7 @@ Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded,
     NearestQuery query(tree, static_cast<std::size_t>(k), ties);
     for (std::int64_t p = begin; p < end; ++p) {
       // The rows of the next points, in leaf order, are scattered over V's: their offsets and
-      // list slots are fetched a query ahead (a query takes about 1 us, a miss 0.1 us).
+      // list slots are fetched a query ahead, so that their misses overlap the query before.
       if (p + 2 < end)
         __builtin_prefetch(&out.offsets[tree.row(static_cast<std::uint32_t>(p + 2))]);
       if (p + 1 < end) {
@@ -623,156 +326,6 @@ Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, i
   });
   return within_radii(V, excluded, max_count, threads,
                       [&radius](int row) { return radius[static_cast<std::size_t>(row)]; });
-}
-
-namespace {
-
-void check_ratio(const char* test, double ratio) {
-  if (!(ratio > 1.0) || !std::isfinite(ratio)) {
-    throw InvalidInput(std::string(test) + ": ratio must be finite and > 1, got " +
-                       std::to_string(ratio));
-  }
-}
-
-void check_lists(const char* test, PositionsRef V, const Neighbourhoods& neighbours) {
-  if (neighbours.vertex_count() != V.rows()) {
-    throw InvalidInput(std::string(test) + ": the neighbourhoods are not V's");
-  }
-}
-
-}  // namespace
-
-std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
-                                 int threads) {
-  check_ratio("outlier_points", ratio);
-  check_threads(threads);
-  check_lists("outlier_points", V, neighbours);
-  const int n = neighbours.vertex_count();
-  std::vector<double> reach(static_cast<std::size_t>(n), NAN);
-  detail::parallel_for(n, threads, [&](std::int64_t i) {
-    const int p = static_cast<int>(i);
-    if (neighbours.size(p) == 0) return;
-    double sum = 0.0;
-    for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
-      sum += (V.row(*j) - V.row(p)).norm();
-    }
-    reach[static_cast<std::size_t>(i)] = sum / neighbours.size(p);
-  });
-  return detail::outlier_points(V, neighbours, reach, ratio, threads);
-}
-
-std::vector<char> detail::outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
-                                         const std::vector<double>& reach, double ratio,
-                                         int threads) {
-  check_ratio("outlier_points", ratio);
-  check_threads(threads);
-  check_lists("outlier_points", V, neighbours);
-  const int n = neighbours.vertex_count();
-  if (reach.size() != static_cast<std::size_t>(n)) {
-    throw InvalidInput("outlier_points: the measures are not the neighbourhoods'");
-  }
-  std::vector<char> outlier(static_cast<std::size_t>(n), 0);
-  // r > ratio x (the median m of the neighbours' finite reaches, element size / 2 of them
-  // sorted) without the median: x -> ratio * x is monotone in floating point too, so the test
-  // holds exactly when more than size / 2 of them have ratio * reach < r (then the sorted
-  // elements 0 .. size / 2 do, m among them; and conversely). The same flags as an nth_element
-  // per point.
-  detail::parallel_for(n, threads, [&](std::int64_t i) {
-    const int p = static_cast<int>(i);
-    const double r = reach[static_cast<std::size_t>(i)];
-    int finite = 0, below = 0;
-    for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
-      const double a = reach[static_cast<std::size_t>(*j)];
-      if (!std::isfinite(a)) continue;
-      ++finite;
-      below += r > ratio * a;
-    }
-    outlier[static_cast<std::size_t>(i)] = finite > 0 && below > finite / 2;
-  });
-  return outlier;
-}
-
-namespace {
-
-/// A point's PlaneOffset over its neighbours, leaving out `without` (-1: none).
-detail::PlaneOffset plane_offset(PositionsRef V, const Neighbourhoods& neighbours, int p,
-                                 int without) {
-  const Eigen::RowVector3d origin = V.row(p);
-  PlaneSums plane;
-  for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
-    if (*j == without) continue;
-    const Eigen::RowVector3d q = V.row(*j) - origin;
-    plane.add(q);
-  }
-  if (!origin.allFinite()) return {};
-  return plane.offset();
-}
-
-/// The median over the neighbours of p of their plane_offset distance without p: how far a
-/// point on this sampling sits off its neighbours' plane, p not counted (NaN when none has one).
-double neighbours_offset_without(PositionsRef V, const Neighbourhoods& neighbours, int p,
-                                 std::vector<double>& around) {
-  around.clear();
-  for (const int* j = neighbours.begin(p); j != neighbours.end(p); ++j) {
-    const double d = plane_offset(V, neighbours, *j, p).distance;
-    if (std::isfinite(d)) around.push_back(d);
-  }
-  if (around.empty()) return NAN;
-  const auto middle = around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2);
-  std::nth_element(around.begin(), middle, around.end());
-  return *middle;
-}
-
-/// off_surface_points with each point's own PlaneOffset from offset_of(p).
-template <class OffsetOf>
-std::vector<char> off_surface(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
-                              int threads, const OffsetOf& offset_of) {
-  std::vector<char> off(static_cast<std::size_t>(neighbours.vertex_count()), 0);
-  detail::parallel_for_blocks(
-      neighbours.vertex_count(), 1024, threads, [&](std::int64_t begin, std::int64_t end) {
-        std::vector<double> around;
-        for (std::int64_t i = begin; i < end; ++i) {
-          const int p = static_cast<int>(i);
-          const detail::PlaneOffset o = offset_of(p);
-          if (!(o.distance > ratio * o.spread)) continue;
-          // A candidate (rare): kept when its neighbours, each without it, sit nearly as far off
-          // their own neighbours' planes: a regular sampling, such as the pole of a sphere
-          // sampled in rings, whose 16 nearest are one ring (spread ~0) with the pole its
-          // sagitta above. Half the ratio: the poles of CGAL's sphere926.pwn sit 2-3 times their
-          // neighbours' offset; the near-surface outliers of the analytic clouds far more (none
-          // kept by it).
-          const double typical = neighbours_offset_without(V, neighbours, p, around);
-          off[static_cast<std::size_t>(i)] = !(o.distance <= 0.5 * ratio * typical);
-        }
-      });
-  return off;
-}
-
-}  // namespace
-
-std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
-                                     int threads) {
-  check_ratio("off_surface_points", ratio);
-  check_threads(threads);
-  check_lists("off_surface_points", V, neighbours);
-  return off_surface(V, neighbours, ratio, threads,
-                     [&](int p) { return plane_offset(V, neighbours, p, -1); });
-}
-
-std::vector<char> detail::off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
-                                             const OutlierMeasures& measures, double ratio,
-                                             int threads) {
-  check_ratio("off_surface_points", ratio);
-  check_threads(threads);
-  check_lists("off_surface_points", V, neighbours);
-  const auto n = static_cast<std::size_t>(neighbours.vertex_count());
-  if (measures.distance.size() != n || measures.spread.size() != n) {
-    throw InvalidInput("off_surface_points: the measures are not the neighbourhoods'");
-  }
-  return off_surface(V, neighbours, ratio, threads, [&](int p) {
-    const auto i = static_cast<std::size_t>(p);
-    return PlaneOffset{measures.distance[i], measures.spread[i]};
-  });
 }
 
 double mean_spacing(PositionsRef V, const Neighbourhoods& neighbours) {

@@ -44,8 +44,8 @@
 /// estimate_cloud_curvature and estimate_cloud_normals run the default, and the k nearest with
 /// the cloud's normals, on a copy of the cloud in a spatial (Morton) order, the results taken
 /// back to the cloud's rows: each point reads its neighbours' rows, which a cloud in no spatial
-/// order scatters over memory (the randomly ordered 1M torus of docs/POINTS.md: 15-23% less
-/// time). The results are those of the cloud in its own order, bit for bit (ties by its rows).
+/// order scatters over memory, and on the copy they lie near each other. The results are those
+/// of the cloud in its own order, bit for bit (ties by its rows).
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -104,8 +104,8 @@ struct CloudOptions {
   double off_surface_ratio = default_off_surface_ratio;
   /// false: CloudCurvature::neighbours is left empty, for callers that do not read the lists
   /// (the focal command, Python's cloud_curvature). A cloud fitted on its copy in Morton order
-  /// (above) would otherwise have its lists taken back to its own rows: about 5% of the CPU of
-  /// `--k 16` on a randomly ordered 1M-point cloud (docs/POINTS.md, "Speed and memory").
+  /// (above) takes its lists back to its own rows only when they are kept: the lists are not
+  /// taken back for callers that do not read them.
   bool keep_neighbours = true;
   int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
 };

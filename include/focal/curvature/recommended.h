@@ -33,10 +33,10 @@
 ///     fit is exact (residual <= 1e-9: the rays meet two slits, as on spheres and cylinders) or
 ///     the triangles give no estimate. Where the file's normals are used (trusted, on clean
 ///     positions), the interpolated corrected curvature measures of those normals (LRTC20,
-///     baselines.h; faster than first order on irregular triangulations) replace the per-triangle
-///     rows over a ball of the vertex's mean edge length, where its 1-ring is not centrally
-///     symmetric (on grids first-order errors cancel and the per-triangle pass stays), not
-///     within 2 rings of a crease (src/curvature/corrected_step.h; measured in
+///     baselines.h; converging faster than first order on irregular triangulations) replace the
+///     per-triangle rows over a ball of the vertex's mean edge length, where its 1-ring is not
+///     centrally symmetric (on grids first-order errors cancel and the per-triangle pass stays),
+///     not within 2 rings of a crease (src/curvature/corrected_step.h; measured in
 ///     docs/ESTIMATOR.md, "The corrected step"). Spikes first: where the file's normals are
 ///     used on clean positions, an isolated vertex that lies off its neighbours' tangent planes
 ///     and off the surface its own and their normals agree on, by more than 0.75 edge lengths
@@ -227,7 +227,7 @@ struct RecommendedMedians {
 /// rings + kMaxExtraRings rings, and the normals that the refit of undefined vertices replaced by
 /// their neighbours' mean one ring further; on clean positions every position read may be a spike's
 /// repaired one, which reads 2 rings further. 11 on clean positions, 12 at most
-/// (kRecommendedMaxReach). Derived in recommended.cpp.
+/// (kRecommendedMaxReach). Derived in recommended_plan.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
 /// recommended_reach of the widest plan (3 rings, 4-ring jets).

@@ -63,7 +63,7 @@ struct ConsistentFaces {
 /// majority of each patch's faces (on a tie, that of the lowest-index face), so a mostly correct
 /// mesh changes little. Faces with a repeated index have no orientation and are left alone. Does
 /// not decide inside from outside: follow with orientation_report and orient_outward for that.
-/// Linear time (the search is serial; ~2 M faces take tens of ms).
+/// Linear time (the search is serial).
 /// \throw InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
 [[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F, int threads = 0);
 

@@ -1,0 +1,264 @@
+// Steps 1 to 3 of the recommended estimator (recommended.h): the normals to fit, the file's
+// where they agree with the positions (outliers replaced), else jets or Max's normals chosen by
+// their roughness, and at creases Max's normals.
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/parallel.h"
+#include "curvature/normal_choice.h"
+#include "curvature/recommended_steps.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/normals/jets.h"
+#include "mesh/prepared_access.h"
+#include "normals/jet_normals_from.h"
+
+namespace focal::detail::recommended {
+namespace {
+
+/// `jets` (the 2-ring cubic jets) with the rows of vertices whose 2-ring is cut by a boundary
+/// (within kBoundaryJetDistance rings of it) replaced by cubic jets over kBoundaryJetRings
+/// rings where those are the smoother field there (1-ring two-slit residual, roughness_of): a
+/// one-sided 2-ring holds about half an interior 2-ring's points, about as many as a cubic's 10
+/// coefficients, and its jet nearly interpolates them; the one-sided 3-ring holds about as many
+/// points as an interior 2-ring (on a thin tube it reaches around it, and the 2-ring may stay
+/// smoother). Rows where the wider jet fails stay.
+RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
+  const std::vector<bool> boundary =
+      boundary_vertices(static_cast<int>(c.mesh.vertex_count()), c.mesh.F(), c.threads);
+  std::vector<int> near;
+  const Eigen::VectorXi distance = rings_to_boundary(*c.one_ring, boundary, kBoundaryJetDistance);
+  for (int i = 0; i < distance.size(); ++i) {
+    if (distance[i] <= kBoundaryJetDistance) near.push_back(i);
+  }
+  RowMatrixX3d out = jets;
+  if (near.empty()) return out;
+  const JetNormals wide = detail::jet_normals_at(c.mesh.V(), *c.one_ring, c.max,
+                                                 jet_options(c, kBoundaryJetRings, 3), near);
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(k);
+    if (wide.N.row(row).allFinite()) out.row(near[k]) = wide.N.row(row);
+  }
+  const Eigen::VectorXd r2 = roughness_at(c, jets, near), r3 = roughness_at(c, out, near);
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(k);
+    if (std::isfinite(r2[row]) && !(r3[row] <= r2[row])) out.row(near[k]) = jets.row(near[k]);
+  }
+  return out;
+}
+
+using detail::select_normal;
+
+/// select_normal at every vertex.
+RowMatrixX3d select_normals(NormalsRef primary, const Eigen::VectorXd& primary_roughness,
+                            NormalsRef secondary, const Eigen::VectorXd& secondary_roughness,
+                            int threads) {
+  RowMatrixX3d out(primary.rows(), 3);
+  detail::parallel_for(primary.rows(), threads, [&](std::int64_t i) {
+    out.row(i) = select_normal(primary.row(i).transpose(), primary_roughness[i],
+                               secondary.row(i).transpose(), secondary_roughness[i], true)
+                     .first.transpose();
+  });
+  return out;
+}
+
+/// Where the chosen normal has none (the jets had too few points, a degenerate fit): Max's
+/// normal if any; turned to the file's side (`side`, -1 or +1; the fit's residuals do not
+/// change: the rays are the same lines).
+Eigen::Vector3d with_max_fallback(const Context& c, Eigen::Vector3d n, Eigen::Index i,
+                                  double side) {
+  if (!n.allFinite()) n = c.max.row(i).transpose();
+  return side < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+/// The positions' normal at vertex i on clean positions (the jets' or Max's, by select_normal
+/// on their roughness `rj`, `rm` there), as choose_normals picks it, and its roughness.
+std::pair<Eigen::Vector3d, double> positions_normal(const Context& c, const JetNormals& jets,
+                                                    double rj, double rm, Eigen::Index i,
+                                                    double side) {
+  const auto [n, r] =
+      select_normal(jets.N.row(i).transpose(), rj, c.max.row(i).transpose(), rm, true);
+  return {with_max_fallback(c, n, i, side), r};
+}
+
+/// The file's normals, replaced by the positions' only at outliers: where a file normal is
+/// unusable or gives no fit, or where it is more than `limit` radians from the jet normal and the
+/// positions' normal (positions_normal) is clearly smoother. On a file whose normals agree with
+/// the positions, such vertices are isolated bad normals; elsewhere the exact normals stay exact
+/// (replacing them where two truncation-level residuals happen to differ by 2x cost up to 0.5%
+/// of H error on clean irregular meshes). The positions' normals are rated only at those
+/// vertices: elsewhere the file's normal is kept whatever they are.
+RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormals& jets,
+                              const Eigen::VectorXd& disagreement, double side, double limit) {
+  const Eigen::VectorXd file_roughness = roughness_of(c, file);
+  const auto may_replace = [&](Eigen::Index i) {
+    return !(disagreement[i] <= limit) || !std::isfinite(file_roughness[i]);
+  };
+  RowMatrixX3d out(file.rows(), 3);
+  std::vector<char> candidate(static_cast<std::size_t>(file.rows()));
+  detail::parallel_for(file.rows(), c.threads, [&](std::int64_t i) {
+    const Eigen::Vector3d a = file.row(i).transpose().normalized();
+    out.row(i) = a.transpose();
+    candidate[static_cast<std::size_t>(i)] = !a.allFinite() || may_replace(i);
+  });
+  std::vector<int> at;
+  for (std::size_t i = 0; i < candidate.size(); ++i) {
+    if (candidate[i]) at.push_back(static_cast<int>(i));
+  }
+  if (at.empty()) return out;
+  const Eigen::VectorXd jets_roughness = roughness_at(c, jets.N, at);
+  const Eigen::VectorXd max_roughness = roughness_at(c, c.max, at);
+  detail::parallel_for(static_cast<std::int64_t>(at.size()), c.threads, [&](std::int64_t k) {
+    const int i = at[static_cast<std::size_t>(k)];
+    const auto [b, rb] = positions_normal(c, jets, jets_roughness[k], max_roughness[k], i, side);
+    out.row(i) = select_normal(file.row(i).transpose(), file_roughness[i], b, rb, may_replace(i))
+                     .first.transpose();
+  });
+  return out;
+}
+
+/// `N` with each row that points against the sum of its 1-ring neighbours' turned round. Under
+/// strong noise a few jets fit in a frame tilted past 90 degrees (their first frame, Max's
+/// normal, comes from folded faces); such a normal leaves every neighbour's ray out of its fit.
+RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
+  std::vector<char> turn(static_cast<std::size_t>(N.rows()), 0);
+  detail::parallel_for(N.rows(), c.threads, [&](std::int64_t i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const int v = static_cast<int>(i);
+    for (const int* j = c.one_ring->begin(v); j != c.one_ring->end(v); ++j) {
+      if (N.row(*j).allFinite()) sum += N.row(*j).transpose();
+    }
+    turn[static_cast<std::size_t>(i)] = N.row(i).dot(sum) < 0.0 ? 1 : 0;
+  });
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    if (turn[static_cast<std::size_t>(i)]) N.row(i) = -N.row(i);
+  }
+  return N;
+}
+
+/// Crease vertices (recommended.h, step 5): corners of an edge whose two faces' normals differ
+/// by more than RecommendedOptions::crease_angle. Per vertex, over pairs of its faces that
+/// share an edge at it.
+std::vector<char> crease_vertices(const Context& c) {
+  const PositionsRef& V = c.mesh.V();
+  const FacesRef& F = c.mesh.F();
+  const auto& incidence = *detail::incidence(c.mesh);
+  const double cos_limit = std::cos(c.options.crease_angle);
+  const auto normal_of = [&](int f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)).transpose(), b = V.row(F(f, 1)).transpose(),
+                          d = V.row(F(f, 2)).transpose();
+    return Eigen::Vector3d((b - a).cross(d - a).normalized());
+  };
+  // A face at v: its normal and its corners other than v (the one there is twice, or a value no
+  // corner has where there is none): two faces share an edge at v exactly when those meet.
+  struct FaceAtVertex {
+    Eigen::Vector3d normal;
+    int other[2];
+  };
+  const auto at_vertex = [&](int f, int v) {
+    FaceAtVertex out{normal_of(f), {-1 - f, -1 - f}};
+    int found = 0;
+    for (int x = 0; x < 3 && found < 2; ++x) {
+      if (F(f, x) != v) out.other[found++] = F(f, x);
+    }
+    if (found == 1) out.other[1] = out.other[0];
+    return out;
+  };
+  const auto share_edge = [](const FaceAtVertex& a, const FaceAtVertex& b) {
+    return a.other[0] == b.other[0] || a.other[0] == b.other[1] || a.other[1] == b.other[0] ||
+           a.other[1] == b.other[1];
+  };
+  std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+  detail::parallel_for_blocks(
+      c.mesh.vertex_count(), 1024, c.threads, [&](std::int64_t begin, std::int64_t end) {
+        // Each face's normal and corners once per vertex (a face meets two others at v).
+        std::vector<FaceAtVertex> faces;
+        for (auto i = begin; i < end; ++i) {
+          const int v = static_cast<int>(i);
+          faces.clear();
+          for (int a = incidence.begin(v); a < incidence.end(v); ++a)
+            faces.push_back(at_vertex(incidence.faces[static_cast<std::size_t>(a)], v));
+          for (std::size_t a = 0; a < faces.size() && !crease[static_cast<std::size_t>(i)]; ++a) {
+            for (std::size_t b = a + 1; b < faces.size(); ++b) {
+              if (share_edge(faces[a], faces[b]) &&
+                  faces[a].normal.dot(faces[b].normal) < cos_limit) {
+                crease[static_cast<std::size_t>(i)] = 1;
+                break;
+              }
+            }
+          }
+        }
+      });
+  return crease;
+}
+
+}  // namespace
+
+std::vector<int> near_flagged(const Context& c, const std::vector<char>& flagged, int rings) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const Eigen::VectorXi distance =
+      rings_to_boundary(*c.one_ring, std::vector<bool>(flagged.begin(), flagged.end()), rings);
+  std::vector<int> out;
+  for (int i = 0; i < distance.size(); ++i) {
+    if (distance[i] >= 1 && distance[i] <= rings) out.push_back(i);
+  }
+  return out;
+}
+
+RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
+  const std::optional<NormalsRef> file = c.mesh.normals();
+  const bool has_normals = file.has_value();
+  const JetNormals jets = local_jets(c, 2, 3);
+  const FileComparison compared = compare_file_normals(c, jets);
+  const RecommendedMeshWide mesh_wide =
+      c.options.mesh_wide ? *c.options.mesh_wide : measure_mesh_wide(c, jets, compared);
+  out.plan = plan_for(mesh_wide, c.options);
+  const double side = compared.side;
+  const Eigen::VectorXd& disagreement = compared.disagreement;
+  out.file_disagreement = mesh_wide.file_disagreement;
+  out.file_normals_used = has_normals && file_normals_agree(out.file_disagreement, out.plan.noise,
+                                                            c.options.file_agreement);
+  if (out.file_normals_used) {
+    // The file's normals, except outliers where the positions' choice is clearly smoother.
+    out.N = replace_outliers(c, *file, jets, disagreement, side,
+                             c.options.outlier_disagreement * out.plan.noise);
+  } else {
+    if (out.plan.rings > 1) {
+      // Noisy positions: normals from wider, lower-degree jets that average the noise.
+      JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
+      o.iterations = out.plan.jet_iterations;
+      out.N =
+          turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
+    } else {
+      // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
+      // first-order (rough) on irregular meshes.
+      const RowMatrixX3d J = with_boundary_jets(c, jets.N);
+      out.N = select_normals(J, roughness_of(c, J), c.max, roughness_of(c, c.max), c.threads);
+    }
+    for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
+      if (side > 0.0 && out.N.row(i).allFinite()) continue;  // nothing to change
+      out.N.row(i) = with_max_fallback(c, out.N.row(i).transpose(), i, side).transpose();
+    }
+  }
+  if (out.plan.rings == 1 && c.options.crease_angle > 0.0) {
+    // Creases on clean positions: jets over the 2-ring mix the pieces' normals; each face lies
+    // on one piece, so Max's normals (of the faces) stay on their piece.
+    const std::vector<char> crease = crease_vertices(c);
+    out.crease = Eigen::Map<const Eigen::Matrix<char, Eigen::Dynamic, 1>>(
+                     crease.data(), static_cast<Eigen::Index>(crease.size()))
+                     .cast<std::uint8_t>();
+    // Used file normals are kept there where they agree with Max's normal within half the
+    // crease angle (the jets they were judged against mix the pieces); others take Max's.
+    const double agree = std::cos(0.5 * c.options.crease_angle);
+    for (const int v : near_flagged(c, crease, 2)) {
+      const Eigen::RowVector3d max = side * c.max.row(v);
+      const bool keep_file = out.file_normals_used && file->row(v).normalized().dot(max) > agree;
+      out.N.row(v) = keep_file ? Eigen::RowVector3d(file->row(v).normalized()) : max;
+    }
+  }
+  return mesh_wide;
+}
+
+}  // namespace focal::detail::recommended

@@ -1,0 +1,278 @@
+// The recommended estimator's mesh-wide measurements and its plan (recommended.h): the position
+// noise from the jets' residuals, the side and the agreement of the file's normals with the
+// jets, the plan they give, and the reach of the estimate in rings.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "core/parallel.h"
+#include "curvature/corrected_step.h"
+#include "curvature/recommended_steps.h"
+#include "curvature/spike_repair.h"
+#include "focal/core/error.h"
+#include "mesh/prepared_access.h"
+#include "normals/jet_normals_from.h"
+
+namespace focal::detail::recommended {
+namespace {
+
+/// Vertices sampled for the noise measurement: at most about kNoiseSamples, evenly by index.
+constexpr Eigen::Index kNoiseSamples = 4096;
+
+/// Whether vertex i (of n) is in the sample of position_noise: every step-th vertex by index,
+/// about kNoiseSamples of them, where the 2-ring jet's residual `r2` is finite.
+bool in_noise_sample(Eigen::Index i, Eigen::Index n, double r2) {
+  const Eigen::Index step = std::max<Eigen::Index>(1, n / kNoiseSamples);
+  return i % step == 0 && std::isfinite(r2);
+}
+
+/// The position noise of recommended_plan (recommended.h) at the listed vertices (entry k:
+/// vertex sample[k], length units): the 2-ring cubic jets' residuals `r2` (of every vertex) with
+/// their truncation error taken out, by the 3-ring jets' residuals. A cubic's truncation error
+/// grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's: its squared residual
+/// grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are per degree of freedom).
+Eigen::VectorXd noise_at(const Context& c, const Eigen::VectorXd& r2,
+                         const std::vector<int>& sample) {
+  const Eigen::VectorXd r3 =
+      detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(c, 3, 3), sample);
+  constexpr double kGrowth = 5.0625 - 1.0;  // (3/2)^4 - 1
+  Eigen::VectorXd noise(static_cast<Eigen::Index>(sample.size()));
+  for (Eigen::Index k = 0; k < noise.size(); ++k) {
+    const double a = r2[sample[static_cast<std::size_t>(k)]], b = r3[k];
+    const double truncation = std::max(0.0, b * b - a * a) / kGrowth;
+    noise[k] = std::isfinite(b) ? std::sqrt(std::max(0.0, a * a - truncation)) : NAN;
+  }
+  return noise;
+}
+
+/// The median of noise_at on the sample (in_noise_sample), length units.
+double position_noise(const Context& c, const Eigen::VectorXd& r2) {
+  std::vector<int> sample;
+  for (Eigen::Index i = 0; i < r2.size(); ++i) {
+    if (in_noise_sample(i, r2.size(), r2[i])) sample.push_back(static_cast<int>(i));
+  }
+  return finite_median(noise_at(c, r2, sample));
+}
+
+/// The rows of `file` that point to the side of `estimated` (first) and against it (second).
+std::pair<std::int64_t, std::int64_t> sides(NormalsRef file, NormalsRef estimated) {
+  std::int64_t along = 0, against = 0;
+  for (Eigen::Index i = 0; i < file.rows(); ++i) {
+    const double d = file.row(i).dot(estimated.row(i));
+    along += d > 0.0;
+    against += d < 0.0;
+  }
+  return {along, against};
+}
+
+double side_of(std::int64_t along, std::int64_t against) { return against > along ? -1.0 : 1.0; }
+
+/// +1 when most usable rows of `file` point to the side of `estimated`, -1 when most point
+/// against it (a file whose normals point inward while the faces turn outward).
+double majority_side(NormalsRef file, NormalsRef estimated) {
+  const auto [along, against] = sides(file, estimated);
+  return side_of(along, against);
+}
+
+/// Angle (radians) between row i of A and side * row i of B: NaN where a row is zero or not
+/// finite.
+double angle_between(NormalsRef A, NormalsRef B, double side, Eigen::Index i) {
+  const Eigen::Vector3d a = A.row(i).transpose(), b = side * B.row(i).transpose();
+  const bool usable = a.allFinite() && b.allFinite() && a != Eigen::Vector3d::Zero() &&
+                      b != Eigen::Vector3d::Zero();
+  return usable ? std::atan2(a.cross(b).norm(), a.dot(b)) : NAN;
+}
+
+/// angle_between at every row.
+Eigen::VectorXd angles_between(NormalsRef A, NormalsRef B, double side, int threads) {
+  Eigen::VectorXd angle(A.rows());
+  detail::parallel_for(A.rows(), threads,
+                       [&](std::int64_t i) { angle[i] = angle_between(A, B, side, i); });
+  return angle;
+}
+
+/// The per-mesh choices from their medians over the whole mesh (length units; radians) and the
+/// side: measured on one mesh (measure_mesh_wide) or over its parts (recommended_mesh_wide_from).
+RecommendedMeshWide mesh_wide_of(double jet_residual, double sample_noise, double file_angle,
+                                 double side, double edge_length) {
+  RecommendedMeshWide m;
+  m.noise = jet_residual / edge_length;
+  m.position_noise = sample_noise / edge_length;
+  m.file_disagreement = file_angle;
+  m.side = side;
+  return m;
+}
+
+}  // namespace
+
+RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions& options) {
+  RecommendedPlan plan = recommended_plan_for_noise(m.position_noise, options);
+  plan.noise = m.noise;
+  return plan;
+}
+
+bool file_normals_agree(double median_angle, double noise, double agreement) {
+  if (!std::isfinite(median_angle)) return false;  // no normal of the file is usable
+  if (!std::isfinite(noise)) return true;          // no jets to judge them by
+  // Angles at rounding level agree whatever the noise (a plane has noise 0).
+  return median_angle <= std::max(agreement * noise, 1e-12);
+}
+
+FileComparison compare_file_normals(const Context& c, const JetNormals& jets) {
+  const std::optional<NormalsRef> file = c.mesh.normals();
+  if (!file) return {};
+  // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
+  // normals from the positions take the side of the faces until turned. A tile takes the whole
+  // mesh's side.
+  const double side =
+      c.options.mesh_wide ? c.options.mesh_wide->side : majority_side(*file, jets.N);
+  return {side, angles_between(*file, jets.N, side, c.threads)};
+}
+
+RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
+                                      const FileComparison& file) {
+  return mesh_wide_of(finite_median(jets.residual), position_noise(c, jets.residual),
+                      c.mesh.has_normals() ? finite_median(file.disagreement) : NAN, file.side,
+                      c.edge_length);
+}
+
+}  // namespace focal::detail::recommended
+
+namespace focal {
+
+using namespace detail::recommended;
+
+RecommendedPlan recommended_plan_for_noise(double noise, const RecommendedOptions& options) {
+  RecommendedPlan plan;
+  plan.noise = plan.position_noise = noise;
+  // Also NaN: no estimate, keep the 1-ring.
+  if (!(noise > options.noise_for_two_rings)) return plan;
+  plan.rings = noise > options.noise_for_three_rings ? 3 : 2;
+  // Strong noise tilts the faces, so Max's normals (the jets' first frame) are far off: a second
+  // fit in the frame of the first.
+  plan.jet_iterations = noise > kNoiseForRefittedJets ? 2 : 1;
+  plan.gaussian = true;
+  plan.jet_rings = plan.rings + 1;
+  plan.jet_degree = 2;
+  return plan;
+}
+
+RecommendedPlan recommended_plan(const PreparedMesh& mesh, const RecommendedOptions& options) {
+  validate_options(options, "recommended_plan");
+  if (options.mesh_wide) return plan_for(*options.mesh_wide, options);
+  const Context c = make_context(mesh, options);
+  const JetNormals jets = local_jets(c, 2, 3);
+  return plan_for(measure_mesh_wide(c, jets, compare_file_normals(c, jets)), options);
+}
+
+RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
+                                          const RecommendedOptions& options) {
+  validate_options(options, "recommended_mesh_wide");
+  RecommendedOptions measured = options;
+  measured.mesh_wide.reset();
+  const Context c = make_context(mesh, measured);
+  const JetNormals jets = local_jets(c, 2, 3);
+  return measure_mesh_wide(c, jets, compare_file_normals(c, jets));
+}
+
+RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std::vector<int>& rows,
+                                             const std::vector<int>& ids,
+                                             Eigen::Index whole_vertex_count,
+                                             const RecommendedOptions& options) {
+  validate_options(options, "recommended_statistics");
+  const auto n = part.vertex_count();
+  if (ids.size() != static_cast<std::size_t>(n)) {
+    throw InvalidInput("recommended_statistics: ids must name every vertex of the part (" +
+                       std::to_string(n) + "), got " + std::to_string(ids.size()));
+  }
+  for (const int r : rows) {
+    if (r < 0 || r >= n) {
+      throw InvalidInput("recommended_statistics: row " + std::to_string(r) +
+                         " is out of range [0, " + std::to_string(n) + ")");
+    }
+  }
+  RecommendedOptions measured = options;
+  measured.mesh_wide.reset();
+  const Context c = make_context(part, measured);
+  // The jets of the listed vertices (detail::jet_normals_at: the bits of local_jets' rows).
+  const JetNormals jets =
+      detail::jet_normals_at(part.V(), *c.one_ring, c.max, jet_options(c, 2, 3), rows);
+  RecommendedStatistics out;
+  out.jet_residual = jets.residual;
+  // position_noise's sample, by whole-mesh index; noise_at reads r2 by part row.
+  Eigen::VectorXd r2 = Eigen::VectorXd::Constant(n, NAN);
+  std::vector<int> sample;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const int r = rows[k];
+    r2[r] = jets.residual[static_cast<Eigen::Index>(k)];
+    if (in_noise_sample(ids[static_cast<std::size_t>(r)], whole_vertex_count, r2[r])) {
+      sample.push_back(r);
+      out.sample.push_back(ids[static_cast<std::size_t>(r)]);
+    }
+  }
+  out.sample_noise = noise_at(c, r2, sample);
+  if (const std::optional<NormalsRef> file = part.normals()) {
+    const auto m = static_cast<Eigen::Index>(rows.size());
+    RowMatrixX3d file_rows(m, 3);
+    for (Eigen::Index k = 0; k < m; ++k) file_rows.row(k) = file->row(rows[std::size_t(k)]);
+    std::tie(out.along, out.against) = sides(file_rows, jets.N);
+    out.angle_along.resize(m);
+    out.angle_against.resize(m);
+    detail::parallel_for(m, c.threads, [&](std::int64_t k) {
+      out.angle_along[k] = angle_between(file_rows, jets.N, 1.0, k);
+      out.angle_against[k] = angle_between(file_rows, jets.N, -1.0, k);
+    });
+  }
+  return out;
+}
+
+RecommendedMeshWide recommended_mesh_wide_from(const RecommendedMedians& whole,
+                                               double mean_edge_length) {
+  const double side = side_of(whole.along, whole.against);
+  const double file_angle =
+      whole.has_normals ? (side < 0.0 ? whole.angle_against : whole.angle_along) : NAN;
+  return mesh_wide_of(whole.jet_residual, finite_median(whole.sample_noise), file_angle,
+                      whole.has_normals ? side : 1.0, mean_edge_length);
+}
+
+int recommended_reach(const RecommendedPlan& plan) {
+  // What the estimate at a vertex v reads, in rings from v (a vertex's Max normal reads its
+  // incident faces, whose corners are one ring further; jets read their k-ring's positions and
+  // Max's normal at their centre only):
+  //  - a fitted normal at u, on clean positions, is chosen between candidates (jets over 2
+  //    rings, Max's, the file's) by their 1-ring fits' residuals at u, and the crease steps read
+  //    the faces of vertices within 2 rings of u: 1 + 2 + 1 = 4 rings from u, one more where
+  //    u is within kBoundaryJetDistance of a boundary (its jets over kBoundaryJetRings rings;
+  //    whether it is reads 2 rings); on noisy
+  //    positions it is the jet of u over plan.jet_rings rings from Max's normals, turned with
+  //    its 1-ring's normals: jet_rings + 2 (with a margin of one);
+  //  - the fit of v reads the fitted normals within plan.rings, the per-triangle pass those at
+  //    the corners of v's faces (1 ring), and where v stays undefined the refits over up to
+  //    kMaxExtraRings more rings; those read the normals that the previous refit replaced by
+  //    their neighbours' mean, one ring further;
+  //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
+  //    fitted normals at the corners of the faces of its ball's vertices (at most
+  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings);
+  //  - on clean positions with trusted normals, each position read is the spike repair's
+  //    (spike_repair.h): a spike's offset reads its 1-ring, whether it is isolated the offsets
+  //    of that 1-ring, 2 rings in all.
+  const int normal_reach = std::max(kBoundaryJetRings + 2, plan.rings > 1 ? plan.jet_rings + 2 : 0);
+  const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
+                                 plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
+  const int position_reach = plan.rings > 1 ? 0 : detail::kSpikeRepairRings;
+  return fit_reach + normal_reach + position_reach;
+}
+
+RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
+  validate_options(options, "recommended_plan");
+  return recommended_plan(detail::PreparedAccess::make(
+                              V, F, std::nullopt, {.threads = options.threads}, "recommended_plan"),
+                          options);
+}
+
+}  // namespace focal

@@ -1,0 +1,109 @@
+// A vertex's jet points (jet_points.h): its k-ring by breadth-first search over the 1-ring with
+// one mark bit per vertex, and the ring's offsets in the vertex's frame.
+#include "normals/jet_points.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace focal::detail::jets {
+namespace {
+
+/// Two doubles as one SSE2 register: x.q and y.q in gather_points, with the same products and
+/// sums per entry (and bits) as one at a time.
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+
+/// Where the marked vertices of `ring` lie within a few words of marks of each other (on a mesh
+/// whose nearby vertices have nearby indices), rewrites `ring` in ascending order by reading
+/// those words, clearing them as it goes, and returns true: the sorted ring without a sort.
+/// Otherwise leaves both as they are and returns false.
+bool read_marks_in_order(std::vector<int>& ring, std::uint64_t* bits) {
+  const auto [lowest, highest] = std::minmax_element(ring.begin(), ring.end());
+  const auto first = static_cast<std::size_t>(*lowest) / 64;
+  const auto last = static_cast<std::size_t>(*highest) / 64;
+  if (last - first >= 4 * ring.size()) return false;
+  int* out = ring.data();
+  for (std::size_t k = first; k <= last; ++k) {
+    for (std::uint64_t word = bits[k]; word != 0; word &= word - 1)
+      *out++ = static_cast<int>(64 * k) + std::countr_zero(word);
+    bits[k] = 0;
+  }
+  return true;
+}
+
+}  // namespace
+
+void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::uint64_t>& in_ring,
+                 const std::vector<int>* sort_rows, std::vector<int>& ring) {
+  if (in_ring.empty()) in_ring.assign(static_cast<std::size_t>(one.vertex_count()) / 64 + 1, 0);
+  std::uint64_t* bits = in_ring.data();
+  const auto test_and_set = [bits](int w) {
+    std::uint64_t& word = bits[static_cast<std::size_t>(w) / 64];
+    const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(w) % 64);
+    const bool was = (word & bit) != 0;
+    word |= bit;
+    return was;
+  };
+  ring.assign(1, v);
+  test_and_set(v);
+  // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
+  // Checked once per vertex whose neighbours were added (the ring may pass the cap by those), not
+  // once per neighbour: past it the ring is dropped either way.
+  const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
+  std::size_t begin = 0;
+  for (int depth = 0; depth < rings && begin < ring.size(); ++depth) {
+    const std::size_t end = ring.size();
+    for (std::size_t k = begin; k < end && ring.size() <= cap; ++k) {
+      const int u = ring[k];
+      for (const int* w = one.begin(u); w != one.end(u); ++w) {
+        if (!test_and_set(*w)) ring.push_back(*w);
+      }
+    }
+    begin = end;
+  }
+  if (!sort_rows && ring.size() <= cap && read_marks_in_order(ring, bits)) return;
+  for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
+  if (ring.size() > cap) ring.resize(1);
+  if (sort_rows) {
+    const int* row = sort_rows->data();
+    detail::sort_small(ring.data(), ring.data() + ring.size(),
+                       [row](int a, int b) { return row[a] < row[b]; });
+  } else {
+    detail::sort_small(ring.data(), ring.data() + ring.size(), std::less<>());
+  }
+}
+
+double gather_points(PositionsRef V, int i, const kernels::Frame<double>& f,
+                     const std::vector<int>& ring, Points& points) {
+  points.resize(ring.size() + 1);  // room for every point: written through a pointer, no checks
+  Point* out = points.data();
+  *out++ = {0.0, 0.0, 0.0};
+  // Plain scalars: Eigen's 3-vectors pack into an SSE pair plus a scalar, which costs more than
+  // the nine products here. x.q and y.q as one pair (the same products and sums per entry):
+  // GCC paired them by itself or not, depending on how the frame was built.
+  const double px = V(i, 0), py = V(i, 1), pz = V(i, 2);
+  const Pair frame_x = {f.x.x, f.y.x}, frame_y = {f.x.y, f.y.y}, frame_z = {f.x.z, f.y.z};
+  const double nx = f.n.x, ny = f.n.y, nz = f.n.z;
+  double scale_sq = 0.0;
+  for (const int j : ring) {
+    if (j == i) continue;
+    const double qx = V(j, 0) - px, qy = V(j, 1) - py, qz = V(j, 2) - pz;
+    // All three finite (x - x is 0 for a finite x, NaN otherwise): one test instead of three.
+    if (!((qx - qx) + (qy - qy) + (qz - qz) == 0.0)) continue;
+    const Pair tangential = frame_x * qx + frame_y * qy + frame_z * qz;
+    *out++ = {tangential[0], tangential[1], nx * qx + ny * qy + nz * qz};
+    scale_sq = std::max(scale_sq, qx * qx + qy * qy + qz * qz);
+  }
+  points.resize(static_cast<std::size_t>(out - points.data()));
+  const double scale = std::sqrt(scale_sq);  // the largest |q|: sqrt is monotonic
+  if (scale > 0.0) {
+    const double inv = 1.0 / scale;
+    for (Point& q : points) q = {q.x * inv, q.y * inv, q.z * inv};
+  }
+  return scale;
+}
+
+}  // namespace focal::detail::jets
