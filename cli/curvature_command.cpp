@@ -115,7 +115,7 @@ void add_curvature_command(CLI::App& app, const Log& log) {
       "  focal curvature scan.ply -o scan.csv --float32   # floats: CSV ~40% smaller\n"
       "With no estimator option, the recommended estimator runs: the two-slit fit of the file's\n"
       "normals fused with normals from local cubic fits of the positions (or of those alone),\n"
-      "on a wider neighbourhood where the positions are noisy (docs/ESTIMATOR.md).");
+      "on a wider neighbourhood where the positions are noisy (docs/METHOD.md).");
   cmd->add_flag("--force", f->force, "replace a read-only output file");
   cmd->add_option("--tiles", f->tiles,
                   "estimate the mesh (or cloud) in N spatial tiles with halos, one after the "

@@ -74,7 +74,7 @@ void add_normals_command(CLI::App& app, const Log& log) {
       "Clouds get the normals of the curvature default (jets over 16 neighbours, 64 on noisy\n"
       "positions; the file's where they agree with them); with --k/--radius PCA + jets over\n"
       "those, on the side of the file's normals. Meshes get the recommended estimator's\n"
-      "normals (docs/POINTS.md, docs/ESTIMATOR.md).");
+      "normals (docs/POINTS.md, docs/METHOD.md).");
   cmd->parse_complete_callback([f] {
     require_extension("-o", f->output, {".ply", ".obj", ".off", ".xyz", ".xyzn"});
     check_output("-o", f->output, f->input, f->force);

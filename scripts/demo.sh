@@ -15,7 +15,7 @@ fi
 echo "== focal info (the scanned Stanford bunny, from $archive)"
 "$focal" info "$out/bunny.off"
 echo
-echo "== focal curvature: the recommended estimator (docs/ESTIMATOR.md): two-slit fit, closed form,"
+echo "== focal curvature: the recommended estimator (docs/METHOD.md): two-slit fit, closed form,"
 echo "   on jet or Max normals from the positions, rings from the measured noise (its plan below)"
 "$focal" -v curvature "$out/bunny.off" -o "$out/bunny-curvature.ply"
 "$focal" curvature "$out/bunny.off" -o "$out/bunny-curvature.csv"

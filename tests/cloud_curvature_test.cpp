@@ -77,7 +77,7 @@ TEST(CloudCurvature, CylinderIsExactWithExactNormals) {
 // is not symmetric about the point; docs/POINTS.md): 4x the points halve h and should halve the
 // error (ratio 2). Measured ratios 2.0-2.4 (seeds 1, 2); asserted > 1.6, i.e. at least order
 // 0.68, a margin of 20% on the expected ratio. The default's corrected step on local
-// triangulations (docs/POINTS.md, "The corrected step on clouds") converges faster: measured
+// triangulations (docs/notes/points-log.md, "The corrected step on clouds") converges faster: measured
 // ratios 2.61-2.92 (order 1.4-1.5) and fine errors 0.00114-0.00126, asserted > 2.1 (20% under
 // the lowest) and < 0.0025 (2x above the highest); the fit alone gave 0.0045 and 0.0050.
 TEST(CloudCurvature, ConvergesOnTheTorus) {

@@ -101,7 +101,7 @@ TEST(CorrectedStep, ExactOnTheSphere) {
 }
 
 // On trusted file normals of a random sampling the default's error falls faster than first
-// order, as the corrected measures do on irregular triangulations (docs/ESTIMATOR.md,
+// order, as the corrected measures do on irregular triangulations (docs/notes/estimator-log.md,
 // "Baselines"), where the per-triangle pass it replaces falls as h: 4 times the vertices (h / 2)
 // divide the per-triangle error by about 2 (measured 2.1, 2.1) and the default's by more than
 // 2.3 (measured 2.9, 2.4); the default stays below 0.75 of the per-triangle error at every size

@@ -260,7 +260,7 @@ TEST_P(Accuracy, ErrorBoundedAndConverging) {
   RecordProperty("rms_coarse", text(coarse.rms));
   RecordProperty("rms_fine", text(fine.rms));
   RecordProperty("median_d1_angle_fine", text(fine.median_angle));
-  // The error as a fraction of the largest curvature (docs/ESTIMATOR.md quotes it for estimated
+  // The error as a fraction of the largest curvature (docs/notes/estimator-log.md quotes it for estimated
   // normals on irregular meshes).
   RecordProperty("rms_over_kappa_coarse", text(coarse.rms / coarse.kappa));
   RecordProperty("rms_over_kappa_fine", text(fine.rms / fine.kappa));

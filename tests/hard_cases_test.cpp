@@ -158,7 +158,7 @@ TEST(HardCases, BoundaryBandAndCreasesScoreTheRightVertices) {
 
 // Creases (recommended.h step 5): on the capped cylinder the default must not smear the rims
 // into the pieces. Every piece is a plane or a cylinder, on which the fit is exact with exact
-// normals (docs/ESTIMATOR.md): 1e-9 is rounding with a wide margin. Before crease handling the
+// normals (docs/notes/estimator-log.md): 1e-9 is rounding with a wide margin. Before crease handling the
 // relative H error was 2.4 (focal eval --suite hard).
 TEST(HardCases, CreasesAreFlaggedAndNotSmeared) {
   AnalyticSurface s = make_capped_cylinder(1.0, 2.0, 2000);

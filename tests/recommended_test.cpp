@@ -1,7 +1,7 @@
 // The recommended estimator (recommended.h): measured accuracy against the paper's method on the
 // irregular and noisy cases of the evaluation suite, exactness on spheres, the noise plan,
 // determinism, boundaries and undefined vertices. DISABLED_SuiteTable prints the table of
-// docs/ESTIMATOR.md ("The recommended estimator").
+// docs/notes/estimator-log.md ("The recommended estimator").
 #include "focal/curvature/recommended.h"
 
 #include <gtest/gtest.h>
@@ -24,7 +24,7 @@ namespace {
 
 enum class Noise { clean, positions, normals };
 
-/// A case of `focal eval`: about 4000 vertices, seed 1, the paper's noise (eval_command.cpp).
+/// A case of `focal eval`: about 4000 vertices, seed 1, the paper's noise (cli/eval_cases.cpp).
 AnalyticSurface suite_case(SurfaceKind kind, Triangulation t, Noise noise, int vertices = 4000) {
   SurfaceOptions o;
   o.kind = kind;
@@ -186,7 +186,7 @@ TEST(Recommended, BoundaryVerticesAreEstimated) {
 
 TEST(Recommended, NormalsFromPositionsNearBoundaries) {
   // Without normals on clean positions, the jets of vertices whose 2-ring a boundary cuts fit
-  // over 3 rings where that field is smoother (recommended.cpp, with_boundary_jets): a one-sided
+  // over 3 rings where that field is smoother (recommended_normals.cpp, with_boundary_jets): a one-sided
   // 2-ring holds about as many points as a cubic has coefficients. Relative RMS error of H
   // within two rings of the boundary against the analytic truth, measured: saddle 0.0134,
   // monkey saddle 0.0114, cylinder 0.0016 (with 2-ring jets there: 0.144, 0.0744, 0.0107).
@@ -315,7 +315,7 @@ TEST(Recommended, RejectsInvalidInput) {
   EXPECT_THROW((void)estimate_curvature_recommended(m.V, F, std::nullopt).curvature, InvalidInput);
 }
 
-// The table of docs/ESTIMATOR.md: build/release/tests/recommended_test
+// The table of docs/notes/estimator-log.md: build/release/tests/recommended_test
 //   --gtest_also_run_disabled_tests --gtest_filter='*SuiteTable*'
 TEST(Recommended, DISABLED_SuiteTable) {
   std::printf(

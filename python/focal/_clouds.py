@@ -75,10 +75,10 @@ def cloud_curvature(
     solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
     outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
         median of the same are left out (NaN, ``undefined``); 0 keeps every point (the library
-        default 3; docs/POINTS.md, "Outliers").
+        default 3; docs/notes/points-log.md, "Outliers").
     off_surface_ratio : then points farther from the plane of their 16 nearest than this many
         times those neighbours' RMS distance to it are left out too; 0 keeps them (the library
-        default 10; docs/POINTS.md, "Near-surface outliers").
+        default 10; docs/notes/points-log.md, "Near-surface outliers").
     threads : worker threads; None: FOCAL_NUM_THREADS if set, else all. Results do not depend
         on it.
 

@@ -10,6 +10,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from . import _focal_ext as _ext
+from ._clouds import _cloud_arguments, _viewpoint
 from ._errors import InvalidInputError
 from ._inputs import _as_rows, _mesh_arrays, _shape_error, _threads, _vector
 from ._results import Curvature, FocalMesh, FocalMeshes, Mesh, MeshFindings, Surface
@@ -145,26 +146,21 @@ def _estimate_options(estimator: str, threads: Optional[int], options: dict) -> 
     return o
 
 
-def _cloud_options(cloud: dict, solver: str, threads: int) -> dict:
-    """The cloud keywords of curvature() as the extension reads them."""
-    radius, adaptive = cloud["radius"], cloud["adaptive_radius"]
-    if int(cloud["k"]) < 0:
-        raise InvalidInputError(f"k must be >= 0 (0: the adaptive default), got {cloud['k']}")
-    if radius is not None and not float(radius) > 0.0:
-        raise InvalidInputError(f"radius must be None or > 0, got {radius}")
-    if adaptive is not None and not (float(adaptive) > 0.0 and np.isfinite(float(adaptive))):
-        raise InvalidInputError(f"adaptive_radius must be None or finite and > 0, got {adaptive}")
-    viewpoint = cloud["viewpoint"]
-    return {
-        "k": int(cloud["k"]),
-        "radius": 0.0 if radius is None else float(radius),
-        "adaptive_radius": 0.0 if adaptive is None else float(adaptive),
+def _cloud_options(V: Any, cloud: dict, solver: str, threads: Optional[int]) -> tuple:
+    """The positions of a cloud and its keywords of curvature() as the extension reads them."""
+    P, k, radius, adaptive, t = _cloud_arguments(
+        V, cloud["k"], cloud["radius"], cloud["adaptive_radius"], threads
+    )
+    return P, {
+        "k": k,
+        "radius": radius,
+        "adaptive_radius": adaptive,
         "normal_method": str(cloud["normal_method"]),
-        "viewpoint": None if viewpoint is None else [float(x) for x in viewpoint],
+        "viewpoint": _viewpoint(cloud["viewpoint"]),
         "solver": solver,
         "outlier_ratio": float(cloud["outlier_ratio"]),
         "off_surface_ratio": float(cloud["off_surface_ratio"]),
-        "threads": threads,
+        "threads": t,
     }
 
 
@@ -286,7 +282,7 @@ def curvature(
             raise InvalidInputError(
                 f"{', '.join(given)}: option(s) of meshes, but F is None (a point cloud)"
             )
-        o["cloud"] = _cloud_options(cloud, solver, o["threads"])
+        V, o["cloud"] = _cloud_options(V, cloud, solver, threads)
         F = np.zeros((0, 3), dtype=np.int32)
     else:
         given = sorted(name for name, default in _CLOUD_OPTIONS.items() if cloud[name] != default)

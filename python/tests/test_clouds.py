@@ -78,7 +78,7 @@ def test_outliers_are_left_out():
 
 def test_near_surface_outliers_are_left_out():
     """Points 2 and 2.5 mean spacings (0.079) off a sphere, the statistical test off: the
-    off-surface test leaves them out and no point of the sphere (docs/POINTS.md, "Near-surface
+    off-surface test leaves them out and no point of the sphere (docs/notes/points-log.md, "Near-surface
     outliers")."""
     P, N = sphere_points(n=2000, seed=5)
     near = np.array([[0.0, 0.0, 2.2], [0.0, 0.0, -1.8], [2.16, 0.0, 0.0]])

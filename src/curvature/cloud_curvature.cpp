@@ -279,7 +279,7 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   if (out.file_normals_used) out.N = *N;
   // The corrected step (step 5) on clean positions, and only where no point was left out as an
-  // outlier: outliers too near the surface to be flagged (docs/POINTS.md, "Outliers") enter
+  // outlier: outliers too near the surface to be flagged (docs/notes/points-log.md, "Outliers") enter
   // the local triangulations, and the corrected measures, unlike the robust fit, take them in.
   out.corrected = out.k == default_cloud_neighbours &&
                   std::find(out.outlier.begin(), out.outlier.end(), 1) == out.outlier.end();
@@ -343,7 +343,7 @@ void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, 
                                 options.threads, true, out.curvature);
     if (out.corrected) {
       // Clean positions without outliers: the corrected step on each point's local
-      // triangulation where the fit is not exact (corrected_step.h; docs/POINTS.md, "The
+      // triangulation where the fit is not exact (corrected_step.h; docs/notes/points-log.md, "The
       // corrected step on clouds").
       detail::cloud_corrected_measures(V, out.N, ok, out.neighbours, {}, fit, scale, order,
                                        out.curvature);
@@ -397,7 +397,7 @@ CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, Positio
 /// cloud's rows. The lists, the tests and the fit read each point's neighbours' rows: on a cloud
 /// whose rows come in no spatial order (scanners' and generators' files often do) each read
 /// is a cache miss, on the copy mostly a hit.
-/// The same bits (docs/POINTS.md, "The whole cloud in Morton order"): every list is that of the
+/// The same bits (docs/notes/points-log.md, "The whole cloud in Morton order"): every list is that of the
 /// cloud's own order renamed, in the same order (ties by the cloud's rows,
 /// detail::nearest_neighbours); mean_spacing sums, and the jets sum each neighbourhood, in the
 /// cloud's row order; the MST runs over the cloud in its own order (adaptive_plan's copy_of);

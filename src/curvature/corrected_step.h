@@ -34,7 +34,7 @@ constexpr double kSymmetricStencil = 0.25;
 /// edge loses the irregular cases (graded torus 0.0055 vs 0.0045), 1.5 and 2 edges the coarse
 /// meshes (median 0.030 and 0.045 vs 0.017); a ball in the
 /// mesh's mean edge length instead of the local one loses the graded meshes (median 0.0073 vs
-/// 0.0057). Symmetric stencils keep the per-triangle pass (docs/ESTIMATOR.md, "The corrected
+/// 0.0057). Symmetric stencils keep the per-triangle pass (docs/notes/estimator-log.md, "The corrected
 /// step": half an edge there won on strip grids and lost on regular ones).
 constexpr double kCorrectedBall = 1.0;
 
@@ -79,7 +79,7 @@ void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResul
 /// slits exactly (spheres, cylinders, planes), and so does the fit, which the later steps keep.
 constexpr double kExactFitResidual = 1e-9;
 
-/// The corrected step of the cloud default (docs/POINTS.md, "The corrected step on clouds"): a
+/// The corrected step of the cloud default (docs/notes/points-log.md, "The corrected step on clouds"): a
 /// cloud has no faces, so each point gets a local triangulation of its own, the Delaunay
 /// triangulation of it and its neighbours projected onto its tangent plane (points/
 /// natural_ring.h; its natural neighbours are its 1-ring). At each point i that is not skipped

@@ -38,7 +38,7 @@ using detail::kExactFitResidual;
 
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
-/// 1.8 times lower H error, docs/ESTIMATOR.md), but only second-order exact where the fit is
+/// 1.8 times lower H error, docs/notes/estimator-log.md), but only second-order exact where the fit is
 /// exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
 /// triangles give no estimate, and takes the triangles' elsewhere, except where `replaced` (if
 /// not empty) is set: the corrected step writes those rows, so the pass runs on the faces of the

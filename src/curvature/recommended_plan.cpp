@@ -35,7 +35,10 @@ bool in_noise_sample(Eigen::Index i, Eigen::Index n, double r2) {
 /// vertex sample[k], length units): the 2-ring cubic jets' residuals `r2` (of every vertex) with
 /// their truncation error taken out, by the 3-ring jets' residuals. A cubic's truncation error
 /// grows as radius^4, and the 3-ring's radius is about 3/2 the 2-ring's: its squared residual
-/// grows (3/2)^8 = 25.6 times, the noise's not at all (the residuals are per degree of freedom).
+/// would grow (3/2)^8 = 25.6 times, the noise's not at all (the residuals are per degree of
+/// freedom). The divisor below is (3/2)^4 - 1, not (3/2)^8 - 1: the plan's noise thresholds
+/// (kNoiseForTwoRings, kNoiseForThreeRings) were measured with it, so it stays until they are
+/// measured again with the other.
 Eigen::VectorXd noise_at(const Context& c, const Eigen::VectorXd& r2,
                          const std::vector<int>& sample) {
   const Eigen::VectorXd r3 =

@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the recommended estimator's robust per-vertex two-slit fit (docs/ESTIMATOR.md,
+// Internal: the recommended estimator's robust per-vertex two-slit fit (docs/notes/estimator-log.md,
 // "Robust weights"): the closed-form fit of two_slit_detail.h, refitted without the
 // rays far off the two slits (outlier normals, spikes, the far side of a crease) lose their pull.
 

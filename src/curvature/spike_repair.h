@@ -25,7 +25,7 @@ Eigen::VectorXd normal_offsets(PositionsRef V, const RowMatrixX3d& N, const Neig
 
 /// Offset (normal_offsets, local edge lengths) beyond which a vertex is a spike candidate.
 /// Spikes of the evaluation are 2 mean edges; clean meshes measure below 0.01, 10% vertex noise
-/// about 0.1 to 0.3 (docs/ESTIMATOR.md, "Spikes").
+/// about 0.1 to 0.3 (docs/notes/estimator-log.md, "Spikes").
 constexpr double kSpikeOffset = 0.75;
 
 /// Spikes: vertices whose offset (`offset`, normal_offsets) and distance from the neighbours'

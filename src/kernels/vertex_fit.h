@@ -1,5 +1,5 @@
 #pragma once
-// The per-vertex closed-form two-slit fit (paper section 5; docs/ESTIMATOR.md) as plain-data
+// The per-vertex closed-form two-slit fit (paper section 5; docs/notes/estimator-log.md) as plain-data
 // math that nvcc compiles into the CUDA kernel and g++ into the CPU test that checks it against
 // estimate_curvature. No Eigen, no allocation: one thread runs fit_vertex for one vertex.
 //

@@ -30,7 +30,7 @@ JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
 /// of oriented by orient_normals_mst (serial, the plan's one serial step), for a plan that may
 /// only need the jets' residuals and lines: a jet is fitted in the frame of its own start normal,
 /// and a start normal of the other sign gives the same residual and the opposite normal, bit for
-/// bit (docs/POINTS.md, "The default's cost"). With a viewpoint, cloud_jets itself. `copy_of`
+/// bit (docs/notes/points-log.md, "The default's cost"). With a viewpoint, cloud_jets itself. `copy_of`
 /// as orient_normals_mst (the jets' points summed in the cloud's order: jet_normals_from).
 JetNormals cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
                             const CloudNormalOptions& options, NormalsRef side,

@@ -27,6 +27,7 @@
 #include "normals/jet_fit.h"
 #include "normals/jet_normals_from.h"
 #include "normals/jet_points.h"
+#include "normals/vertex_normals_from.h"
 
 namespace focal {
 namespace {

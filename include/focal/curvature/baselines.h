@@ -58,7 +58,7 @@ struct BallOptions {
 /// k1 k2); k1, k2, d1, d2 from -sym(muXY) / mu0 projected to the plane of u_i (n = u_i).
 /// \param N #V x 3 outward normals (normalised per row), or std::nullopt for Max's (1999)
 ///        face-weighted normals.
-/// Ball: default radius 1 mean edge length (docs/ESTIMATOR.md, "Baselines"). Uses
+/// Ball: default radius 1 mean edge length (docs/METHOD.md). Uses
 /// options.zero_tolerance, umbilic_tolerance and threads.
 /// \throw InvalidInput when F indexes outside V, N has not #V rows, or the radius is negative or
 /// not finite.
@@ -77,7 +77,7 @@ struct BallOptions {
 /// oriented by the area-weighted normal, and the curvature of larger magnitude belongs to the
 /// tangent eigenvector of C with the smaller eigenvalue. Error O(r^2) from the truncated
 /// expansion plus O(h^2 / r^2) from the discretisation (h the edge length). Positions only.
-/// Ball: default radius 4 mean edge lengths (docs/ESTIMATOR.md, "Baselines"). Uses
+/// Ball: default radius 4 mean edge lengths (docs/METHOD.md). Uses
 /// options.zero_tolerance, umbilic_tolerance and threads.
 /// \throw InvalidInput when F indexes outside V or the radius is negative or not finite.
 [[nodiscard]] CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball = {},

@@ -73,7 +73,7 @@ inline constexpr double default_outlier_ratio = 3.0;
 /// analytic clouds (3000 points, seeds 1 and 2, clean, 10% position noise, graded density 0.5
 /// and 2% outliers) was below 6.0 (noisy; clean and graded below 3.5), at 30000 noisy points
 /// below 8.25 (the torus): 10 flags no point on a surface there. 10 against 20 lowered the
-/// H error of every 2% outlier case, 12 none (docs/POINTS.md, "Near-surface outliers").
+/// H error of every 2% outlier case, 12 none (docs/notes/points-log.md, "Near-surface outliers").
 inline constexpr double default_off_surface_ratio = 10.0;
 
 struct CloudOptions {

@@ -1,65 +1,20 @@
 #pragma once
 /// \file recommended.h
-/// The recommended estimator: what `focal curvature` runs when no estimator option is given,
-/// and what `focal eval` reports as "focal default". One entry point, on a mesh whose normals
-/// come from a file (and may be noisy) or that has none. Measured against the paper's method and
-/// the baselines in docs/ESTIMATOR.md, "The recommended estimator".
-///
-/// It runs the paper's estimators (the closed-form two-slit fit, and on clean positions the
-/// per-triangle characteristic equation) on better normals and, where the positions are noisy,
-/// over a wider neighbourhood:
-///  1. Jets (normal_estimation.h): a cubic height fit over the 2-ring of every vertex gives
-///     third-order normals from the positions, and its residual measures the position noise:
-///     noise = median residual / mean edge length (about 1e-4 on clean smooth meshes, 0.056 for
-///     the paper's 10% vertex noise).
-///  2. Neighbourhood (recommended_plan_for_noise): the 1-ring (the paper) on clean positions;
-///     Gaussian-weighted 2 or 3 rings when the position noise (the jets' residual without their
-///     truncation error, recommended_plan) is above RecommendedOptions::noise_for_two_rings or
-///     noise_for_three_rings.
-///  3. Normals. From the positions: per vertex the jets' normals, or Max's (exact on spheres)
-///     where those are clearly smoother: the RMS misfit (residual) of their 1-ring two-slit fit
-///     below half the jets'; on noisy positions instead those of wider quadratic jets (rings + 1
-///     rings), which average the noise. The file's normals are judged as a whole by their median
-///     angle to the jet normals: within twice the position noise (file_agreement; the jets' own
-///     error is about the noise) they are used, and only outliers are replaced by the positions'
-///     choice (more than 10 times the noise from the jet normal, outlier_disagreement, and half
-///     as rough); beyond it they are ignored and the positions' normals are used, turned to the
-///     file's side. Measured ratio of that median angle to the noise: 0.09 to 0.95 on clean
-///     meshes, 0.8 to 1.05 under 10% vertex noise with exact normals (used), 5.3 to 4600 under
-///     5% normal noise (ignored).
-///  4. The two-slit fit of those normals over that neighbourhood. On clean positions (1 ring)
-///     each vertex then takes the per-triangle characteristic equation averaged to the vertex
-///     (Method::triangle; 1.3 to 1.8 times lower H error on irregular meshes), except where the
-///     fit is exact (residual <= 1e-9: the rays meet two slits, as on spheres and cylinders) or
-///     the triangles give no estimate. Where the file's normals are used (trusted, on clean
-///     positions), the interpolated corrected curvature measures of those normals (LRTC20,
-///     baselines.h; converging faster than first order on irregular triangulations) replace the
-///     per-triangle rows over a ball of the vertex's mean edge length, where its 1-ring is not
-///     centrally symmetric (on grids first-order errors cancel and the per-triangle pass stays),
-///     not within 2 rings of a crease (src/curvature/corrected_step.h; measured in
-///     docs/ESTIMATOR.md, "The corrected step"). Spikes first: where the file's normals are
-///     used on clean positions, an isolated vertex that lies off its neighbours' tangent planes
-///     and off the surface its own and their normals agree on, by more than 0.75 edge lengths
-///     (kSpikeOffset), is moved back along its normal onto that surface, and the whole estimate
-///     runs again on the repaired positions with this mesh's mesh-wide choices
-///     (src/curvature/spike_repair.h; docs/ESTIMATOR.md, "Spikes").
-///  5. Creases (clean positions only): an edge whose faces' normals differ by more than
-///     RecommendedOptions::crease_angle (60 degrees) is sharp, its corners are crease vertices
-///     (RecommendedResult::crease). Within 2 rings of them the normals are Max's (each face lies
-///     on one piece) or the file's where those agree with Max's; vertices next to a crease vertex
-///     take the 1-ring fit without the crease vertices' rays.
-///  6. Robust refit (noisy positions): where a ray's misfit exceeds 5 robust scales (1.4826 x
-///     the median misfit), it is left out and the fit repeated (curvature/robust_fit.h); clean
-///     misfits never get there, so the least-squares fit stays where nothing is wild. Under
-///     position noise above kNoiseForRefittedJets the positions' jets fit twice, and normals
-///     pointing against the sum of their 1-ring's are turned.
-///  7. Never NaN where a fit is possible: undefined vertices are refitted robustly in the frame
-///     of their neighbours' mean normal over 1, then 2 more rings (kMaxExtraRings); the reach of
-///     the whole estimator is recommended_reach(plan).
-/// The paper's method as written remains estimate_curvature with default CurvatureOptions.
+/// The recommended estimator: what `focal curvature` (and focal::curvature, focal/curvature.h)
+/// runs when no estimator is chosen, and what `focal eval` reports as "focal default", on a mesh
+/// whose normals come from a file (and may be noisy) or that has none. It runs the paper's fits
+/// (the closed-form two-slit fit, and on clean positions the per-triangle characteristic
+/// equation) on better normals and, where the positions are noisy, over a wider neighbourhood:
+/// jets of the positions measure the noise and give normals, the file's normals are judged
+/// against them (used, repaired at outliers, or ignored but for their side), the rings and
+/// weights follow the noise, creases are not fitted across, wild rays are rejected, and every
+/// vertex where a fit is possible gets one. Its steps, one by one, with the reasons for each
+/// threshold: docs/METHOD.md, "The recommended estimator"; what they measure:
+/// docs/ACCURACY.md.
 ///
 /// Deterministic for any thread count. Vertices the fit cannot handle are `undefined` (NaN) as
-/// in estimate_curvature.
+/// in estimate_curvature; the paper's method as written remains estimate_curvature with default
+/// CurvatureOptions.
 
 #include <cmath>
 #include <cstdint>
@@ -101,7 +56,8 @@ struct RecommendedMeshWide {
 };
 
 /// Options of the recommended estimator. The defaults are the measured choices of
-/// docs/ESTIMATOR.md; each field is a knob of one of the steps above.
+/// docs/METHOD.md; each field is a knob of one of its steps (docs/METHOD.md, "The recommended
+/// estimator", numbered as there).
 struct RecommendedOptions {
   /// Step 2: position noise (median cubic-jet residual over the mean edge length) above which the
   /// two-slit fit uses 2 Gaussian-weighted rings...
@@ -114,7 +70,7 @@ struct RecommendedOptions {
   /// Step 3: among used file normals, one more than this many times the noise from its jet normal
   /// (and rougher than the positions' normal by half) is an outlier, replaced.
   double outlier_disagreement = 10.0;
-  /// Step 5: on clean positions, an edge whose two faces' normals differ by more than this
+  /// Step 7: on clean positions, an edge whose two faces' normals differ by more than this
   /// (radians; 0 turns crease handling off) is a crease; its corners are crease vertices.
   /// 60 degrees: above the 46 degrees that faces of the coarsest suite meshes (spacing 0.8 /
   /// max |curvature|) turn between neighbours on smooth surfaces.
@@ -145,7 +101,7 @@ struct RecommendedPlan {
   int jet_iterations = 1;  ///< their fits per vertex (2 above kNoiseForRefittedJets)
 };
 
-/// The plan for a given noise level (see the steps above); reads the noise thresholds.
+/// The plan for a given noise level (docs/METHOD.md, steps 1-2); reads the noise thresholds.
 [[nodiscard]] RecommendedPlan recommended_plan_for_noise(double noise,
                                                          const RecommendedOptions& options = {});
 
@@ -153,7 +109,8 @@ struct RecommendedPlan {
 /// position noise. A jet's residual r mixes the position noise s with the truncation error t of
 /// a cubic, which grows as the 4th power of the neighbourhood's radius: on a sample of the
 /// vertices the 3-ring jet's residual r3 (radius about 3/2 times the 2-ring's) then gives
-/// t2^2 = (r3^2 - r2^2) / ((3/2)^8 - 1) and s^2 = r2^2 - t2^2 per vertex; position_noise is the
+/// t2^2 = (r3^2 - r2^2) / ((3/2)^4 - 1) and s^2 = r2^2 - t2^2 per vertex (the thresholds were
+/// measured with this divisor; see recommended_plan.cpp); position_noise is the
 /// median s over the mean edge length. On coarse meshes of curved surfaces t dominates r.
 /// \throw InvalidInput when an option is out of range.
 [[nodiscard]] RecommendedPlan recommended_plan(const PreparedMesh& mesh,
@@ -244,7 +201,7 @@ struct RecommendedResult {
   /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
   /// their side.
   bool file_normals_used = false;
-  /// #V flags, 1 at crease vertices (step 5; clean positions only, else all 0 or empty): the
+  /// #V flags, 1 at crease vertices (step 7; clean positions only, else all 0 or empty): the
   /// curvature does not exist there, their values are not to be trusted.
   VectorXu8 crease;
 };
