@@ -12,6 +12,7 @@
 #include "bench_meshes.h"
 #include "curvature/vertex_fit.h"
 #include "curvature/vertex_rows.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/curvature.h"
 #include "focal/curvature/focal_mesh.h"
@@ -36,7 +37,7 @@ void sizes_and_threads(benchmark::internal::Benchmark* b) {
 
 const Mesh& setup(benchmark::State& state) { return torus(static_cast<int>(state.range(0))); }
 
-/// The benchmark's thread count, passed to every call.
+/// The benchmark's thread count, set for its calls by an ExecutionScope.
 int threads_of(const benchmark::State& state) { return static_cast<int>(state.range(1)); }
 
 void per_vertex(benchmark::State& state, const Mesh& m) {
@@ -45,27 +46,29 @@ void per_vertex(benchmark::State& state, const Mesh& m) {
 }
 
 void BM_Normals(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(vertex_normals(m.V, m.F, NormalWeighting::max, threads_of(state)));
+    benchmark::DoNotOptimize(vertex_normals(m.V, m.F, NormalWeighting::max));
   }
   per_vertex(state, m);
 }
 BENCHMARK(BM_Normals)->Apply(sizes_and_threads);
 
 void BM_Adjacency(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   for (auto _ : state)
-    benchmark::DoNotOptimize(
-        vertex_adjacency(static_cast<int>(m.V.rows()), m.F, threads_of(state)));
+    benchmark::DoNotOptimize(vertex_adjacency(static_cast<int>(m.V.rows()), m.F));
   per_vertex(state, m);
 }
 BENCHMARK(BM_Adjacency)->Apply(sizes_and_threads);
 
 void BM_TwoRing(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
-  for (auto _ : state) benchmark::DoNotOptimize(k_ring(one, 2, threads_of(state)));
+  for (auto _ : state) benchmark::DoNotOptimize(k_ring(one, 2));
   per_vertex(state, m);
 }
 BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
@@ -75,12 +78,11 @@ BENCHMARK(BM_TwoRing)->Apply(sizes_and_threads);
 void fit_step(benchmark::State& state, CurvatureOptions o,
               detail::SimdIsa isa = detail::SimdIsa::best) {
   const Mesh& m = setup(state);
-  o.threads = threads_of(state);
   std::vector<char> ok;
-  const RowMatrixX3d unit = detail::unit_rows(m.N, ok, o.threads);
-  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F, o.threads);
-  const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings, o.threads);
-  const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F, o.threads)};
+  const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
+  const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
+  const Neighbourhoods rings = o.rings == 1 ? one : k_ring(one, o.rings);
+  const detail::VertexFitInput in{m.V, unit, ok, rings, mean_edge_length(m.V, m.F)};
   for (auto _ : state) benchmark::DoNotOptimize(detail::fit_vertices(in, o, isa));
   per_vertex(state, m);
 }
@@ -124,9 +126,9 @@ BENCHMARK(BM_FitLevenbergMarquardt)
 
 // estimate_curvature as the library user calls it: unit normals, 1-ring, mean edge length, fit.
 void BM_EstimateCurvature(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = threads_of(state);
   for (auto _ : state) benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, m.N, o));
   per_vertex(state, m);
 }
@@ -134,9 +136,9 @@ BENCHMARK(BM_EstimateCurvature)->Apply(sizes_and_threads);
 
 // The per-triangle path (issue 5 target: 50 M faces/s on 2 threads).
 void BM_TriangleCurvature(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = threads_of(state);
   for (auto _ : state) benchmark::DoNotOptimize(triangle_curvature(m.V, m.F, m.N, o));
   state.counters["faces/s"] = benchmark::Counter(static_cast<double>(m.F.rows()),
                                                  benchmark::Counter::kIsIterationInvariantRate);
@@ -146,9 +148,9 @@ BENCHMARK(BM_TriangleCurvature)->Apply(sizes_and_threads);
 // The same with only k1, k2, H, K and the class asked for (TriangleFields): 41 B per face
 // written instead of 225.
 void BM_TriangleCurvatureCurvaturesOnly(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = threads_of(state);
   TriangleFields fields;
   fields.coefficients = fields.focal_depths = fields.directions = fields.slits = false;
   fields.face_normal = fields.shape_operator = false;
@@ -160,9 +162,9 @@ BENCHMARK(BM_TriangleCurvatureCurvaturesOnly)->Apply(sizes_and_threads);
 
 // Method::triangle: the per-face operators averaged per vertex (what `--method triangle` runs).
 void BM_EstimateCurvatureTriangleMethod(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   CurvatureOptions o;
-  o.threads = threads_of(state);
   o.method = Method::triangle;
   for (auto _ : state) benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, m.N, o));
   per_vertex(state, m);
@@ -171,46 +173,50 @@ BENCHMARK(BM_EstimateCurvatureTriangleMethod)->Apply(sizes_and_threads);
 
 // The robustness check of `focal curvature` (check stage): statistics, orientation, normals.
 void BM_CheckMesh(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(check_mesh(m.V, m.F, m.normals(), threads_of(state)));
+    benchmark::DoNotOptimize(check_mesh(m.V, m.F, m.normals()));
   }
   per_vertex(state, m);
 }
 BENCHMARK(BM_CheckMesh)->Apply(sizes_and_threads);
 
 void BM_OrientationReport(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
-  for (auto _ : state) benchmark::DoNotOptimize(orientation_report(m.V, m.F, threads_of(state)));
+  for (auto _ : state) benchmark::DoNotOptimize(orientation_report(m.V, m.F));
   per_vertex(state, m);
 }
 BENCHMARK(BM_OrientationReport)->Apply(sizes_and_threads);
 
 void BM_FocalMeshes(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
-  const FocalMeshOptions o{.threads = threads_of(state)};
+  const FocalMeshOptions o{};
   for (auto _ : state) benchmark::DoNotOptimize(focal_meshes(m.V, m.F, m.N, c, o));
   per_vertex(state, m);
 }
 BENCHMARK(BM_FocalMeshes)->Apply(sizes_and_threads);
 
 void BM_WriteCurvaturePly(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   const CurvatureResult c = estimate_curvature(m.V, m.F, m.N);
   const auto path = std::filesystem::temp_directory_path() / "focal-bench-write.ply";
-  for (auto _ : state)
-    write_curvature_ply(path, m, c, {.binary = true, .comments = {}, .threads = threads_of(state)});
+  for (auto _ : state) write_curvature_ply(path, m, c, {.binary = true, .comments = {}});
   std::filesystem::remove(path);
   per_vertex(state, m);
 }
 BENCHMARK(BM_WriteCurvaturePly)->Apply(sizes_and_threads);
 
 void BM_ReadPly(benchmark::State& state) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   const Mesh& m = setup(state);
   const auto path = std::filesystem::temp_directory_path() / "focal-bench-read.ply";
   write_ply(path, m);
-  for (auto _ : state) benchmark::DoNotOptimize(read_mesh(path, {.threads = threads_of(state)}));
+  for (auto _ : state) benchmark::DoNotOptimize(read_mesh(path));
   std::filesystem::remove(path);
   per_vertex(state, m);
 }
@@ -235,14 +241,14 @@ double best_seconds(int runs, const std::function<void()>& work) {
 }
 
 void compare_with_focal(benchmark::State& state, const Mesh& m, const Estimator& baseline) {
+  const ExecutionScope scope({.threads = threads_of(state)});
   CurvatureOptions o;
-  o.threads = threads_of(state);
-  const RowMatrixX3d N = vertex_normals(m.V, m.F, NormalWeighting::max, o.threads);
+  const RowMatrixX3d N = vertex_normals(m.V, m.F, NormalWeighting::max);
   const double fit =
       best_seconds(5, [&] { benchmark::DoNotOptimize(estimate_curvature(m.V, m.F, N, o)); });
   const double with_normals = best_seconds(5, [&] {
     benchmark::DoNotOptimize(
-        estimate_curvature(m.V, m.F, vertex_normals(m.V, m.F, NormalWeighting::max, o.threads), o));
+        estimate_curvature(m.V, m.F, vertex_normals(m.V, m.F, NormalWeighting::max), o));
   });
   const auto start = std::chrono::steady_clock::now();
   for (auto _ : state) benchmark::DoNotOptimize(baseline(m, o));

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "estimator_flags.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/io/fields_io.h"
 #include "focal/io/mesh_io.h"
@@ -24,14 +25,9 @@ struct CurvatureFlags {
   EstimatorFlags estimator;
   OutputFlags out;
 
-  [[nodiscard]] WriteOptions csv_options() const {
-    return {.threads = estimator.threads, .precision = out.precision()};
-  }
+  [[nodiscard]] WriteOptions csv_options() const { return {.precision = out.precision()}; }
   [[nodiscard]] PlyWriteOptions ply_options() const {
-    return {.binary = !ascii,
-            .comments = {},
-            .threads = estimator.threads,
-            .precision = out.precision()};
+    return {.binary = !ascii, .comments = {}, .precision = out.precision()};
   }
 };
 
@@ -46,6 +42,7 @@ struct FocalMeshFlags {
 };
 
 void run_curvature(CurvatureFlags& f, const Log& log) {
+  const ExecutionScope scope({.threads = f.estimator.threads});
   Input input(f.input, f.estimator, log);
   Estimate e = run_estimate(input, f.estimator, log, f.tiles);
   Stage stage(log, "write");
@@ -62,8 +59,7 @@ void run_curvature(CurvatureFlags& f, const Log& log) {
 
 /// The focal meshes of a mesh, or the focal point clouds (no faces) of a point cloud.
 FocalMeshes focal_meshes_of(const Input& input, FocalMeshFlags& f, const Log& log) {
-  FocalMeshOptions o = f.focal;
-  o.threads = f.estimator.threads;
+  const FocalMeshOptions& o = f.focal;
   const Estimate e = run_estimate(input, f.estimator, log);
   if (input.cloud) {
     Stage stage(log, "focal points");
@@ -74,13 +70,11 @@ FocalMeshes focal_meshes_of(const Input& input, FocalMeshFlags& f, const Log& lo
 }
 
 void run_focal_mesh(FocalMeshFlags& f, const Log& log) {
+  const ExecutionScope scope({.threads = f.estimator.threads});
   const Input input(f.input, f.estimator, log);
   const FocalMeshes meshes = focal_meshes_of(input, f, log);
   Stage stage(log, "write");
-  const PlyWriteOptions o{.binary = !f.ascii,
-                          .comments = {},
-                          .threads = f.estimator.threads,
-                          .precision = f.out.precision()};
+  const PlyWriteOptions o{.binary = !f.ascii, .comments = {}, .precision = f.out.precision()};
   // All or nothing: a failed run leaves neither new focal mesh, and existing files as they were.
   write_focal_meshes_ply(f.prefix + ".focal1.ply", f.prefix + ".focal2.ply", meshes, o);
   std::printf("wrote %s.focal1.ply (%lld faces) and %s.focal2.ply (%lld faces)\n", f.prefix.c_str(),

@@ -154,7 +154,6 @@ CloudOptions EstimatorFlags::cloud_options() const {
   }
   CloudOptions o = cloud;
   o.solver = options.solver;
-  o.threads = threads;
   if (viewpoint.size() == 3)
     o.normals.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
   return o;
@@ -178,16 +177,13 @@ EstimateOptions EstimatorFlags::estimate_options() const {
   o.estimator = recommended() ? Estimator::recommended : Estimator::paper;
   o.normals = normals;
   o.paper = options;
-  o.execution.threads = threads;
   return o;
 }
 
 Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& log) : path(path) {
   {
     Stage stage(log, "read");
-    ReadOptions read = flags.read;
-    read.threads = flags.threads;
-    mesh = read_mesh(path, read);
+    mesh = read_mesh(path, flags.read);
     // Every output has one row per vertex: an empty mesh would write an empty file and exit 0.
     if (mesh.V.rows() == 0) throw IoError(path + ": no vertices, nothing to compute");
     log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
@@ -196,14 +192,13 @@ Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& lo
   cloud = mesh.is_cloud();
   if (cloud) {
     check_cloud(mesh, path, flags.strict, log);
-    prepared.emplace(mesh.V, mesh.F, mesh.normals(), PrepareOptions{.threads = flags.threads});
+    prepared.emplace(mesh.V, mesh.F, mesh.normals());
     return;
   }
   // No output of these commands maps triangles back to input polygons: 4 bytes per face less.
   mesh.face_source = Eigen::VectorXi();
   // The one validation of the arrays for the whole run.
-  prepared.emplace(mesh.V, mesh.F, flags.uses_file_normals(mesh) ? mesh.normals() : std::nullopt,
-                   PrepareOptions{.threads = flags.threads});
+  prepared.emplace(mesh.V, mesh.F, flags.uses_file_normals(mesh) ? mesh.normals() : std::nullopt);
   findings = check_input(*prepared, path, flags.strict, log);
 }
 
@@ -219,7 +214,7 @@ Estimate run_estimate(const Input& input, const EstimatorFlags& flags, const Log
     const std::int64_t n = mesh.vertex_count();
     options.tile_vertices = static_cast<int>(std::max<std::int64_t>(1, (n + tiles - 1) / tiles));
   }
-  options.execution = execution_for(log, input.path, flags.threads);
+  options.execution = execution_for(log, input.path);
   Estimate e = curvature(mesh, options);
   print_summary(e.curvature, log);
   return e;
@@ -228,7 +223,7 @@ Estimate run_estimate(const Input& input, const EstimatorFlags& flags, const Log
 PreparedMesh estimated_mesh(const Input& input, const Estimate& e) {
   const PreparedMesh& mesh = *input.prepared;
   // Reversed faces come with normals estimated from them.
-  if (e.F) return PreparedMesh(mesh.V(), *e.F, *e.N, {.threads = mesh.threads()});
+  if (e.F) return PreparedMesh(mesh.V(), *e.F, *e.N);
   return e.N ? mesh.with_normals(*e.N) : mesh;
 }
 

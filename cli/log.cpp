@@ -61,9 +61,8 @@ Stage::~Stage() {
   std::fprintf(stderr, "  %-22s %9.1f ms\n", (name_ + ":").c_str(), ms);
 }
 
-Execution execution_for(const Log& log, const std::string& name, int threads) {
+Execution execution_for(const Log& log, const std::string& name) {
   Execution e;
-  e.threads = threads;
   // Stages begin and end in nesting order, on the calling thread.
   auto stages = std::make_shared<std::vector<std::unique_ptr<Stage>>>();
   e.progress = [&log, stages](const Progress& p) {

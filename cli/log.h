@@ -52,9 +52,10 @@ class Stage {
   std::thread watcher_;
 };
 
-/// The library's execution settings that print through `log`: each stage a Stage (timed with
+/// The library's execution callbacks that print through `log` (the thread count is the
+/// command's ExecutionScope's, from --threads): each stage a Stage (timed with
 /// -v), each warning a `Warning: <name>: ...` line, each piece of information a -v line.
 /// The returned callbacks hold a reference to `log`, which must outlive them.
-[[nodiscard]] Execution execution_for(const Log& log, const std::string& name, int threads);
+[[nodiscard]] Execution execution_for(const Log& log, const std::string& name);
 
 }  // namespace focal::cli

@@ -13,6 +13,7 @@
 
 #include "commands.h"
 #include "estimator_flags.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/io/mesh_io.h"
 #include "paths.h"
@@ -29,6 +30,7 @@ struct NormalsFlags {
 };
 
 void run_normals(NormalsFlags& f, const Log& log) {
+  const ExecutionScope scope({.threads = f.estimator.threads});
   Input input(f.input, f.estimator, log);
   RowMatrixX3d N;
   if (input.cloud) {
@@ -47,8 +49,7 @@ void run_normals(NormalsFlags& f, const Log& log) {
   }
   Stage stage(log, "write");
   input.mesh.N = std::move(N);
-  write_mesh(f.output, input.mesh,
-             {.threads = f.estimator.threads, .precision = f.out.precision()});
+  write_mesh(f.output, input.mesh, {.precision = f.out.precision()});
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "estimator_flags.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/focal_mesh.h"
 #include "focal/io/mesh_io.h"
 #include "focal/render/render.h"
@@ -115,9 +116,8 @@ Image render_mesh(RenderFlags& f, const Input& input, const Log& log) {
   if (f.focal_meshes) {
     Stage stage(log, "focal meshes");
     // Faces reaching a focal point at infinity would only draw long slivers across the view.
-    p.focal_meshes = focal_meshes(
-        mesh, fields,
-        {.max_distance = 0.0, .drop_faces_at_infinity = true, .threads = f.estimator.threads});
+    p.focal_meshes =
+        focal_meshes(mesh, fields, {.max_distance = 0.0, .drop_faces_at_infinity = true});
   }
   if (f.directions == "d1") p.directions = fields.d1;
   if (f.directions == "d2") p.directions = fields.d2;
@@ -135,8 +135,7 @@ Image render_cloud(RenderFlags& f, const Input& input, const Log& log) {
   const RowMatrixX3i no_faces(0, 3);
   if (f.focal_meshes) {
     Stage stage(log, "focal points");
-    p.focal_meshes = focal_meshes(input.mesh.V, no_faces, N, fields,
-                                  {.max_distance = 0.0, .threads = f.estimator.threads});
+    p.focal_meshes = focal_meshes(input.mesh.V, no_faces, N, fields, {.max_distance = 0.0});
   }
   if (f.directions == "d1") p.directions = fields.d1;
   if (f.directions == "d2") p.directions = fields.d2;
@@ -145,9 +144,9 @@ Image render_cloud(RenderFlags& f, const Input& input, const Log& log) {
 }
 
 void run_render(RenderFlags& f, const Log& log) {
+  const ExecutionScope scope({.threads = f.estimator.threads});
   const Input input(f.input, f.estimator, log);
   FieldPictureOptions& p = f.picture;
-  p.threads = f.estimator.threads;
   p.title = f.title.empty() ? std::filesystem::path(f.input).filename().string() + ": " +
                                   field_description(f.field)
                             : f.title;

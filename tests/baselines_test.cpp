@@ -10,6 +10,7 @@
 #include "focal/core/error.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -122,20 +123,20 @@ TEST(Baselines, ReversedFacesReverseTheSign) {
 TEST(Baselines, DeterministicForAnyThreadCountAndRingSize) {
   const AnalyticSurface s = surface(SurfaceKind::torus, Triangulation::irregular, 3000);
   for (int rings : {1, 2}) {
-    CurvatureOptions one, two;
-    one.rings = two.rings = rings;
-    one.threads = 1;
-    two.threads = 2;
-    const auto a = baselines::cohen_steiner_morvan_2003(s.mesh.V, s.mesh.F, one);
-    const auto b = baselines::cohen_steiner_morvan_2003(s.mesh.V, s.mesh.F, two);
+    CurvatureOptions o;
+    o.rings = rings;
+    const auto a = test::on_threads(
+        1, [&] { return baselines::cohen_steiner_morvan_2003(s.mesh.V, s.mesh.F, o); });
+    const auto b = test::on_threads(
+        2, [&] { return baselines::cohen_steiner_morvan_2003(s.mesh.V, s.mesh.F, o); });
     EXPECT_TRUE(a.k1.cwiseEqual(b.k1).all() && a.d1.cwiseEqual(b.d1).all());
-    const auto c = baselines::meyer_2003(s.mesh.V, s.mesh.F, one);
-    const auto d = baselines::meyer_2003(s.mesh.V, s.mesh.F, two);
+    const auto c =
+        test::on_threads(1, [&] { return baselines::meyer_2003(s.mesh.V, s.mesh.F, o); });
+    const auto d =
+        test::on_threads(2, [&] { return baselines::meyer_2003(s.mesh.V, s.mesh.F, o); });
     EXPECT_TRUE(c.k1.cwiseEqual(d.k1).all() && c.d1.cwiseEqual(d.d1).all());
   }
-  CurvatureOptions one, two;
-  one.threads = 1;
-  two.threads = 2;
+  const CurvatureOptions defaults;
   const std::vector<std::function<CurvatureResult(const CurvatureOptions&)>> others = {
       [&](const CurvatureOptions& o) {
         return baselines::lachaud_2020(s.mesh.V, s.mesh.F, {}, {}, o);
@@ -143,7 +144,8 @@ TEST(Baselines, DeterministicForAnyThreadCountAndRingSize) {
       [&](const CurvatureOptions& o) { return baselines::yang_2006(s.mesh.V, s.mesh.F, {}, o); },
       [&](const CurvatureOptions& o) { return baselines::grinspun_2006(s.mesh.V, s.mesh.F, o); }};
   for (const auto& run : others) {
-    const CurvatureResult a = run(one), b = run(two);
+    const CurvatureResult a = test::on_threads(1, [&] { return run(defaults); });
+    const CurvatureResult b = test::on_threads(2, [&] { return run(defaults); });
     EXPECT_TRUE(a.k1.cwiseEqual(b.k1).all() && a.d1.cwiseEqual(b.d1).all() &&
                 a.H.cwiseEqual(b.H).all());
   }

@@ -17,6 +17,7 @@
 #include "focal/surfaces/cloud_samples.h"
 #include "test_clouds.h"
 #include "test_identical.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -133,8 +134,9 @@ TEST(CloudCurvature, TheCorrectedStepLowersTheErrorOnCleanClouds) {
 
 TEST(CloudCurvature, SameBitsForAnyThreadCount) {
   const AnalyticSurface s = test::cloud_of(SurfaceKind::pear, 6000);
-  const CloudCurvature one = estimate_cloud_curvature(s.mesh.V, std::nullopt, {.threads = 1});
-  const CloudCurvature two = estimate_cloud_curvature(s.mesh.V, std::nullopt, {.threads = 2});
+  const auto run = [&] { return estimate_cloud_curvature(s.mesh.V); };
+  const CloudCurvature one = test::on_threads(1, run);
+  const CloudCurvature two = test::on_threads(2, run);
   EXPECT_EQ(one.N, two.N);
   EXPECT_EQ(one.curvature.k1, two.curvature.k1);
   EXPECT_EQ(one.curvature.d1, two.curvature.d1);
@@ -200,20 +202,21 @@ TEST(CloudCurvature, SpatialCopyGivesTheBitsOfTheCloudsOwnOrder) {
       {"pear with outliers", sample_cloud(pear)},
       {"pear with noisy normals", sample_cloud(bent)},
       {"noisy pear", sample_cloud(noisy)}};
-  const std::vector<CloudOptions> options = {
-      CloudOptions{.threads = 2},
-      CloudOptions{.outlier_ratio = 0, .off_surface_ratio = 0, .threads = 1},
-      CloudOptions{.k = 16, .threads = 1},
-      CloudOptions{.k = 16, .threads = 2},
-      CloudOptions{.k = 7, .threads = 3},
-      CloudOptions{.k = 16, .outlier_ratio = 0, .off_surface_ratio = 0, .threads = 2}};
+  const std::vector<std::pair<CloudOptions, int>> options = {
+      {CloudOptions{}, 2},
+      {CloudOptions{.outlier_ratio = 0, .off_surface_ratio = 0}, 1},
+      {CloudOptions{.k = 16}, 1},
+      {CloudOptions{.k = 16}, 2},
+      {CloudOptions{.k = 7}, 3},
+      {CloudOptions{.k = 16, .outlier_ratio = 0, .off_surface_ratio = 0}, 2}};
   for (const auto& [name, s] : clouds) {
     for (const bool given : {true, false}) {
       const std::optional<NormalsRef> N =
           given ? std::optional<NormalsRef>(s.mesh.N) : std::nullopt;
-      for (const CloudOptions& o : options) {
+      for (const auto& [o, threads] : options) {
+        const ExecutionScope scope({.threads = threads});
         const std::string what = name + (given ? ", normals" : ", no normals") + ", k " +
-                                 std::to_string(o.k) + ", " + std::to_string(o.threads) +
+                                 std::to_string(o.k) + ", " + std::to_string(threads) +
                                  " threads, tests " + (o.outlier_ratio > 0 ? "on" : "off");
         const CloudCurvature copy = estimate_cloud_curvature(s.mesh.V, N, o);
         CloudCurvature own = plan_cloud_curvature(s.mesh.V, N, o);
@@ -236,7 +239,7 @@ TEST(CloudCurvature, SpatialCopyGivesTheBitsOfTheCloudsOwnOrder) {
       if (!given) continue;
       // The branches the check is to cover: the file's normals rejected (the MST; the lattice's
       // tilted normals disagree with its flat planes), 64 neighbours.
-      const CloudCurvature plan = estimate_cloud_curvature(s.mesh.V, N, options[0]);
+      const CloudCurvature plan = estimate_cloud_curvature(s.mesh.V, N, options[0].first);
       EXPECT_EQ(plan.file_normals_used, name == "pear with outliers" || name == "noisy pear")
           << name;
       EXPECT_EQ(plan.k, name == "noisy pear" ? 64 : 16) << name;
@@ -253,11 +256,11 @@ TEST(CloudCurvature, ListsLeftOutChangeNoOtherField) {
   pear.surface.target_vertices = 3000;
   pear.outliers = 0.02;
   const AnalyticSurface s = sample_cloud(pear);
-  const std::vector<std::pair<bool, CloudOptions>> cases = {
-      {true, CloudOptions{.threads = 2}},
-      {true, CloudOptions{.k = 16, .threads = 2}},
-      {false, CloudOptions{.k = 7, .threads = 2}},
-      {true, CloudOptions{.radius = 0.2, .threads = 2}}};
+  const std::vector<std::pair<bool, CloudOptions>> cases = {{true, CloudOptions{}},
+                                                            {true, CloudOptions{.k = 16}},
+                                                            {false, CloudOptions{.k = 7}},
+                                                            {true, CloudOptions{.radius = 0.2}}};
+  const ExecutionScope scope({.threads = 2});
   for (const auto& [given, o] : cases) {
     const std::optional<NormalsRef> N = given ? std::optional<NormalsRef>(s.mesh.N) : std::nullopt;
     const std::string what = std::string(given ? "normals" : "no normals") + ", k " +
@@ -415,8 +418,6 @@ TEST(CloudCurvature, RejectsInvalidInput) {
   EXPECT_THROW((void)estimate_cloud_curvature(s.mesh.V, NormalsRef(few)), InvalidInput);
   EXPECT_THROW((void)estimate_cloud_curvature(s.mesh.V, std::nullopt, {.k = -1}), InvalidInput);
   EXPECT_THROW((void)estimate_cloud_curvature(s.mesh.V, std::nullopt, {.radius = -1.0}),
-               InvalidInput);
-  EXPECT_THROW((void)estimate_cloud_curvature(s.mesh.V, std::nullopt, {.threads = -1}),
                InvalidInput);
   for (double ratio : {-1.0, 0.5, 1.0, double(INFINITY), double(NAN)}) {
     EXPECT_THROW((void)estimate_cloud_curvature(s.mesh.V, std::nullopt, {.outlier_ratio = ratio}),

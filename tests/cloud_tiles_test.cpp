@@ -15,6 +15,7 @@
 #include "focal/surfaces/cloud_samples.h"
 #include "focal/tiles/tiles.h"
 #include "test_identical.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -72,12 +73,11 @@ TEST(CloudTiles, TheTilesGiveTheWholeCloudsBits) {
         const std::string what =
             c.name + ", " + names[o] + (normals ? ", the file's normals" : ", no normals");
         // The whole run on 3 threads, the tiled one on 1: no thread count shows in the bits.
-        CloudOptions whole_options = options[o], tiled_options = options[o];
-        whole_options.threads = 3;
-        tiled_options.threads = 1;
-        const CloudCurvature whole = estimate_cloud_curvature(c.s.mesh.V, N, whole_options);
-        const TileEstimate tiled = estimate_cloud_tiled(c.s.mesh.V, N, tiled_options,
-                                                        {.tile_vertices = 313, .threads = 1});
+        const CloudCurvature whole = test::on_threads(
+            3, [&] { return estimate_cloud_curvature(c.s.mesh.V, N, options[o]); });
+        const TileEstimate tiled = test::on_threads(1, [&] {
+          return estimate_cloud_tiled(c.s.mesh.V, N, options[o], {.tile_vertices = 313});
+        });
         expect_identical(whole.curvature, tiled.curvature, what);
         EXPECT_EQ(tiled.crease.size(), 0) << what;
         wide_plan |= whole.k == 4 * default_cloud_neighbours;
@@ -122,8 +122,9 @@ TEST(CloudTiles, EveryPointIsOwnedOnceWithItsNeighboursInItsTile) {
     for (int v = 0; v < n; ++v) EXPECT_NE(owner[static_cast<std::size_t>(v)], -1) << v;
   }
   // Any thread count: the same tiles.
-  const Tiling one = partition_cloud(s.mesh.V, nb, 1, {.tile_vertices = 170, .threads = 1});
-  const Tiling three = partition_cloud(s.mesh.V, nb, 1, {.tile_vertices = 170, .threads = 3});
+  const auto partition = [&] { return partition_cloud(s.mesh.V, nb, 1, {.tile_vertices = 170}); };
+  const Tiling one = test::on_threads(1, partition);
+  const Tiling three = test::on_threads(3, partition);
   ASSERT_EQ(one.tiles.size(), three.tiles.size());
   for (std::size_t t = 0; t < one.tiles.size(); ++t) {
     EXPECT_EQ(one.tiles[t].vertices, three.tiles[t].vertices);

@@ -11,6 +11,7 @@
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -158,13 +159,12 @@ TEST(Curvature, InvalidArgumentsThrow) {
 TEST(Curvature, DeterministicForAnyThreadCount) {
   const AnalyticSurface s = surface(SurfaceKind::torus, Triangulation::irregular, 3000);
   for (auto method : {Method::vertex, Method::triangle}) {
-    CurvatureOptions one, two;
-    one.method = two.method = method;
-    one.rings = two.rings = 2;
-    one.threads = 1;
-    two.threads = 2;
-    const CurvatureResult a = estimate_curvature(s.mesh.V, s.mesh.F, s.mesh.N, one);
-    const CurvatureResult b = estimate_curvature(s.mesh.V, s.mesh.F, s.mesh.N, two);
+    CurvatureOptions o;
+    o.method = method;
+    o.rings = 2;
+    const auto run = [&] { return estimate_curvature(s.mesh.V, s.mesh.F, s.mesh.N, o); };
+    const CurvatureResult a = test::on_threads(1, run);
+    const CurvatureResult b = test::on_threads(2, run);
     EXPECT_TRUE(a.k1.cwiseEqual(b.k1).all());
     EXPECT_TRUE(a.k2.cwiseEqual(b.k2).all());
     EXPECT_TRUE(a.d1.cwiseEqual(b.d1).all());

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/curvature.h"
 #include "focal/curvature/baselines.h"
 #include "focal/curvature/cloud_curvature.h"
@@ -18,6 +19,7 @@
 #include "test_clouds.h"
 #include "test_identical.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -56,6 +58,11 @@ TEST(FrontDoor, TheSameBitsForAnyThreadCount) {
   three.execution.threads = 3;
   test::expect_identical(curvature(mesh, one).curvature, curvature(mesh, three).curvature,
                          "threads 1 vs 3");
+  // An enclosing scope's count is taken where the options' is 0, and theirs wins over it.
+  const EstimateOptions defaults;
+  test::expect_identical(test::on_threads(2, [&] { return curvature(mesh, defaults); }).curvature,
+                         test::on_threads(2, [&] { return curvature(mesh, three); }).curvature,
+                         "scope of 2, options 0 vs 3");
 }
 
 TEST(FrontDoor, TilesGiveTheWholeMeshBits) {
@@ -142,7 +149,7 @@ TEST(FrontDoor, OptionsThatDoNotApplyAreErrors) {
   file.normals = NormalsSource::file;
   EXPECT_THROW((void)curvature(bare, file), InvalidInput);
   EstimateOptions negative;
-  negative.execution.threads = -1;
+  negative.execution.threads = -1;  // ExecutionScope's check
   EXPECT_THROW((void)curvature(bare, negative), InvalidInput);
 }
 

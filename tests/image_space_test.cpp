@@ -29,6 +29,7 @@
 #include "kernels/pixel.h"
 #include "kernels/triplet.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -44,8 +45,7 @@ GeometryImage image_of(SurfaceKind kind, int width, int height) {
 ImageCurvature estimate(const GBuffer& g, int window = 0, int threads = 0) {
   ImageSpaceOptions o;
   o.window = window;
-  o.threads = threads;
-  return estimate_image_curvature(g, o);
+  return test::on_threads(threads, [&] { return estimate_image_curvature(g, o); });
 }
 
 /// Errors of an estimate against a geometry image's truth over the pixels valid in the estimate.

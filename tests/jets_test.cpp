@@ -18,6 +18,7 @@
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -181,10 +182,9 @@ TEST(JetNormals, ResidualMeasuresNoiseNormalToTheSurface) {
 TEST(JetNormals, OrientedLikeTheFacesAndDeterministic) {
   const AnalyticSurface s = irregular(SurfaceKind::torus, 3000);
   for (JetOptions o : {jet(3), jet(2, 4)}) {
-    o.threads = 1;
-    const JetNormals one = jet_normals(s.mesh.V, s.mesh.F, o);
-    o.threads = 3;
-    const JetNormals three = jet_normals(s.mesh.V, s.mesh.F, o);
+    const auto run = [&] { return jet_normals(s.mesh.V, s.mesh.F, o); };
+    const JetNormals one = test::on_threads(1, run);
+    const JetNormals three = test::on_threads(3, run);
     EXPECT_TRUE(one.N == three.N) << o.rings << " rings";
     const auto a = one.residual.array(), b = three.residual.array();
     EXPECT_TRUE((a == b || (a.isNaN() && b.isNaN())).all()) << o.rings << " rings";
@@ -236,31 +236,28 @@ TEST(JetNormals, LowersTheDegreeOnSmallNeighbourhoodsAndFlagsIsolatedVertices) {
 
 TEST(JetNormals, RejectsInvalidOptions) {
   const AnalyticSurface s = irregular(SurfaceKind::sphere, 200);
-  for (auto bad : {[] {
-                     JetOptions o;
-                     o.rings = 0;
-                     return o;
-                   }(),
-                   [] {
-                     JetOptions o;
-                     o.degree = 5;
-                     return o;
-                   }(),
-                   [] {
-                     JetOptions o;
-                     o.degree = 0;
-                     return o;
-                   }(),
-                   [] {
-                     JetOptions o;
-                     o.iterations = 0;
-                     return o;
-                   }(),
-                   [] {
-                     JetOptions o;
-                     o.threads = -1;
-                     return o;
-                   }()}) {
+  for (auto bad : {
+           [] {
+             JetOptions o;
+             o.rings = 0;
+             return o;
+           }(),
+           [] {
+             JetOptions o;
+             o.degree = 5;
+             return o;
+           }(),
+           [] {
+             JetOptions o;
+             o.degree = 0;
+             return o;
+           }(),
+           [] {
+             JetOptions o;
+             o.iterations = 0;
+             return o;
+           }(),
+       }) {
     EXPECT_THROW((void)jet_normals(s.mesh.V, s.mesh.F, bad), InvalidInput);
   }
   RowMatrixX3i F(1, 3);

@@ -21,10 +21,12 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/io/fields_io.h"
 #include "test_meshes.h"
 
 namespace fs = std::filesystem;
+using focal::ExecutionScope;
 using focal::Mesh;
 using focal::RowMatrixX3d;
 using focal::RowMatrixX3i;
@@ -304,14 +306,14 @@ TEST_F(MeshIo, TextWritersGiveTheSameBytesOnAnyThreadCount) {
   for (const focal::Precision precision : {focal::Precision::float64, focal::Precision::float32}) {
     std::vector<std::string> first;
     for (const int threads : {1, 2, 3}) {
+      const ExecutionScope scope({.threads = threads});
       SCOPED_TRACE("threads " + std::to_string(threads));
-      const focal::WriteOptions o{.threads = threads, .precision = precision};
+      const focal::WriteOptions o{.precision = precision};
       focal::write_obj(file("t.obj"), m, o);
       focal::write_off(file("t.off"), m, o);
       focal::write_xyz(file("t.xyz"), m, o);
-      focal::write_ply(
-          file("t.ply"), m, {},
-          {.binary = false, .comments = {}, .threads = threads, .precision = precision});
+      focal::write_ply(file("t.ply"), m, {},
+                       {.binary = false, .comments = {}, .precision = precision});
       focal::write_csv(file("t.csv"), columns, o);
       const std::vector<std::string> bytes{slurp(file("t.obj")), slurp(file("t.off")),
                                            slurp(file("t.xyz")), slurp(file("t.ply")),
@@ -324,8 +326,6 @@ TEST_F(MeshIo, TextWritersGiveTheSameBytesOnAnyThreadCount) {
     EXPECT_EQ(back.V.rows(), n);
     EXPECT_EQ(back.F.rows(), n);
   }
-  expect_error<focal::InvalidInput>([&] { focal::write_obj(file("t.obj"), m, {.threads = -1}); },
-                                    {"write_obj", "threads"});
 }
 
 TEST_F(MeshIo, PlyAsciiRoundTripIsExact) {
@@ -1218,11 +1218,10 @@ TEST_F(MeshIo, CsvIsTheSameForAnyThreadCount) {
   }
   const std::vector<focal::CsvColumn> cols{{"x", x}, {"w", words}};
   for (const int threads : {1, 2, 3}) {
-    focal::write_csv(file("p.csv"), cols, threads);
+    const ExecutionScope scope({.threads = threads});
+    focal::write_csv(file("p.csv"), cols);
     EXPECT_EQ(slurp(file("p.csv")), expected) << threads << " threads";
   }
-  expect_error<focal::InvalidInput>([&] { focal::write_csv(file("p.csv"), cols, -1); },
-                                    {"threads"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1463,8 +1462,9 @@ TEST_F(MeshIo, BytesThatAreNotUtf8) {
 
 /// The read_mesh() message for p, or "" when it reads.
 std::string read_error(const fs::path& p, int threads = 0) {
+  const ExecutionScope scope({.threads = threads});
   try {
-    (void)focal::read_mesh(p, {.threads = threads});
+    (void)focal::read_mesh(p);
   } catch (const focal::IoError& e) {
     return e.what();
   }
@@ -1545,9 +1545,10 @@ TEST_F(MeshIo, PlyBinaryReadIsTheSameForAnyThreadCount) {
     const BigPly ply = big_binary_ply(big_endian, 50000, 90000, big_endian);
     const fs::path p = write("big.ply", ply.data);
     for (const int threads : {1, 2, 3}) {
+      const ExecutionScope scope({.threads = threads});
       SCOPED_TRACE("big endian " + std::to_string(big_endian) + ", threads " +
                    std::to_string(threads));
-      expect_same_mesh(ply.expected, focal::read_mesh(p, {.threads = threads}));
+      expect_same_mesh(ply.expected, focal::read_mesh(p));
     }
   }
 }
@@ -1599,8 +1600,9 @@ TEST_F(MeshIo, PlyBinaryParallelReadFallsBackWithTheSameResultsAndErrors) {
   q.put(std::uint8_t{4}).put(0).put(1).put(2).put(3);
   q.put(std::uint8_t{3}).put(3).put(2).put(1);
   for (const int threads : {1, 2}) {
-    expect_faces(focal::read_mesh(write("quad.ply", q.data), {.threads = threads}),
-                 {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}}, {0, 0, 1});
+    const ExecutionScope scope({.threads = threads});
+    expect_faces(focal::read_mesh(write("quad.ply", q.data)), {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}},
+                 {0, 0, 1});
   }
 }
 
@@ -1678,9 +1680,10 @@ TEST_F(MeshIo, PlyBinaryWriteIsTheSameForAnyThreadCount) {
     const std::string reference = normals ? expected : reference_ply_body(m, props);
     std::string first;
     for (const int threads : {1, 2, 3}) {
+      const ExecutionScope scope({.threads = threads});
       SCOPED_TRACE("threads " + std::to_string(threads));
       const fs::path p = file("out.ply");
-      focal::write_ply(p, m, props, {.binary = true, .comments = {}, .threads = threads});
+      focal::write_ply(p, m, props, {.binary = true, .comments = {}});
       const std::string bytes = slurp(p);
       EXPECT_TRUE(body_of(bytes) == reference);
       if (first.empty()) {
@@ -1733,9 +1736,9 @@ TEST_F(MeshIo, CurvaturePlyIsWritePlyOfTheFields) {
       focal::write_ply(file("plain.ply"), m, props,
                        {.binary = binary, .comments = {comment}, .precision = precision});
       for (const int threads : {1, 2}) {
-        focal::write_curvature_ply(
-            file("fields.ply"), m, r,
-            {.binary = binary, .comments = {}, .threads = threads, .precision = precision});
+        const ExecutionScope scope({.threads = threads});
+        focal::write_curvature_ply(file("fields.ply"), m, r,
+                                   {.binary = binary, .comments = {}, .precision = precision});
         EXPECT_TRUE(slurp(file("fields.ply")) == slurp(file("plain.ply")))
             << binary << threads << static_cast<int>(precision);
       }
@@ -1798,13 +1801,11 @@ TEST_F(MeshIo, PlyFloat32HoldsTheFloatOfEveryValue) {
     expected_header +=
         "property float f\nproperty float d\nproperty uchar u\nproperty int i\nelement face";
     for (const int threads : {1, 2}) {
+      const ExecutionScope scope({.threads = threads});
       SCOPED_TRACE("normals " + std::to_string(normals) + ", threads " + std::to_string(threads));
       const fs::path p = file("f32.ply");
       focal::write_ply(p, m, props,
-                       {.binary = true,
-                        .comments = {},
-                        .threads = threads,
-                        .precision = focal::Precision::float32});
+                       {.binary = true, .comments = {}, .precision = focal::Precision::float32});
       const std::string bytes = slurp(p);
       const std::string header = bytes.substr(0, bytes.find("end_header\n"));
       EXPECT_NE(header.find(expected_header), std::string::npos) << header;
@@ -1855,7 +1856,7 @@ TEST_F(MeshIo, TextMeshesFloat32ReadBackAsTheFloats) {
   for (const char* name : {"m.obj", "m.off", "m.xyz", "m.ply"}) {
     SCOPED_TRACE(name);
     focal::write_mesh(file(std::string("f64-") + name), m);
-    focal::write_mesh(file(name), m, {.threads = 0, .precision = focal::Precision::float32});
+    focal::write_mesh(file(name), m, {.precision = focal::Precision::float32});
     const Mesh r = focal::read_mesh(file(name));
     const bool binary = std::string_view(name) == "m.ply";
     expect_same(as_floats(m.V), binary ? r.V : as_floats(r.V));
@@ -1906,8 +1907,9 @@ TEST_F(MeshIo, CurvatureCsvFloat32HoldsTheFloatOfEveryValue) {
   const std::string doubles = slurp(file("f64.csv"));
   std::string first;
   for (const int threads : {1, 2, 3}) {
+    const ExecutionScope scope({.threads = threads});
     focal::write_curvature_csv(file("f32.csv"), r, crease,
-                               {.threads = threads, .precision = focal::Precision::float32});
+                               {.precision = focal::Precision::float32});
     const std::string text = slurp(file("f32.csv"));
     if (first.empty()) first = text;
     EXPECT_TRUE(text == first) << threads << " threads";

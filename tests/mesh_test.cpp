@@ -9,6 +9,7 @@
 #include <string>
 
 #include "focal/core/error.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -70,11 +71,11 @@ TEST(MeanEdgeLength, IsTheSameForAnyThreadCount) {
   const std::string saved = env != nullptr ? env : "";
   double first = 0.0;
   for (const int threads : {1, 2, 3}) {
-    const double mean = mean_edge_length(V, F, threads);
+    const double mean = test::on_threads(threads, [&] { return mean_edge_length(V, F); });
     EXPECT_NEAR(mean, expected, 1e-12 * expected) << threads;
     if (threads == 1) first = mean;
     EXPECT_EQ(mean, first) << threads;  // bit for bit
-    // threads = 0: FOCAL_NUM_THREADS.
+    // No scope: FOCAL_NUM_THREADS.
     setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
     EXPECT_EQ(mean_edge_length(V, F), first) << threads;
   }
@@ -95,12 +96,12 @@ TEST(ValidateMeshArrays, NamesTheFirstBadFaceForAnyThreadCount) {
   const std::string saved = env != nullptr ? env : "";
   for (const int threads : {1, 2, 3}) {
     try {
-      validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test", threads);
+      test::on_threads(threads, [&] { validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test"); });
       ADD_FAILURE() << "no exception";
     } catch (const InvalidInput& e) {
       EXPECT_STREQ(e.what(), "test: face 70000 refers to vertex 10, but there are 10 vertices");
     }
-    // threads = 0: FOCAL_NUM_THREADS.
+    // No scope: FOCAL_NUM_THREADS.
     setenv("FOCAL_NUM_THREADS", std::to_string(threads).c_str(), 1);
     EXPECT_THROW(validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "test"), InvalidInput);
   }

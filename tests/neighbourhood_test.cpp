@@ -12,6 +12,7 @@
 
 #include "focal/core/error.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -165,10 +166,14 @@ TEST(VertexAdjacency, GridRingsMatchDistanceOracle) {
 TEST(VertexAdjacency, BitwiseIdenticalForAnyThreadCount) {
   const TestMesh m = grid(60, 50);
   Neighbourhoods one_a, one_b, ring_a, ring_b;
-  one_a = vertex_adjacency(3000, m.F, 1);
-  ring_a = k_ring(one_a, 3, 1);
-  one_b = vertex_adjacency(3000, m.F, 3);
-  ring_b = k_ring(one_b, 3, 3);
+  test::on_threads(1, [&] {
+    one_a = vertex_adjacency(3000, m.F);
+    ring_a = k_ring(one_a, 3);
+  });
+  test::on_threads(3, [&] {
+    one_b = vertex_adjacency(3000, m.F);
+    ring_b = k_ring(one_b, 3);
+  });
   EXPECT_EQ(one_a.offsets, one_b.offsets);
   EXPECT_EQ(one_a.indices, one_b.indices);
   EXPECT_EQ(ring_a.offsets, ring_b.offsets);

@@ -13,7 +13,9 @@
 
 #include "core/spatial_order.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "points/measured_neighbours.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -66,10 +68,12 @@ void expect_lists(const Neighbourhoods& nb, const RowMatrixX3d& V, int k, double
 
 TEST(NearestNeighbours, MatchBruteForceWithTiesBrokenByIndex) {
   const RowMatrixX3d random = random_cloud(1500, 7);
-  expect_lists(nearest_neighbours(random, 10, 2), random, 10, 0.0);
+  expect_lists(test::on_threads(2, [&] { return nearest_neighbours(random, 10); }), random, 10,
+               0.0);
   // On the lattice the 6th, 18th, ... neighbours tie with others at the same distance.
   const RowMatrixX3d grid = lattice();
-  for (int k : {1, 6, 7, 20}) expect_lists(nearest_neighbours(grid, k, 2), grid, k, 0.0);
+  for (int k : {1, 6, 7, 20})
+    expect_lists(test::on_threads(2, [&] { return nearest_neighbours(grid, k); }), grid, k, 0.0);
 }
 
 // The tree's top 8 levels are split one level at a time and the subtrees below built in
@@ -80,7 +84,8 @@ TEST(NearestNeighbours, MatchBruteForceOnALargeCloudBuiltInParallel) {
   for (int i = 0; i < 2000; ++i) V.row(10000 + i) = V.row(i);  // duplicates
   for (int i = 12000; i < 14000; ++i) V(i, 2) = 0.25;          // a plane z = 0.25
   for (int threads : {1, 2}) {
-    const Neighbourhoods nb = nearest_neighbours(V, 16, threads);
+    const ExecutionScope scope({.threads = threads});
+    const Neighbourhoods nb = nearest_neighbours(V, 16);
     for (int i = 0; i < V.rows(); i += 37) {
       const std::vector<int> got(nb.begin(i), nb.end(i));
       ASSERT_EQ(got, brute_force(V, i, 16, 0.0)) << "point " << i << ", threads " << threads;
@@ -116,8 +121,9 @@ TEST(NearestNeighbours, EqualNanoflannsOwnTree) {
   Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   constexpr int k = 16;
   constexpr double radius = 0.12;
-  const Neighbourhoods knn = nearest_neighbours(V, k, 2);
-  const Neighbourhoods within = radius_neighbours(V, radius, 0, 2);
+  const Neighbourhoods knn = test::on_threads(2, [&] { return nearest_neighbours(V, k); });
+  const Neighbourhoods within =
+      test::on_threads(2, [&] { return radius_neighbours(V, radius, 0); });
   std::size_t radius_total = 0;
   for (int i = 0; i < V.rows(); ++i) {
     const double* q = V.row(i).data();
@@ -144,9 +150,9 @@ TEST(NearestNeighbours, EqualNanoflannsOwnTree) {
 
 TEST(NearestNeighbours, SameForAnyThreadCount) {
   const RowMatrixX3d V = random_cloud(20000, 3);
-  const Neighbourhoods one = nearest_neighbours(V, 16, 1);
-  const Neighbourhoods two = nearest_neighbours(V, 16, 2);
-  const Neighbourhoods five = nearest_neighbours(V, 16, 5);
+  const Neighbourhoods one = test::on_threads(1, [&] { return nearest_neighbours(V, 16); });
+  const Neighbourhoods two = test::on_threads(2, [&] { return nearest_neighbours(V, 16); });
+  const Neighbourhoods five = test::on_threads(5, [&] { return nearest_neighbours(V, 16); });
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.indices, two.indices);
   EXPECT_EQ(one.indices, five.indices);
@@ -156,8 +162,8 @@ TEST(NearestNeighbours, SameForAnyThreadCount) {
   EXPECT_EQ(detail::mean_spacing(V, one, 1), sum / static_cast<double>(V.rows()));
   EXPECT_EQ(detail::mean_spacing(V, one, 2), sum / static_cast<double>(V.rows()));
   EXPECT_EQ(mean_spacing(V, one), sum / static_cast<double>(V.rows()));
-  const Neighbourhoods r1 = radius_neighbours(V, 0.1, 0, 1);
-  const Neighbourhoods r2 = radius_neighbours(V, 0.1, 0, 2);
+  const Neighbourhoods r1 = test::on_threads(1, [&] { return radius_neighbours(V, 0.1, 0); });
+  const Neighbourhoods r2 = test::on_threads(2, [&] { return radius_neighbours(V, 0.1, 0); });
   EXPECT_EQ(r1.indices, r2.indices);
 }
 
@@ -165,7 +171,7 @@ TEST(NearestNeighbours, NonFinitePointsAreLeftOutAndFewPointsGiveShortLists) {
   RowMatrixX3d V = random_cloud(50, 1);
   V(3, 1) = NAN;
   V(10, 0) = INFINITY;
-  const Neighbourhoods nb = nearest_neighbours(V, 60, 1);
+  const Neighbourhoods nb = test::on_threads(1, [&] { return nearest_neighbours(V, 60); });
   EXPECT_EQ(nb.size(3), 0);
   EXPECT_EQ(nb.size(10), 0);
   for (int i = 0; i < 50; ++i) {
@@ -180,11 +186,11 @@ TEST(NearestNeighbours, NonFinitePointsAreLeftOutAndFewPointsGiveShortLists) {
 
 TEST(RadiusNeighbours, MatchBruteForceAndLimit) {
   const RowMatrixX3d V = random_cloud(1500, 11);
-  expect_lists(radius_neighbours(V, 0.15, 0, 2), V, 0, 0.15);
-  expect_lists(radius_neighbours(V, 0.3, 12, 2), V, 12, 0.3);
+  expect_lists(test::on_threads(2, [&] { return radius_neighbours(V, 0.15, 0); }), V, 0, 0.15);
+  expect_lists(test::on_threads(2, [&] { return radius_neighbours(V, 0.3, 12); }), V, 12, 0.3);
   // The radius is inclusive: lattice neighbours at distance exactly 1.
   const RowMatrixX3d grid = lattice();
-  expect_lists(radius_neighbours(grid, 1.0, 0, 2), grid, 0, 1.0);
+  expect_lists(test::on_threads(2, [&] { return radius_neighbours(grid, 1.0, 0); }), grid, 0, 1.0);
 }
 
 // Each point's list is exactly the brute-force list within its own radius, scale x the median
@@ -193,10 +199,11 @@ TEST(AdaptiveRadiusNeighbours, MatchBruteForceWithTheLocalRadius) {
   const RowMatrixX3d V = random_cloud(1500, 12);
   const int k = 10;
   const double scale = 1.2;
-  const Neighbourhoods knn = nearest_neighbours(V, k, 1);
+  const Neighbourhoods knn = test::on_threads(1, [&] { return nearest_neighbours(V, k); });
   std::vector<double> reach(static_cast<std::size_t>(V.rows()));
   for (int i = 0; i < V.rows(); ++i) reach[i] = (V.row(*(knn.end(i) - 1)) - V.row(i)).norm();
-  const Neighbourhoods nb = adaptive_radius_neighbours(V, k, scale, 0, {}, 1);
+  const Neighbourhoods nb =
+      test::on_threads(1, [&] { return adaptive_radius_neighbours(V, k, scale, 0, {}); });
   for (int i = 0; i < V.rows(); ++i) {
     std::vector<double> around{reach[i]};
     for (const int* j = knn.begin(i); j != knn.end(i); ++j) around.push_back(reach[*j]);
@@ -205,7 +212,8 @@ TEST(AdaptiveRadiusNeighbours, MatchBruteForceWithTheLocalRadius) {
     const std::vector<int> got(nb.begin(i), nb.end(i));
     ASSERT_EQ(got, brute_force(V, i, 0, radius)) << "point " << i;
   }
-  const Neighbourhoods two = adaptive_radius_neighbours(V, k, scale, 0, {}, 2);
+  const Neighbourhoods two =
+      test::on_threads(2, [&] { return adaptive_radius_neighbours(V, k, scale, 0, {}); });
   EXPECT_EQ(two.offsets, nb.offsets);
   EXPECT_EQ(two.indices, nb.indices);
 }
@@ -255,12 +263,13 @@ TEST(NearestNeighbours, ExcludedPointsAreLeftOut) {
   for (int i = 0; i < 400; i += 7) excluded[static_cast<std::size_t>(i)] = 1;
   RowMatrixX3d without = V;  // the exclusion must be what non-finite points get
   for (int i = 0; i < 400; i += 7) without(i, 0) = NAN;
-  const Neighbourhoods a = nearest_neighbours(V, 10, excluded, 2);
-  const Neighbourhoods b = nearest_neighbours(without, 10, 2);
+  const Neighbourhoods a = test::on_threads(2, [&] { return nearest_neighbours(V, 10, excluded); });
+  const Neighbourhoods b = test::on_threads(2, [&] { return nearest_neighbours(without, 10); });
   EXPECT_EQ(a.offsets, b.offsets);
   EXPECT_EQ(a.indices, b.indices);
-  const Neighbourhoods r = radius_neighbours(V, 0.3, 0, excluded, 2);
-  const Neighbourhoods s = radius_neighbours(without, 0.3, 0, 2);
+  const Neighbourhoods r =
+      test::on_threads(2, [&] { return radius_neighbours(V, 0.3, 0, excluded); });
+  const Neighbourhoods s = test::on_threads(2, [&] { return radius_neighbours(without, 0.3, 0); });
   EXPECT_EQ(r.offsets, s.offsets);
   EXPECT_EQ(r.indices, s.indices);
   EXPECT_THROW((void)nearest_neighbours(V, 10, std::vector<char>(3, 0)), InvalidInput);
@@ -456,9 +465,10 @@ TEST(Neighbours, OutlierTestsMatchTheirDefinitionsInAnyOrder) {
     EXPECT_GT(std::count(isolated.begin(), isolated.end(), 1), 5) << seed;
     EXPECT_GT(std::count(off.begin(), off.end(), 1), 5) << seed;
     for (int threads : {1, 2, 5}) {
-      const Neighbourhoods nb = nearest_neighbours(V, 16, threads);
-      EXPECT_EQ(outlier_points(V, nb, 3.0, threads), isolated) << seed << " " << threads;
-      EXPECT_EQ(off_surface_points(V, nb, 10.0, threads), off) << seed << " " << threads;
+      const ExecutionScope scope({.threads = threads});
+      const Neighbourhoods nb = nearest_neighbours(V, 16);
+      EXPECT_EQ(outlier_points(V, nb, 3.0), isolated) << seed << " " << threads;
+      EXPECT_EQ(off_surface_points(V, nb, 10.0), off) << seed << " " << threads;
       // The cloud estimators' path: the measures taken by the kNN query itself, from the tree's
       // copies of the points; the same lists, the same flags.
       const detail::MeasuredNeighbours measured =
@@ -473,7 +483,7 @@ TEST(Neighbours, OutlierTestsMatchTheirDefinitionsInAnyOrder) {
       const detail::MeasuredNeighbours rest =
           detail::measured_nearest_neighbours(V, 16, isolated, threads);
       EXPECT_EQ(detail::off_surface_points(V, rest.neighbours, rest.measures, 10.0, threads),
-                off_surface_points(V, nearest_neighbours(V, 16, isolated, threads), 10.0, threads))
+                off_surface_points(V, nearest_neighbours(V, 16, isolated), 10.0))
           << seed << " " << threads;
     }
   }
@@ -548,7 +558,7 @@ TEST(MortonOrder, APermutationThatKeepsNeighboursTogether) {
 TEST(Neighbours, RejectInvalidArguments) {
   const RowMatrixX3d V = random_cloud(10, 1);
   EXPECT_THROW((void)nearest_neighbours(V, 0), InvalidInput);
-  EXPECT_THROW((void)nearest_neighbours(V, 4, -1), InvalidInput);
+  EXPECT_THROW((void)test::on_threads(-1, [&] { return nearest_neighbours(V, 4); }), InvalidInput);
   EXPECT_THROW((void)radius_neighbours(V, 0.0), InvalidInput);
   EXPECT_THROW((void)radius_neighbours(V, NAN), InvalidInput);
   EXPECT_THROW((void)radius_neighbours(V, INFINITY), InvalidInput);

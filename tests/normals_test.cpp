@@ -15,6 +15,7 @@
 #include "focal/mesh/orientation.h"
 #include "focal/normals/vertex_normals.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -294,8 +295,9 @@ TEST(VertexNormals, BitwiseIdenticalForAnyThreadCount) {
   const TestMesh m = jittered_sphere(4, Eigen::Vector3d::Zero(), 1.0, 0.3, 11);
   ASSERT_GT(m.V.rows(), 2048);
   for (const auto weighting : kAllWeightings) {
-    const RowMatrixX3d one = vertex_normals(m.V, m.F, weighting, 1);
-    const RowMatrixX3d three = vertex_normals(m.V, m.F, weighting, 3);
+    const auto run = [&] { return vertex_normals(m.V, m.F, weighting); };
+    const RowMatrixX3d one = test::on_threads(1, run);
+    const RowMatrixX3d three = test::on_threads(3, run);
     EXPECT_TRUE((one.array() == three.array()).all());
   }
 }

@@ -19,6 +19,7 @@
 #include "focal/normals/jets.h"
 #include "focal/normals/vertex_normals.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -56,7 +57,8 @@ Mesh noisy_torus() {
 TEST(PreparedMesh, EveryFunctionGivesTheBitsOfItsArrays) {
   const Mesh m = noisy_torus();
   // One PreparedMesh through every function, so that each reuses what the earlier ones built.
-  const PreparedMesh p(m.V, m.F, m.N, {.threads = 2});
+  const ExecutionScope scope({.threads = 2});
+  const PreparedMesh p(m.V, m.F, m.N);
   const MeshFindings f = check_mesh(p);
   const MeshFindings g = check_mesh(m.V, m.F, m.N);
   EXPECT_EQ(f.summary(), g.summary());
@@ -99,12 +101,18 @@ TEST(PreparedMesh, EveryFunctionGivesTheBitsOfItsArrays) {
 
 TEST(PreparedMesh, SameResultForAnyThreadCount) {
   const Mesh m = noisy_torus();
-  const PreparedMesh one(m, {.threads = 1}), three(m, {.threads = 3});
-  expect_same(estimate_curvature(one), estimate_curvature(three));
-  expect_same(estimate_curvature_recommended(one).curvature,
-              estimate_curvature_recommended(three).curvature);
-  EXPECT_EQ(check_mesh(one).normals_against_faces_count,
-            check_mesh(three).normals_against_faces_count);
+  // Each PreparedMesh builds what it keeps on the thread count of the calls that need it.
+  const PreparedMesh one(m), three(m);
+  const auto on = [](int threads, const PreparedMesh& p) {
+    const ExecutionScope scope({.threads = threads});
+    return std::make_tuple(estimate_curvature(p), estimate_curvature_recommended(p).curvature,
+                           check_mesh(p).normals_against_faces_count);
+  };
+  const auto [a1, b1, c1] = on(1, one);
+  const auto [a3, b3, c3] = on(3, three);
+  expect_same(a1, a3);
+  expect_same(b1, b3);
+  EXPECT_EQ(c1, c3);
 }
 
 TEST(PreparedMesh, WithNormalsSharesTheGeometry) {
@@ -133,7 +141,6 @@ TEST(PreparedMesh, RejectsBadArraysOnce) {
   EXPECT_THROW(PreparedMesh(m.V, m.F, m.N.topRows(10)), InvalidInput);
   // No normals is std::nullopt, not a matrix of 0 rows.
   EXPECT_THROW(PreparedMesh(m.V, m.F, RowMatrixX3d(0, 3)), InvalidInput);
-  EXPECT_THROW(PreparedMesh(m.V, m.F, std::nullopt, {.threads = -1}), InvalidInput);
   RowMatrixX3i F = m.F;
   F(5, 1) = static_cast<int>(m.V.rows());
   try {
@@ -170,9 +177,10 @@ TEST(PreparedMesh, TheRingOfTheCheckIsTheOneRing) {
   odd.F = F;
   for (const Mesh& m : {odd, noisy_torus()}) {
     const Neighbourhoods expected =
-        vertex_adjacency(static_cast<int>(m.V.rows()), m.F, /*threads=*/1);
+        test::on_threads(1, [&] { return vertex_adjacency(static_cast<int>(m.V.rows()), m.F); });
     for (const int threads : {1, 2}) {
-      const PreparedMesh p(m.V, m.F, std::nullopt, {.threads = threads});
+      const ExecutionScope scope({.threads = threads});
+      const PreparedMesh p(m.V, m.F, std::nullopt, {});
       (void)check_mesh(p);
       const Neighbourhoods& ring = p.one_ring();
       EXPECT_EQ(ring.offsets, expected.offsets);

@@ -18,6 +18,7 @@
 #include "focal/evaluation/evaluation.h"
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -154,12 +155,14 @@ void expect_same(const CurvatureResult& a, const CurvatureResult& b) {
 TEST(Recommended, SameResultForAnyThreadCount) {
   for (Noise noise : {Noise::normals, Noise::positions}) {
     const AnalyticSurface s = suite_case(SurfaceKind::saddle, irregular, noise, 3000);
-    expect_same(
-        estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, {.threads = 1}).curvature,
-        estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N, {.threads = 3}).curvature);
-    expect_same(
-        estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt, {.threads = 1}).curvature,
-        estimate_curvature_recommended(s.mesh.V, s.mesh.F, std::nullopt, {.threads = 3}).curvature);
+    for (const bool given : {true, false}) {
+      const auto run = [&] {
+        return estimate_curvature_recommended(s.mesh.V, s.mesh.F,
+                                              given ? s.mesh.normals() : std::nullopt)
+            .curvature;
+      };
+      expect_same(test::on_threads(1, run), test::on_threads(3, run));
+    }
   }
 }
 
@@ -305,11 +308,6 @@ TEST(Recommended, IsolatedBadFileNormalsAreReplaced) {
 TEST(Recommended, RejectsInvalidInput) {
   const Mesh m = suite_case(SurfaceKind::sphere, irregular, Noise::clean, 200).mesh;
   EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, m.N.topRows(5)), InvalidInput);
-  EXPECT_THROW((void)estimate_curvature_recommended(m.V, m.F, m.N, {.threads = -1}).curvature,
-               InvalidInput);
-  EXPECT_THROW(
-      (void)estimate_curvature_recommended(m.V, m.F, std::nullopt, {.threads = -1}).curvature,
-      InvalidInput);
   RowMatrixX3i F = m.F;
   F(0, 0) = static_cast<int>(m.V.rows());
   EXPECT_THROW((void)estimate_curvature_recommended(m.V, F, std::nullopt).curvature, InvalidInput);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/curvature.h"
 #include "focal/mesh/check.h"
 #include "focal/mesh/neighbourhood.h"
@@ -30,6 +31,7 @@
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -615,7 +617,8 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
   ASSERT_GT(against, 10000);
 
   for (const int threads : {1, 2, 3}) {
-    const MeshStatistics s = mesh_statistics(m.V, m.F, threads);
+    const ExecutionScope scope({.threads = threads});
+    const MeshStatistics s = mesh_statistics(m.V, m.F);
     EXPECT_EQ(s.edge_count, reference.edges);
     EXPECT_EQ(s.boundary_edge_count, reference.boundary);
     EXPECT_EQ(s.non_manifold_edge_count, reference.non_manifold);
@@ -624,12 +627,12 @@ TEST(Robustness, TopologyCountsMatchASerialReferenceForAnyThreadCount) {
     EXPECT_EQ(s.unreferenced_vertex_count, 1);
     EXPECT_EQ(s.non_manifold_vertex_count, 1);  // vertex 0: its grid fan and the joining face
     EXPECT_EQ(s.component_count, 2);            // the joining face makes one of the first two
-    const OrientationReport r = orientation_report(m.V, m.F, threads);
+    const OrientationReport r = orientation_report(m.V, m.F);
     ASSERT_EQ(r.face_component.size(), static_cast<Eigen::Index>(components.size()));
     for (std::size_t f = 0; f < components.size(); ++f) {
       ASSERT_EQ(r.face_component[static_cast<Eigen::Index>(f)], components[f]) << "face " << f;
     }
-    const MeshFindings findings = check_mesh(m.V, m.F, m.normals(), threads);
+    const MeshFindings findings = check_mesh(m.V, m.F, m.normals());
     EXPECT_EQ(findings.component_count, 2);
     EXPECT_EQ(findings.duplicate_face_count, 1);
     EXPECT_EQ(findings.repeated_index_face_count, 2);
@@ -655,7 +658,8 @@ TEST(Robustness, InwardNormalComponentsAreCountedAlikeForAnyThreadCount) {
   m.N.middleRows(n, n) *= -1.0;  // the second torus: most normals inward
   m.N.topRows(n / 3) *= -1.0;    // a third of the first: a minority, still outward
   for (const int threads : {1, 2, 3}) {
-    const MeshFindings f = check_mesh(m.V, m.F, m.normals(), threads);
+    const ExecutionScope scope({.threads = threads});
+    const MeshFindings f = check_mesh(m.V, m.F, m.normals());
     EXPECT_EQ(f.component_count, 3);
     EXPECT_EQ(f.inward_normal_component_count, 1) << threads << " threads";
     EXPECT_EQ(f.normals_against_faces_count, n + n / 3) << threads << " threads";
@@ -720,7 +724,8 @@ TEST(Robustness, FindingsAndRingOfEveryKindOfFanAreAlikeForAnyThreadCount) {
   const Mesh m = fan_gadgets(kCopies);
   const ReferenceCounts reference = reference_counts(m);
   const auto [against, compared] = reference_against_and_compared(m);
-  const Neighbourhoods ring = vertex_adjacency(static_cast<int>(m.V.rows()), m.F, 1);
+  const Neighbourhoods ring =
+      test::on_threads(1, [&] { return vertex_adjacency(static_cast<int>(m.V.rows()), m.F); });
   const auto fields = [](const MeshFindings& f) {
     return std::vector<int>{f.non_finite_vertex_count,
                             f.repeated_index_face_count,
@@ -742,14 +747,15 @@ TEST(Robustness, FindingsAndRingOfEveryKindOfFanAreAlikeForAnyThreadCount) {
   };
   std::vector<int> first;
   for (const int threads : {1, 2, 3, 8}) {
-    const MeshStatistics s = mesh_statistics(m.V, m.F, threads);
+    const ExecutionScope scope({.threads = threads});
+    const MeshStatistics s = mesh_statistics(m.V, m.F);
     EXPECT_EQ(s.edge_count, reference.edges) << threads << " threads";
     EXPECT_EQ(s.boundary_edge_count, reference.boundary) << threads << " threads";
     EXPECT_EQ(s.non_manifold_edge_count, reference.non_manifold) << threads << " threads";
     EXPECT_EQ(s.duplicate_face_count, kCopies) << threads << " threads";
     EXPECT_EQ(s.non_manifold_vertex_count, kCopies) << threads << " threads";  // the shared apex
     EXPECT_EQ(s.component_count, 5 * kCopies) << threads << " threads";
-    const PreparedMesh p(m.V, m.F, m.N, {.threads = threads});
+    const PreparedMesh p(m.V, m.F, m.N);
     const MeshFindings f = check_mesh(p);
     EXPECT_EQ(f.boundary_edge_count, reference.boundary);
     EXPECT_EQ(f.duplicate_face_count, kCopies);

@@ -19,6 +19,7 @@
 #include "curvature/two_slit_detail.h"
 #include "curvature/vertex_fit.h"
 #include "curvature/vertex_rows.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/normal_rays.h"
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/curvature/two_slit_fit.h"
@@ -85,7 +86,7 @@ CurvatureResult fit(const Mesh& m, const FitCase& c, int threads, SimdIsa isa) {
   CurvatureOptions o;
   o.rings = c.rings;
   o.weighting = c.weighting;
-  o.threads = threads;
+  const ExecutionScope scope({.threads = threads});
   std::vector<char> ok;
   const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
   const Neighbourhoods one = vertex_adjacency(static_cast<int>(m.V.rows()), m.F);
@@ -131,7 +132,7 @@ TEST(SimdKernels, RoughnessIsTheFullFitsResidualWhereNoRayWasExcluded) {
     const Neighbourhoods rings = c.rings == 1 ? one : k_ring(one, c.rings);
     for (SimdIsa isa : available_isas()) {
       for (int threads : {1, 2, 3}) {
-        o.threads = threads;
+        const ExecutionScope scope({.threads = threads});
         const Eigen::VectorXd r =
             detail::fit_roughness({m.V, unit, ok, rings, mean_edge_length(m.V, m.F)}, o, isa);
         EXPECT_TRUE(identical(r, expected))
@@ -307,12 +308,12 @@ TEST(SimdKernels, TriangleIsBitIdenticalForEveryInstructionSetAndThreadCount) {
   curvatures.slits = curvatures.face_normal = curvatures.shape_operator = false;
   for (const TriangleFields& fields : {all, curvatures}) {
     CurvatureOptions o;
-    o.threads = 1;
+    const ExecutionScope serial({.threads = 1});
     const TriangleCurvatureResult reference =
         detail::triangle_curvature(m.V, m.F, m.N, o, fields, SimdIsa::baseline);
     for (SimdIsa isa : available_isas()) {
       for (int threads : {1, 2, 3}) {
-        o.threads = threads;
+        const ExecutionScope scope({.threads = threads});
         const TriangleCurvatureResult t = detail::triangle_curvature(m.V, m.F, m.N, o, fields, isa);
         EXPECT_TRUE(identical(t.A, reference.A) && identical(t.B, reference.B) &&
                     identical(t.C, reference.C) && identical(t.K, reference.K) &&
@@ -400,7 +401,7 @@ TEST(SimdKernels, JetLanesEqualTheScalarPathVertexByVertex) {
   cases[4].degree = 1, cases[4].rings = 1;
   cases[5].iterations = 2;
   for (JetOptions o : cases) {
-    o.threads = 1;
+    const ExecutionScope serial({.threads = 1});
     const JetNormals scalar = detail::jet_normals_from(m.V, m.one, m.start, o, std::nullopt);
     const auto with_degree = [&](auto predicate) {
       return (scalar.degree.array().unaryExpr(predicate)).count();
@@ -416,7 +417,7 @@ TEST(SimdKernels, JetLanesEqualTheScalarPathVertexByVertex) {
     }
     for (SimdIsa isa : available_isas()) {
       for (int threads : {1, 2, 3}) {
-        o.threads = threads;
+        const ExecutionScope scope({.threads = threads});
         EXPECT_TRUE(identical(detail::jet_normals_from(m.V, m.one, m.start, o, isa), scalar))
             << "degree " << o.degree << " rings " << o.rings << " isa " << static_cast<int>(isa)
             << " threads " << threads;

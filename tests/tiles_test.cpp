@@ -19,6 +19,7 @@
 #include "focal/surfaces/surfaces.h"
 #include "test_identical.h"
 #include "test_meshes.h"
+#include "test_threads.h"
 
 namespace focal {
 namespace {
@@ -338,9 +339,11 @@ TEST(Tiles, EveryVertexIsOwnedOnceAndItsReachIsInItsTile) {
 TEST(Tiles, TheTilesAreTheSameForAnyThreadCount) {
   // The tiles are cut in parallel with per-thread marks: none of it may show in a tile.
   const Mesh m = awkward_mesh(4);
-  const Tiling one = partition_mesh(m.V, m.F, 3, {.tile_vertices = 90, .threads = 1});
+  const Tiling one =
+      test::on_threads(1, [&] { return partition_mesh(m.V, m.F, 3, {.tile_vertices = 90}); });
   for (const int threads : {2, 3}) {
-    const Tiling many = partition_mesh(m.V, m.F, 3, {.tile_vertices = 90, .threads = threads});
+    const ExecutionScope scope({.threads = threads});
+    const Tiling many = partition_mesh(m.V, m.F, 3, {.tile_vertices = 90});
     ASSERT_EQ(one.tiles.size(), many.tiles.size());
     ASSERT_GT(one.tiles.size(), 4U);
     for (std::size_t t = 0; t < one.tiles.size(); ++t) {
@@ -397,7 +400,8 @@ TEST(Tiles, IdsInIsMembershipInAnAscendingSet) {
   set.erase(std::unique(set.begin(), set.end()), set.end());
   for (int& v : x) v = id(rng) + 250;  // some below and above the set's span
   for (const int threads : {1, 3}) {
-    const std::vector<char> in = ids_in(x, set, threads);
+    const ExecutionScope scope({.threads = threads});
+    const std::vector<char> in = ids_in(x, set);
     ASSERT_EQ(in.size(), x.size());
     int hits = 0;
     for (std::size_t i = 0; i < x.size(); ++i) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/surfaces/surfaces.h"
 #include "kernels/triplet.h"
 #include "mesh/prepared_access.h"
@@ -233,7 +234,7 @@ TEST(TriangleCurvature, FieldSelectionFillsOnlyTheAskedFieldsWithTheSameValues) 
   few.coefficients = few.focal_depths = few.slits = few.face_normal = false;
   CurvatureOptions o;
   for (const int threads : {1, 3}) {
-    o.threads = threads;
+    const ExecutionScope scope({.threads = threads});
     const TriangleCurvatureResult t = triangle_curvature(m.V, m.F, m.N, o, few);
     for (const Eigen::VectorXd* v : {&t.A, &t.B, &t.C, &t.lambda1, &t.lambda2}) {
       EXPECT_EQ(v->size(), 0);

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "curvature/vertex_fit.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/normals/cloud_normals.h"
 #include "focal/points/neighbours.h"
@@ -68,31 +69,31 @@ int main(int argc, char** argv) {
   focal::RowMatrixX3d V, N;
   torus_cloud(n, V, N);
   std::printf("%d points, k = %d, threads = %d\n", n, k, threads);
+  const focal::ExecutionScope scope({.threads = threads});
   focal::Neighbourhoods nb;
   {
     Timer t("kd-tree + kNN");
-    nb = focal::nearest_neighbours(V, k, threads);
+    nb = focal::nearest_neighbours(V, k);
   }
   std::vector<char> ok;
-  const focal::RowMatrixX3d unit = focal::detail::unit_rows(N, ok, threads);
+  const focal::RowMatrixX3d unit = focal::detail::unit_rows(N, ok);
   {
     Timer t("two-slit fit (closed form)");
     focal::CurvatureOptions o;
-    o.threads = threads;
     const auto r = focal::detail::fit_vertices({V, unit, ok, nb, 0.003}, o);
     std::printf("  (H of point 0: %.6f)\n", r.H[0]);
   }
   {
     Timer t("PCA normals");
-    (void)focal::pca_normals(V, nb, threads);
+    (void)focal::pca_normals(V, nb);
   }
   {
     Timer t("cloud_normals (PCA+MST+jet)");
-    (void)focal::cloud_normals(V, nb, {.threads = threads});
+    (void)focal::cloud_normals(V, nb, {});
   }
   {
     Timer t("estimate_cloud_curvature");
-    (void)focal::estimate_cloud_curvature(V, focal::NormalsRef(N), {.k = k, .threads = threads});
+    (void)focal::estimate_cloud_curvature(V, focal::NormalsRef(N), {.k = k});
   }
   return 0;
 }

@@ -3,7 +3,7 @@
 /// The front door: the curvature of a triangle mesh or of a point cloud in one call, what the
 /// `focal curvature` command runs. The options name the estimator (the recommended default, the
 /// paper's method, or a baseline of the literature), the device, tiling and the execution
-/// (threads, progress, messages, cancellation); the result carries the fields and everything a
+/// (focal/core/execution.h); the result carries the fields and everything a
 /// caller may want to report about how they were made.
 ///
 ///     focal::Mesh mesh = focal::read_mesh("bunny.ply");  // or a cloud: a file without faces

@@ -93,8 +93,8 @@ nb::dict curvature_dict(focal::CurvatureResult&& r);
 focal::EstimateOptions estimate_options(const nb::dict& o);
 
 /// A cloud's options from the dict of focal.curvature's (and cloud tiles') cloud keywords: k,
-/// radius, adaptive_radius, normal_method, viewpoint, solver, outlier_ratio, off_surface_ratio,
-/// threads (clouds.cpp).
+/// radius, adaptive_radius, normal_method, viewpoint, solver, outlier_ratio, off_surface_ratio
+/// (clouds.cpp; its "threads" is the caller's ExecutionScope's).
 focal::CloudOptions cloud_options_from(const nb::dict& d);
 
 inline std::optional<focal::NormalsRef> normals_ref(const std::optional<DoubleRows>& N) {

@@ -31,12 +31,11 @@ using namespace nb::literals;
 focal::CloudOptions cloud_options(int k, double radius, double adaptive_radius,
                                   const std::string& normal_method,
                                   const std::optional<std::vector<double>>& viewpoint,
-                                  const std::string& solver, int threads) {
+                                  const std::string& solver) {
   focal::CloudOptions o;
   o.k = k;
   o.radius = radius;
   o.adaptive_radius = adaptive_radius;
-  o.threads = threads;
   if (normal_method == "jet") {
     o.normals.method = focal::CloudNormalMethod::jet;
   } else if (normal_method == "pca") {
@@ -65,13 +64,14 @@ nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N
                          const std::string& solver, double outlier_ratio, double off_surface_ratio,
                          int threads) {
   focal::CloudOptions o =
-      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver, threads);
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver);
   o.outlier_ratio = outlier_ratio;
   o.off_surface_ratio = off_surface_ratio;
   o.keep_neighbours = false;  // not returned
   focal::CloudCurvature c;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     c = N ? focal::estimate_cloud_curvature(view(V), focal::NormalsRef(view(*N)), o)
           : focal::estimate_cloud_curvature(view(V), std::nullopt, o);
   }
@@ -84,13 +84,12 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adapt
                          const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint, int threads) {
   const focal::CloudOptions o =
-      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, "closed-form", threads);
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, "closed-form");
   focal::RowMatrixX3d N;
   {
     nb::gil_scoped_release release;
-    focal::CloudNormalOptions normals = o.normals;
-    normals.threads = threads;
-    N = focal::cloud_normals(view(V), focal::cloud_neighbourhoods(view(V), o), normals);
+    const focal::ExecutionScope scope({.threads = threads});
+    N = focal::cloud_normals(view(V), focal::cloud_neighbourhoods(view(V), o), o.normals);
   }
   return nb::cast(to_numpy(std::move(N)));
 }
@@ -104,10 +103,9 @@ focal::CloudOptions cloud_options_from(const nb::dict& d) {
                                                   : nb::cast<std::vector<double>>(d["viewpoint"]);
   const double adaptive_radius =
       d.contains("adaptive_radius") ? nb::cast<double>(d["adaptive_radius"]) : 0.0;
-  focal::CloudOptions o =
-      cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]), adaptive_radius,
-                    nb::cast<std::string>(d["normal_method"]), viewpoint,
-                    nb::cast<std::string>(d["solver"]), nb::cast<int>(d["threads"]));
+  focal::CloudOptions o = cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]),
+                                        adaptive_radius, nb::cast<std::string>(d["normal_method"]),
+                                        viewpoint, nb::cast<std::string>(d["solver"]));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
   o.off_surface_ratio = nb::cast<double>(d["off_surface_ratio"]);
   return o;
@@ -141,14 +139,15 @@ nb::object flags_to_numpy(const std::vector<char>& flags) {
 nb::dict cloud_tile_plan(const DoubleRows& V, const std::optional<DoubleRows>& N,
                          const nb::dict& options, int tile_vertices) {
   const focal::CloudOptions o = cloud_options_of(options);
+  const int threads = nb::cast<int>(options["threads"]);
   focal::CloudCurvature plan;
   focal::Tiling tiling;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     plan = N ? focal::plan_cloud_curvature(view(V), focal::NormalsRef(view(*N)), o)
              : focal::plan_cloud_curvature(view(V), std::nullopt, o);
-    tiling = focal::partition_cloud(view(V), plan.neighbours, 1,
-                                    {.tile_vertices = tile_vertices, .threads = o.threads});
+    tiling = focal::partition_cloud(view(V), plan.neighbours, 1, {.tile_vertices = tile_vertices});
   }
   nb::list tiles;
   for (const focal::Tile& t : tiling.tiles) {
@@ -191,9 +190,11 @@ nb::dict estimate_cloud_tile(const DoubleRows& V, const DoubleRows& N,
   const focal::CloudOptions o = cloud_options_of(options);
   const focal::CloudWideChoices c{nb::cast<double>(choices["spacing"]), nb::cast<int>(choices["k"]),
                                   nb::cast<bool>(choices["corrected"])};
+  const int threads = nb::cast<int>(options["threads"]);
   focal::TileEstimate r;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     const focal::TileCloud tile{view(V), view(N), flags_from(outlier)};
     r = focal::estimate_cloud_tile(tile, c, o);
   }

@@ -1,5 +1,6 @@
 // focal.image_space_curvature and focal.ImageCurvatureContext: the paper's image-space estimator
-// (section 5.1) on a G-buffer of NumPy arrays, on the CPU or a GPU, one-shot or frame after frame (focal/image_space/image_space.h; docs/IMAGE_SPACE.md).
+// (section 5.1) on a G-buffer of NumPy arrays, on the CPU or a GPU, one-shot or frame after frame
+// (focal/image_space/image_space.h; docs/IMAGE_SPACE.md).
 
 #include "focal/image_space/image_space.h"
 
@@ -48,11 +49,11 @@ nb::dict image_space_curvature(const FloatPixels& position, const FloatPixels& n
                                const BytePixels& mask, double discontinuity_ratio, int window,
                                int threads, std::optional<int> device) {
   const focal::GBuffer g = gbuffer_of(position, normal, mask);
-  const focal::ImageSpaceOptions o{
-      .discontinuity_ratio = discontinuity_ratio, .window = window, .threads = threads};
+  const focal::ImageSpaceOptions o{.discontinuity_ratio = discontinuity_ratio, .window = window};
   focal::ImageCurvature c;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     c = device ? focal::estimate_image_curvature_cuda(g, o, *device)
                : focal::estimate_image_curvature(g, o);
   }

@@ -68,7 +68,6 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   focal::EstimateOptions e;
   e.estimator = parse_enum(nb::cast<std::string>(o["estimator"]), "estimator", estimators);
   e.normals = parse_enum(nb::cast<std::string>(o["normals"]), "normals", sources);
-  const int threads = nb::cast<int>(o["threads"]);
   focal::CurvatureOptions& p = e.paper;
   p.method = parse_enum(nb::cast<std::string>(o["method"]), "method", methods);
   p.solver = parse_enum(nb::cast<std::string>(o["solver"]), "solver", solvers);
@@ -80,7 +79,6 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   p.levenberg_marquardt.tolerance = nb::cast<double>(o["lm_tolerance"]);
   p.zero_tolerance = nb::cast<double>(o["zero_tolerance"]);
   p.umbilic_tolerance = nb::cast<double>(o["umbilic_tolerance"]);
-  p.threads = threads;
   focal::RecommendedOptions& r = e.recommended;
   r.noise_for_two_rings = nb::cast<double>(o["noise_for_two_rings"]);
   r.noise_for_three_rings = nb::cast<double>(o["noise_for_three_rings"]);
@@ -88,8 +86,7 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   r.outlier_disagreement = nb::cast<double>(o["outlier_disagreement"]);
   r.zero_tolerance = p.zero_tolerance;
   r.umbilic_tolerance = p.umbilic_tolerance;
-  r.threads = threads;
-  e.execution.threads = threads;
+  e.execution.threads = nb::cast<int>(o["threads"]);
   if (o.contains("device")) {
     e.device = parse_enum(nb::cast<std::string>(o["device"]), "device", devices);
   }
@@ -146,11 +143,11 @@ nb::dict default_options() {
 }
 
 /// The estimate of focal.curvature's timing helper: the mesh pipeline (focal::estimate on a
-/// PreparedMesh of the arrays as given).
+/// PreparedMesh of the arrays as given), with the options' execution.
 focal::Estimate run_estimate(const DoubleRows& V, const IntRows& F,
-                             const std::optional<DoubleRows>& N, const focal::EstimateOptions& o,
-                             int threads) {
-  const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+                             const std::optional<DoubleRows>& N, const focal::EstimateOptions& o) {
+  const focal::ExecutionScope scope(o.execution);
+  const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N));
   return focal::estimate(mesh, o);
 }
 
@@ -170,13 +167,13 @@ nb::dict cloud_plan_dict(const focal::CloudPlan& c) {
 nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                    const nb::dict& options) {
   focal::EstimateOptions o = estimate_options(options);
-  const int threads = nb::cast<int>(options["threads"]);
   std::vector<std::string> warnings;
   o.execution.warning = [&warnings](const std::string& w) { warnings.push_back(w); };
   focal::Estimate e;
   {
     nb::gil_scoped_release release;
-    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+    const focal::ExecutionScope scope(o.execution);
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N));
     e = focal::curvature(mesh, o);
   }
   nb::dict d = curvature_dict(std::move(e.curvature));
@@ -212,12 +209,11 @@ std::vector<double> estimate_seconds(const DoubleRows& V, const IntRows& F,
                                      const std::optional<DoubleRows>& N, const nb::dict& options,
                                      int repeats) {
   const focal::EstimateOptions o = estimate_options(options);
-  const int threads = nb::cast<int>(options["threads"]);
   std::vector<double> seconds;
   nb::gil_scoped_release release;
   for (int i = 0; i < repeats; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    const focal::Estimate e = run_estimate(V, F, N, o, threads);
+    const focal::Estimate e = run_estimate(V, F, N, o);
     seconds.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
@@ -236,18 +232,16 @@ nb::dict focal_mesh_dict(focal::FocalMesh&& m) {
 nb::dict focal_meshes(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                       const nb::dict& options, double max_distance, bool drop_faces_at_infinity) {
   const focal::EstimateOptions o = estimate_options(options);
-  const int threads = nb::cast<int>(options["threads"]);
   focal::FocalMeshes meshes;
   {
     nb::gil_scoped_release release;
-    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+    const focal::ExecutionScope scope(o.execution);
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N));
     const focal::Estimate e = focal::estimate(mesh, o);
     const focal::FocalMeshOptions fo{.max_distance = max_distance,
-                                     .drop_faces_at_infinity = drop_faces_at_infinity,
-                                     .threads = threads};
+                                     .drop_faces_at_infinity = drop_faces_at_infinity};
     if (e.F) {
-      meshes = focal::focal_meshes(focal::PreparedMesh(mesh.V(), *e.F, *e.N, {.threads = threads}),
-                                   e.curvature, fo);
+      meshes = focal::focal_meshes(focal::PreparedMesh(mesh.V(), *e.F, *e.N), e.curvature, fo);
     } else {
       meshes = focal::focal_meshes(e.N ? mesh.with_normals(*e.N) : mesh, e.curvature, fo);
     }
@@ -263,7 +257,8 @@ nb::dict check_mesh(const DoubleRows& V, const IntRows& F, const std::optional<D
   focal::MeshFindings f;
   {
     nb::gil_scoped_release release;
-    f = focal::check_mesh(view(V), view(F), normals_ref(N), threads);
+    const focal::ExecutionScope scope({.threads = threads});
+    f = focal::check_mesh(view(V), view(F), normals_ref(N));
   }
   nb::dict d;
 #define FOCAL_FIELD(name) d[#name] = f.name
@@ -296,7 +291,8 @@ nb::ndarray<nb::numpy, double> vertex_normals(const DoubleRows& V, const IntRows
   focal::RowMatrixX3d N;
   {
     nb::gil_scoped_release release;
-    N = focal::vertex_normals(view(V), view(F), w, threads);
+    const focal::ExecutionScope scope({.threads = threads});
+    N = focal::vertex_normals(view(V), view(F), w);
   }
   return to_numpy(std::move(N));
 }
@@ -305,7 +301,8 @@ nb::dict read_mesh(const std::string& path, int threads) {
   focal::Mesh mesh;
   {
     nb::gil_scoped_release release;
-    mesh = focal::read_mesh(path, {.threads = threads});
+    const focal::ExecutionScope scope({.threads = threads});
+    mesh = focal::read_mesh(path);
   }
   return mesh_dict(std::move(mesh));
 }
@@ -322,7 +319,7 @@ void write_mesh(const std::string& path, const DoubleRows& V, const IntRows& F,
   mesh.V = view(V);
   mesh.F = view(F);
   if (N) mesh.N = view(*N);
-  focal::write_mesh(path, mesh, {.threads = 0, .precision = precision_of(float32)});
+  focal::write_mesh(path, mesh, {.precision = precision_of(float32)});
 }
 
 template <class Vector, class Scalar>
@@ -358,19 +355,18 @@ void write_fields(const std::string& path, const nb::dict& fields,
                                       ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])
                                       : focal::VectorXu8();
   nb::gil_scoped_release release;
+  const focal::ExecutionScope scope({.threads = threads});
   if (!V) {
-    focal::write_curvature_csv(path, r, crease,
-                               {.threads = threads, .precision = precision_of(float32)});
+    focal::write_curvature_csv(path, r, crease, {.precision = precision_of(float32)});
     return;
   }
   focal::Mesh mesh;
   mesh.V = view(*V);
   mesh.F = view(*F);
   if (N) mesh.N = view(*N);
-  focal::write_curvature_ply(
-      path, mesh, r,
-      {.binary = binary, .comments = {}, .threads = threads, .precision = precision_of(float32)},
-      crease);
+  focal::write_curvature_ply(path, mesh, r,
+                             {.binary = binary, .comments = {}, .precision = precision_of(float32)},
+                             crease);
 }
 
 nb::dict generate_surface(const std::string& kind, const std::string& triangulation,

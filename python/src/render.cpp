@@ -77,7 +77,6 @@ nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& 
   p.glyph_count = nb::cast<int>(o["glyph_count"]);
   p.splat_radius = nb::cast<double>(o["splat_radius"]);
   p.samples = nb::cast<int>(o["samples"]);
-  p.threads = nb::cast<int>(o["threads"]);
   if (directions) p.directions = view(*directions);
   if (gammas) {
     const nb::tuple& g = *gammas;
@@ -90,9 +89,11 @@ nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& 
                                                  static_cast<Eigen::Index>(field.shape(0)));
   // The camera reads the keywords (Python objects): with the GIL held.
   p.camera = camera(view(V), o);
+  const int threads = nb::cast<int>(o["threads"]);
   focal::Image image;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     image = focal::render_field_picture(view(V), view(F), view(N), values, p);
     if (path) focal::write_png(*path, image);
   }

@@ -113,7 +113,8 @@ void bind_streaming(nb::module_& m) {
         std::vector<std::int32_t> cells;
         {
           nb::gil_scoped_release release;
-          cells = focal::tile_grid_cells(view(P), box_of(lo, hi), threads);
+          const focal::ExecutionScope scope({.threads = threads});
+          cells = focal::tile_grid_cells(view(P), box_of(lo, hi));
         }
         return int32_array(cells);
       },
@@ -133,7 +134,8 @@ void bind_streaming(nb::module_& m) {
         std::vector<std::int32_t> tiles;
         {
           nb::gil_scoped_release release;
-          tiles = focal::tile_grid_tiles(view(P), box_of(lo, hi), ids_view(cell_tile), threads);
+          const focal::ExecutionScope scope({.threads = threads});
+          tiles = focal::tile_grid_tiles(view(P), box_of(lo, hi), ids_view(cell_tile));
         }
         return int32_array(tiles);
       },

@@ -52,17 +52,17 @@ focal::MeshWideChoices choices_from(const nb::dict& d) {
 nb::dict tile_plan(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
                    const nb::dict& options, int tile_vertices) {
   const focal::EstimateOptions o = estimate_options(options);
-  const int threads = nb::cast<int>(options["threads"]);
   focal::MeshWideChoices choices;
   focal::Tiling tiling;
   {
     nb::gil_scoped_release release;
-    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N), {.threads = threads});
+    const focal::ExecutionScope scope(o.execution);
+    const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N));
     choices = focal::mesh_wide_choices(mesh, o);
     const focal::FacesRef faces = choices.F ? focal::FacesRef(*choices.F) : mesh.F();
     tiling = focal::partition_mesh(mesh.V(), faces,
                                    focal::estimate_reach(focal::options_for_part(o, choices)),
-                                   {.tile_vertices = tile_vertices, .threads = threads});
+                                   {.tile_vertices = tile_vertices});
   }
   nb::list tiles;
   for (const focal::Tile& t : tiling.tiles) {
@@ -107,12 +107,12 @@ nb::dict estimate_tile(const DoubleRows& V, const IntRows& F, const std::optiona
                        const nb::dict& options, const nb::dict& choices) {
   const focal::EstimateOptions o = estimate_options(options);
   const focal::MeshWideChoices c = choices_from(choices);
-  const int threads = nb::cast<int>(options["threads"]);
   focal::TileEstimate r;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope(o.execution);
     const focal::TileMesh tile = tile_of(V, F, N);
-    r = focal::estimate_tile(tile, c, o, threads);
+    r = focal::estimate_tile(tile, c, o);
   }
   nb::dict d = curvature_dict(std::move(r.curvature));
   d["crease"] = crease_or_none(std::move(r.crease));
@@ -125,13 +125,13 @@ nb::dict tile_statistics(const DoubleRows& V, const IntRows& F, const std::optio
                          const Ids& ids, const Ids& owned, std::int64_t whole_vertex_count,
                          const nb::dict& options, double mean_edge_length) {
   const focal::EstimateOptions o = estimate_options(options);
-  const int threads = nb::cast<int>(options["threads"]);
   focal::RecommendedStatistics r;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope(o.execution);
     const focal::TileMesh tile = tile_of(V, F, N);
     r = focal::tile_statistics(tile, ids_from(ids), ids_from(owned), whole_vertex_count,
-                               mean_edge_length, o, threads);
+                               mean_edge_length, o);
   }
   nb::dict d;
   d["jet_residual"] = to_numpy(std::move(r.jet_residual));
@@ -169,8 +169,9 @@ nb::ndarray<nb::numpy, bool> ids_in(
   std::vector<char> in;
   {
     nb::gil_scoped_release release;
+    const focal::ExecutionScope scope({.threads = threads});
     in = focal::ids_in(std::span<const int>(x.data(), x.size()),
-                       std::span<const int>(ascending.data(), ascending.shape(0)), threads);
+                       std::span<const int>(ascending.data(), ascending.shape(0)));
   }
   auto* data = new bool[in.size()];
   for (std::size_t i = 0; i < in.size(); ++i) data[i] = in[i] != 0;
@@ -187,8 +188,9 @@ nb::tuple edge_length_sums(const DoubleRows& V, const IntRows& F, int threads) {
   {
     nb::gil_scoped_release release;
     const focal::RowMatrixX3d no_normals;
-    focal::validate_mesh_arrays(view(V), view(F), no_normals, "edge_length_sums", threads);
-    s = focal::edge_length_sums(view(V), view(F), threads);
+    const focal::ExecutionScope scope({.threads = threads});
+    focal::validate_mesh_arrays(view(V), view(F), no_normals, "edge_length_sums");
+    s = focal::edge_length_sums(view(V), view(F));
   }
   const auto n = static_cast<Eigen::Index>(s.sums.size());
   return nb::make_tuple(

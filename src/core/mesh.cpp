@@ -13,14 +13,14 @@
 
 namespace focal {
 
-void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what, int threads) {
+void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what) {
   const auto n = V.rows();
   // Checked in parallel blocks; only a mesh with a bad index is scanned again, in order, for the
   // first one.
   constexpr std::int64_t kBlock = 1 << 15;
   const std::int64_t faces = F.rows();
   std::vector<unsigned char> bad(static_cast<std::size_t>((faces + kBlock - 1) / kBlock), 0);
-  detail::parallel_for_blocks(faces, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+  detail::parallel_for_blocks(faces, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
     // One unsigned comparison per index (a negative one wraps above n), without branches, so
     // that the loop over the faces has no branch per index.
     const auto count = static_cast<std::uint64_t>(n);
@@ -47,7 +47,7 @@ void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* 
   }
 }
 
-EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F, int threads) {
+EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F) {
   // Edges with a NaN or infinite end are left out: one bad coordinate would otherwise make the
   // tolerances derived from this length NaN for the whole mesh, not just near the bad vertex.
   const std::int64_t faces = F.rows();
@@ -55,7 +55,7 @@ EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F, int threads) {
   EdgeLengthSums out{std::vector<double>(static_cast<std::size_t>(blocks), 0.0),
                      std::vector<std::int64_t>(static_cast<std::size_t>(blocks), 0)};
   detail::parallel_for_blocks(
-      faces, kEdgeLengthBlock, threads, [&](std::int64_t begin, std::int64_t end) {
+      faces, kEdgeLengthBlock, 0, [&](std::int64_t begin, std::int64_t end) {
         double sum = 0.0;
         std::int64_t count = 0;
         for (std::int64_t f = begin; f < end; ++f) {
@@ -73,10 +73,10 @@ EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F, int threads) {
   return out;
 }
 
-double mean_edge_length(PositionsRef V, FacesRef F, int threads) {
+double mean_edge_length(PositionsRef V, FacesRef F) {
   // The blocks' sums added in block order: blocks do not depend on the thread count, so
   // neither does the result (and a mesh of one block sums as before).
-  const EdgeLengthSums blocks = edge_length_sums(V, F, threads);
+  const EdgeLengthSums blocks = edge_length_sums(V, F);
   double sum = 0.0;
   std::int64_t count = 0;
   for (std::size_t b = 0; b < blocks.sums.size(); ++b) {

@@ -1,4 +1,5 @@
-// The process-wide worker pool behind parallel_chunks (see parallel.h for why it exists).
+// The process-wide worker pool behind parallel_chunks (see parallel.h for why it exists), and
+// the calling thread's current Execution (focal/core/execution.h) that sets its thread count.
 #include "core/parallel.h"
 
 #if defined(__linux__)
@@ -15,6 +16,40 @@
 #include <thread>
 #include <utility>
 
+#include "focal/core/error.h"
+#include "focal/core/execution.h"
+
+namespace focal {
+
+namespace {
+/// The innermost ExecutionScope's Execution on this thread (null: none); on a pool worker, that
+/// of the loop it is working on.
+thread_local const Execution* t_execution = nullptr;
+}  // namespace
+
+ExecutionScope::ExecutionScope(const Execution& execution)
+    : execution_(execution), enclosing_(t_execution) {
+  if (execution.threads < 0) throw InvalidInput("ExecutionScope: threads must be >= 0");
+  if (enclosing_ != nullptr) {
+    // Fields left at their defaults are the enclosing scope's.
+    if (execution_.threads == 0) execution_.threads = enclosing_->threads;
+    if (!execution_.progress) execution_.progress = enclosing_->progress;
+    if (!execution_.warning) execution_.warning = enclosing_->warning;
+    if (!execution_.info) execution_.info = enclosing_->info;
+    if (execution_.cancel == nullptr) execution_.cancel = enclosing_->cancel;
+  }
+  t_execution = &execution_;
+}
+
+ExecutionScope::~ExecutionScope() { t_execution = enclosing_; }
+
+const Execution& current_execution() {
+  static const Execution defaults;
+  return t_execution != nullptr ? *t_execution : defaults;
+}
+
+}  // namespace focal
+
 namespace focal::detail {
 
 namespace {
@@ -25,6 +60,9 @@ struct Job {
   std::int64_t chunks = 0;
   const std::function<void(std::int64_t)>* chunk = nullptr;
   int max_helpers = 0;  ///< workers that may join (threads - 1)
+  /// The caller's current Execution: current on each worker while it takes chunks, so that a
+  /// loop's body sees the settings of the thread that started the loop.
+  const Execution* execution = nullptr;
   std::atomic<std::int64_t> next{0};
   int joined = 0;            ///< workers that joined; guarded by Pool::mutex
   int inside = 0;            ///< workers still working on it; guarded by Pool::mutex
@@ -38,6 +76,7 @@ thread_local int t_depth = 0;  // > 0 while running chunks: a nested loop runs s
 /// Takes chunks of `job` until none is left, as worker `slot` of it.
 void take_chunks(Job& job, int slot) {
   const int saved_slot = std::exchange(t_slot, slot);
+  const Execution* saved_execution = std::exchange(t_execution, job.execution);
   ++t_depth;
   for (std::int64_t c; (c = job.next.fetch_add(1, std::memory_order_relaxed)) < job.chunks;) {
     try {
@@ -49,6 +88,7 @@ void take_chunks(Job& job, int slot) {
     }
   }
   --t_depth;
+  t_execution = saved_execution;
   t_slot = saved_slot;
 }
 
@@ -124,6 +164,7 @@ int available_cpus() {
 
 int thread_count(int requested) {
   if (requested > 0) return requested;
+  if (const int scoped = current_execution().threads; scoped > 0) return scoped;
   if (const char* env = std::getenv("FOCAL_NUM_THREADS")) {
     const int n = std::atoi(env);
     if (n > 0) return n;
@@ -154,6 +195,7 @@ void parallel_chunks(std::int64_t chunks, int threads,
   job.chunks = chunks;
   job.chunk = &chunk;
   job.max_helpers = t - 1;
+  job.execution = t_execution;
   Pool::instance().run(job);
 }
 

@@ -31,7 +31,8 @@ namespace focal::detail {
 /// CPUs this process may run on (its affinity mask), at least 1.
 int available_cpus();
 
-/// Threads to use: `requested` if > 0, else FOCAL_NUM_THREADS if set, else available_cpus().
+/// Threads to use: `requested` if > 0, else the current ExecutionScope's threads if > 0
+/// (focal/core/execution.h), else FOCAL_NUM_THREADS if set, else available_cpus().
 /// At most this many threads work on one loop; fewer when the process-wide pool is busy.
 int thread_count(int requested);
 

@@ -4,9 +4,9 @@
 #include <string>
 #include <utility>
 
+#include "focal/core/error.h"
 #include "focal/cuda/curvature.h"
 #include "focal/cuda/device.h"
-#include "focal/core/error.h"
 
 namespace focal::detail {
 
@@ -18,7 +18,7 @@ TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
     throw InvalidInput(std::string(what) + ": " + std::to_string(N.rows()) + " normals for " +
                        std::to_string(V.rows()) + " vertices");
   }
-  validate_mesh_arrays(V, F, N, what, options.threads);
+  validate_mesh_arrays(V, F, N, what);
   TriangleInput in;
   in.faces = static_cast<int>(F.rows());
   in.V.resize(3 * static_cast<std::size_t>(V.rows()));
@@ -32,8 +32,7 @@ TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
     for (int c = 0; c < 3; ++c) in.F[3 * f + c] = F(f, c);
   }
   // The thresholds of triangle_curvature (detail::class_tolerances), rounded to float.
-  in.zero_tolerance =
-      static_cast<float>(options.zero_tolerance / mean_edge_length(V, F, options.threads));
+  in.zero_tolerance = static_cast<float>(options.zero_tolerance / mean_edge_length(V, F));
   in.umbilic_tolerance = static_cast<float>(options.umbilic_tolerance);
   return in;
 }

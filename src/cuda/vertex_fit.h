@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vertex_fit.h"
-#include "focal/curvature/curvature.h"
 #include "focal/core/error.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/curvature.h"
 #include "focal/mesh/neighbourhood.h"
+#include "kernels/vertex_fit.h"
 
 namespace focal::cuda {
 
@@ -39,12 +39,11 @@ inline void validate_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N,
   if (!(o.gaussian_width >= 0.0)) throw InvalidInput(who + "gaussian_width must be >= 0");
   if (!(o.zero_tolerance >= 0.0)) throw InvalidInput(who + "zero_tolerance must be >= 0");
   if (!(o.umbilic_tolerance >= 0.0)) throw InvalidInput(who + "umbilic_tolerance must be >= 0");
-  if (o.threads < 0) throw InvalidInput(who + "threads must be >= 0");
   if (N.rows() != V.rows()) {
     throw InvalidInput(who + std::to_string(N.rows()) + " normals for " + std::to_string(V.rows()) +
                        " vertices (normals are required; estimate them with vertex_normals)");
   }
-  validate_mesh_arrays(V, F, N, "estimate_curvature_cuda", o.threads);
+  validate_mesh_arrays(V, F, N, "estimate_curvature_cuda");
 }
 
 /// Threshold of det / (trace/3)^3 below which a fit is `undefined`. The CPU (double) uses 1e-12.
@@ -105,7 +104,7 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
   validate_vertex_fit(V, F, N, options);
   PreparedVertexFit<T> p;
   const Eigen::Index n = V.rows();
-  const double h = mean_edge_length(V, F, options.threads);
+  const double h = mean_edge_length(V, F);
   const double unit = length_unit(h, options.rings);
   p.vertices.resize(static_cast<std::size_t>(n));
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -113,8 +112,8 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
     for (int c = 0; c < 3; ++c) split(V(i, c) / unit, r.position_hi[c], r.position_lo[c]);
     set_record_normal(N, i, r);
   }
-  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(n), F, options.threads);
-  p.rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings, options.threads);
+  const Neighbourhoods one_ring = vertex_adjacency(static_cast<int>(n), F);
+  p.rings = options.rings == 1 ? one_ring : k_ring(one_ring, options.rings);
   // As curvature.cpp: Gaussian width = mean edge length x rings unless given; class_tolerances.
   const double width = options.gaussian_width > 0.0 ? options.gaussian_width : h * options.rings;
   VertexFitParams<T>& q = p.params;

@@ -51,7 +51,6 @@ void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o
   if (!(o.adaptive_radius >= 0.0) || !std::isfinite(o.adaptive_radius)) {
     throw InvalidInput("cloud curvature: adaptive_radius must be finite and >= 0");
   }
-  if (o.threads < 0) throw InvalidInput("cloud curvature: threads must be >= 0");
   if (!(o.outlier_ratio == 0.0 || (o.outlier_ratio > 1.0 && std::isfinite(o.outlier_ratio)))) {
     throw InvalidInput("cloud curvature: outlier_ratio must be 0 (off) or finite and > 1, got " +
                        std::to_string(o.outlier_ratio));
@@ -74,18 +73,18 @@ void validate(PositionsRef V, std::optional<NormalsRef> N, const CloudOptions& o
 Neighbourhoods neighbourhoods_without(PositionsRef V, const CloudOptions& options,
                                       const std::vector<char>& excluded,
                                       const std::vector<int>& tie_rows = {}) {
-  if (options.k < 0 || !(options.radius >= 0.0) || options.threads < 0) {
-    throw InvalidInput("cloud neighbourhoods: k, radius and threads must be >= 0");
+  if (options.k < 0 || !(options.radius >= 0.0)) {
+    throw InvalidInput("cloud neighbourhoods: k and radius must be >= 0");
   }
   if (options.radius > 0.0) {
-    return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, excluded, options.threads);
+    return radius_neighbours(V, options.radius, kMaxRadiusNeighbours, excluded);
   }
   const int k = options.k > 0 ? options.k : default_cloud_neighbours;
   if (options.adaptive_radius > 0.0) {
-    return adaptive_radius_neighbours(V, k, options.adaptive_radius, kMaxRadiusNeighbours, excluded,
-                                      options.threads);
+    return adaptive_radius_neighbours(V, k, options.adaptive_radius, kMaxRadiusNeighbours,
+                                      excluded);
   }
-  return detail::nearest_neighbours(V, k, excluded, options.threads, tie_rows);
+  return detail::nearest_neighbours(V, k, excluded, 0, tie_rows);
 }
 
 bool any_flag(const std::vector<char>& flags) {
@@ -103,19 +102,18 @@ std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours
   std::vector<char> flags;
   if (o.outlier_ratio > 0.0) {
     flags = detail::outlier_points(V, nearest16.neighbours, nearest16.measures.reach,
-                                   o.outlier_ratio, o.threads);
+                                   o.outlier_ratio, 0);
   }
   if (o.off_surface_ratio == 0.0) return flags;
   // The planes without the isolated outliers, which would tilt them.
   std::vector<char> off;
   if (any_flag(flags)) {
-    const detail::MeasuredNeighbours rest = detail::measured_nearest_neighbours(
-        V, default_cloud_neighbours, flags, o.threads, tie_rows);
-    off = detail::off_surface_points(V, rest.neighbours, rest.measures, o.off_surface_ratio,
-                                     o.threads);
+    const detail::MeasuredNeighbours rest =
+        detail::measured_nearest_neighbours(V, default_cloud_neighbours, flags, 0, tie_rows);
+    off = detail::off_surface_points(V, rest.neighbours, rest.measures, o.off_surface_ratio, 0);
   } else {
     off = detail::off_surface_points(V, nearest16.neighbours, nearest16.measures,
-                                     o.off_surface_ratio, o.threads);
+                                     o.off_surface_ratio, 0);
   }
   if (flags.empty()) return off;
   for (std::size_t i = 0; i < flags.size(); ++i) flags[i] = flags[i] || off[i];
@@ -124,7 +122,6 @@ std::vector<char> outlier_flags(PositionsRef V, const detail::MeasuredNeighbours
 
 CloudNormalOptions normal_options(const CloudOptions& o) {
   CloudNormalOptions normals = o.normals;
-  normals.threads = o.threads;
   return normals;
 }
 
@@ -138,8 +135,7 @@ CloudCurvature given_lists(PositionsRef V, const CloudOptions& options,
   const bool sixteen = options.radius == 0.0 && options.adaptive_radius == 0.0 &&
                        options.k == default_cloud_neighbours;
   const auto nearest16 = [&] {
-    return detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, options.threads,
-                                               tie_rows);
+    return detail::measured_nearest_neighbours(V, default_cloud_neighbours, {}, 0, tie_rows);
   };
   if (!tests_on(options)) {
     out.neighbours = neighbourhoods_without(V, options, {}, tie_rows);
@@ -155,7 +151,7 @@ CloudCurvature given_lists(PositionsRef V, const CloudOptions& options,
     if (any_flag(out.outlier))
       out.neighbours = neighbourhoods_without(V, options, out.outlier, tie_rows);
   }
-  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads, tie_rows);
+  out.spacing = detail::mean_spacing(V, out.neighbours, 0, tie_rows);
   out.k = options.radius > 0.0 || options.adaptive_radius > 0.0 ? 0 : options.k;
   return out;
 }
@@ -207,7 +203,6 @@ RowMatrixX3d with_max_normals(PositionsRef V, RowMatrixX3d jets, const Neighbour
   const RowMatrixX3d M = detail::unit_rows(max, max_ok, threads);
   max = RowMatrixX3d();
   CurvatureOptions fit;
-  fit.threads = threads;
   const Eigen::VectorXd rj = detail::fit_roughness({V, J, ok, neighbours, spacing}, fit);
   const Eigen::VectorXd rm = detail::fit_roughness({V, M, max_ok, neighbours, spacing}, fit);
   detail::parallel_for(V.rows(), threads, [&](std::int64_t i) {
@@ -230,20 +225,20 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   static const std::vector<int> own_order;
   const std::vector<int>& tie_rows = copy_of ? copy_of->permutation.order : own_order;
   const auto nearest = [&](int k, const std::vector<char>& excluded) {
-    return detail::nearest_neighbours(V, k, excluded, options.threads, tie_rows);
+    return detail::nearest_neighbours(V, k, excluded, 0, tie_rows);
   };
   CloudCurvature out;
   out.k = default_cloud_neighbours;
   if (tests_on(options)) {
     detail::MeasuredNeighbours nearest16 =
-        detail::measured_nearest_neighbours(V, out.k, {}, options.threads, tie_rows);
+        detail::measured_nearest_neighbours(V, out.k, {}, 0, tie_rows);
     out.outlier = outlier_flags(V, nearest16, options, tie_rows);
     out.neighbours =
         any_flag(out.outlier) ? nearest(out.k, out.outlier) : std::move(nearest16.neighbours);
   } else {
     out.neighbours = nearest(out.k, {});
   }
-  out.spacing = detail::mean_spacing(V, out.neighbours, options.threads, tie_rows);
+  out.spacing = detail::mean_spacing(V, out.neighbours, 0, tie_rows);
   CloudNormalOptions normals = normal_options(options);
   // With the file's normals, the jets start on their side: the noise and the agreement below
   // need no orientation, and the MST (serial) runs only if the file's normals are not used.
@@ -270,7 +265,7 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   out.N = std::move(jets.N);
   jets = JetNormals();  // the residuals and degrees let go before Max's normals
   if (out.k == default_cloud_neighbours && !out.file_normals_used) {
-    out.N = with_max_normals(V, std::move(out.N), out.neighbours, out.spacing, options.threads);
+    out.N = with_max_normals(V, std::move(out.N), out.neighbours, out.spacing, 0);
   }
   if (N && !out.file_normals_used) {
     for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
@@ -313,13 +308,12 @@ namespace {
 /// copy), which the default's later steps then visit them in.
 void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, bool spatial_rows) {
   std::vector<char> ok;
-  out.N = detail::unit_rows(out.N, ok, options.threads);
+  out.N = detail::unit_rows(out.N, ok, 0);
   CurvatureOptions fit;
   fit.solver = options.solver;
   fit.levenberg_marquardt = options.levenberg_marquardt;
   fit.zero_tolerance = options.zero_tolerance;
   fit.umbilic_tolerance = options.umbilic_tolerance;
-  fit.threads = options.threads;
   detail::validate_curvature_options(fit);
   // A spacing of 0 (a single point, or all duplicates) would make every |k| "not zero"; 1 keeps
   // the tolerance finite, and such points are undefined anyway (fewer than two rays).
@@ -334,13 +328,13 @@ void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, 
     if (spatial_rows) {
       std::iota(order.begin(), order.end(), 0);
     } else {
-      order = detail::morton_order(V, options.threads);
+      order = detail::morton_order(V, 0);
     }
     // The default, as the mesh default on noisy positions: where rays lie far off the fit
     // (a neighbour off the surface, or with a normal bent by one), it is repeated without them
     // (curvature/robust_fit.h; clean fits keep every ray, bit for bit).
-    detail::robust_fit_vertices({input, {}, 0.0}, order, detail::class_tolerances(fit, scale),
-                                options.threads, true, out.curvature);
+    detail::robust_fit_vertices({input, {}, 0.0}, order, detail::class_tolerances(fit, scale), 0,
+                                true, out.curvature);
     if (out.corrected) {
       // Clean positions without outliers: the corrected step on each point's local
       // triangulation where the fit is not exact (corrected_step.h; docs/notes/points-log.md, "The
@@ -387,7 +381,7 @@ void take_rows(CurvatureResult& r, const std::vector<int>& from, int threads) {
 CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, PositionsRef copy,
                             const detail::RowPermutation& p, const CloudOptions& options) {
   std::optional<RowMatrixX3d> sided;  // the jets start on the side of N's rows
-  if (N) sided = detail::rows_from(*N, p.order, options.threads);
+  if (N) sided = detail::rows_from(*N, p.order, 0);
   const detail::CloudCopy copy_of{p, V};
   return adaptive_plan(copy, sided ? std::optional<NormalsRef>(*sided) : std::nullopt, options,
                        &copy_of);
@@ -404,25 +398,24 @@ CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, Positio
 /// every other step reads a point's own and its list's rows only.
 CloudCurvature in_spatial_order(PositionsRef V, std::optional<NormalsRef> N,
                                 const CloudOptions& options) {
-  const detail::RowPermutation p = detail::morton_permutation(V, options.threads);
-  RowMatrixX3d copy = detail::rows_from(V, p.order, options.threads);
+  const detail::RowPermutation p = detail::morton_permutation(V, 0);
+  RowMatrixX3d copy = detail::rows_from(V, p.order, 0);
   CloudCurvature c;
   if (uses_plan(options)) {
     c = plan_on_copy(V, N, copy, p, options);
   } else {
     c = given_lists(copy, options, p.order);
     c.file_normals_used = true;
-    c.N = detail::rows_from(*N, p.order, options.threads);
+    c.N = detail::rows_from(*N, p.order, 0);
   }
   fit_plan(copy, c, options, true);
   copy = RowMatrixX3d();
   // Each field's copy is let go as it is taken back: the results are held once, as without the
   // copy, but for the one field in flight (docs/POINTS.md, "Speed and memory").
-  c.neighbours = options.keep_neighbours
-                     ? detail::unpermuted_neighbours(c.neighbours, p, options.threads)
-                     : Neighbourhoods();
-  take_rows(c.curvature, p.position, options.threads);
-  take_rows(c.N, p.position, options.threads);
+  c.neighbours = options.keep_neighbours ? detail::unpermuted_neighbours(c.neighbours, p, 0)
+                                         : Neighbourhoods();
+  take_rows(c.curvature, p.position, 0);
+  take_rows(c.N, p.position, 0);
   if (!c.outlier.empty()) {
     std::vector<char> outlier(c.outlier.size());
     for (std::size_t i = 0; i < outlier.size(); ++i)
@@ -459,18 +452,17 @@ RowMatrixX3d estimate_cloud_normals(PositionsRef V, std::optional<NormalsRef> N,
     return out;
   }
   // The plan on the cloud's copy in Morton order, as estimate_cloud_curvature runs it.
-  const detail::RowPermutation p = detail::morton_permutation(V, options.threads);
-  CloudCurvature plan =
-      plan_on_copy(V, N, detail::rows_from(V, p.order, options.threads), p, options);
+  const detail::RowPermutation p = detail::morton_permutation(V, 0);
+  CloudCurvature plan = plan_on_copy(V, N, detail::rows_from(V, p.order, 0), p, options);
   if (!plan.file_normals_used) {  // jet normals: unit or NaN rows
-    return detail::rows_from(plan.N, p.position, options.threads);
+    return detail::rows_from(plan.N, p.position, 0);
   }
   std::vector<char> ok;
-  RowMatrixX3d out = detail::unit_rows(plan.N, ok, options.threads);
+  RowMatrixX3d out = detail::unit_rows(plan.N, ok, 0);
   for (Eigen::Index i = 0; i < out.rows(); ++i) {
     if (!ok[static_cast<std::size_t>(i)]) out.row(i).setConstant(NAN);
   }
-  return detail::rows_from(out, p.position, options.threads);
+  return detail::rows_from(out, p.position, 0);
 }
 
 }  // namespace focal

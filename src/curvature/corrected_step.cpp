@@ -147,7 +147,7 @@ void cloud_corrected_measures(PositionsRef V, const RowMatrixX3d& N, const std::
     throw InvalidInput("cloud_corrected_measures: the order does not have #V rows");
   }
   const ClassTolerances tol = class_tolerances(options, scale);
-  parallel_for_blocks(V.rows(), 64, options.threads, [&](std::int64_t begin, std::int64_t end) {
+  parallel_for_blocks(V.rows(), 64, 0, [&](std::int64_t begin, std::int64_t end) {
     LocalScratch scratch;
     for (std::int64_t k = begin; k < end; ++k) {
       const std::int64_t i = order.empty() ? k : order[static_cast<std::size_t>(k)];
@@ -179,9 +179,8 @@ Eigen::VectorXd stencil_asymmetry(PositionsRef V, const RowMatrixX3d& N,
 CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
                              const CurvatureOptions& options, const std::vector<char>& keep,
                              double exact_residual, const CurvatureResult& fit) {
-  return corrected_rows(
-      fitted, one_ring, options, keep, exact_residual, fit,
-      stencil_asymmetry(fitted.V(), unit_normals(fitted).N, one_ring, options.threads));
+  return corrected_rows(fitted, one_ring, options, keep, exact_residual, fit,
+                        stencil_asymmetry(fitted.V(), unit_normals(fitted).N, one_ring, 0));
 }
 
 CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
@@ -191,7 +190,7 @@ CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& o
   const UnitNormals& unit = unit_normals(fitted);
   // Each vertex's radius from its own asymmetry: written in place, no second array.
   Eigen::VectorXd& radius = asymmetry;
-  parallel_for(fitted.vertex_count(), options.threads, [&](std::int64_t i) {
+  parallel_for(fitted.vertex_count(), 0, [&](std::int64_t i) {
     const bool replaceable = !(fit.residual[i] <= exact_residual) &&
                              (keep.empty() || !keep[static_cast<std::size_t>(i)]);
     // Radius 0, no measure: symmetric stencils (and NaN asymmetry: no normal, no neighbour).
@@ -208,7 +207,7 @@ CorrectedRows corrected_rows(const PreparedMesh& fitted, const Neighbourhoods& o
   CorrectedRows out{
       baselines::detail::corrected_curvature(fitted, unit.N, radius, kCorrectedBallRings, options),
       std::vector<char>(static_cast<std::size_t>(fitted.vertex_count()), 0)};
-  parallel_for(fitted.vertex_count(), options.threads, [&](std::int64_t i) {
+  parallel_for(fitted.vertex_count(), 0, [&](std::int64_t i) {
     out.replace[static_cast<std::size_t>(i)] = radius[i] > 0.0 && std::isfinite(out.values.H[i]);
   });
   return out;
@@ -223,8 +222,8 @@ void apply_corrected_rows(const CorrectedRows& rows, int threads, CurvatureResul
 void prefer_corrected_measures(const PreparedMesh& fitted, const Neighbourhoods& one_ring,
                                const CurvatureOptions& options, const std::vector<char>& keep,
                                double exact_residual, CurvatureResult& fit) {
-  apply_corrected_rows(corrected_rows(fitted, one_ring, options, keep, exact_residual, fit),
-                       options.threads, fit);
+  apply_corrected_rows(corrected_rows(fitted, one_ring, options, keep, exact_residual, fit), 0,
+                       fit);
 }
 
 }  // namespace focal::detail

@@ -33,7 +33,6 @@ void detail::validate_curvature_options(const CurvatureOptions& o) {
   if (!(o.zero_tolerance >= 0.0)) throw InvalidInput("curvature: zero_tolerance must be >= 0");
   if (!(o.umbilic_tolerance >= 0.0))
     throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
-  if (o.threads < 0) throw InvalidInput("curvature: threads must be >= 0");
 }
 
 namespace {
@@ -349,11 +348,10 @@ CurvatureResult detail::vertex_curvature_from_rays(const PreparedMesh& mesh,
                                                    const Neighbourhoods& one_ring,
                                                    const CurvatureOptions& options) {
   CurvatureOptions o = options;
-  o.threads = threads_for(mesh, options.threads);
   const UnitNormals& unit = unit_normals(mesh);
   const VertexFitInput in{mesh.V(), unit.N, unit.ok, one_ring, mesh.mean_edge_length()};
   if (o.rings == 1) return fit_vertices(in, o);
-  const Neighbourhoods rings = k_ring(one_ring, o.rings, o.threads);
+  const Neighbourhoods rings = k_ring(one_ring, o.rings);
   return fit_vertices({in.V, unit.N, unit.ok, rings, in.mean_edge_length}, o);
 }
 
@@ -377,8 +375,7 @@ CurvatureResult estimate_curvature(const PreparedMesh& mesh, const CurvatureOpti
 CurvatureResult estimate_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                    const CurvatureOptions& options) {
   detail::validate_curvature_options(options);
-  return estimate_curvature(
-      detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "curvature"), options);
+  return estimate_curvature(detail::PreparedAccess::make(V, F, N, {}, "curvature"), options);
 }
 
 namespace detail {
@@ -391,7 +388,7 @@ CurvatureResult fit_vertices(const VertexFitInput& in, const CurvatureOptions& o
   // Blocks of vertices share one scratch; 256 vertices amortise its allocation and still give
   // each thread many blocks (static schedule, so the same split for any run). Blocks are whole
   // groups of any lane width, so a group never straddles two threads' output.
-  parallel_for_blocks(in.V.rows(), 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+  parallel_for_blocks(in.V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {
     if (options.solver == Solver::closed_form) return fit_block(context, begin, end, result);
     detail::VertexRays scratch;
     for (auto i = begin; i < end; ++i) fit_vertex(context, static_cast<int>(i), scratch, result);
@@ -414,7 +411,7 @@ Eigen::VectorXd fit_roughness_at(const VertexFitInput& in, const CurvatureOption
   Eigen::VectorXd roughness(count);
   Roughness out{roughness.data()};
   const FitBlock<Roughness> fit_block = fit_block_for<Roughness>(isa);
-  parallel_for_blocks(count, 256, options.threads, [&](std::int64_t begin, std::int64_t end) {
+  parallel_for_blocks(count, 256, 0, [&](std::int64_t begin, std::int64_t end) {
     fit_block(context, begin, end, out);
   });
   return roughness;

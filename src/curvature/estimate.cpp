@@ -91,8 +91,7 @@ PreparedMesh mesh_to_fit(const PreparedMesh& mesh, const PreparedNormals& normal
       normals.N ? std::optional<NormalsRef>(*normals.N) : mesh.normals();
   if (!normals.F) return normals.N ? mesh.with_normals(N) : mesh;
   // Reversed faces have the same corners: F was valid, so are they.
-  return detail::PreparedAccess::make(mesh.V(), *normals.F, N, {.threads = mesh.threads()},
-                                      "estimate");
+  return detail::PreparedAccess::make(mesh.V(), *normals.F, N, {}, "estimate");
 }
 
 /// The paper's estimator. The per-vertex fit gets the 1-ring, then the incidence is freed: the

@@ -60,7 +60,6 @@ FocalMeshes focal_meshes(const PreparedMesh& mesh, const CurvatureResult& curvat
                        std::to_string(curvature.k1.size()) + " curvature values");
   }
   if (!(options.max_distance >= 0.0)) throw InvalidInput("focal meshes: max_distance must be >= 0");
-  if (options.threads < 0) throw InvalidInput("focal meshes: threads must be >= 0");
   const double max_distance =
       options.max_distance > 0.0 ? options.max_distance : 10.0 * bounding_box_diagonal(V);
   const detail::UnitNormals& unit = detail::unit_normals(mesh);
@@ -73,10 +72,8 @@ FocalMeshes focal_meshes(const PreparedMesh& mesh, const CurvatureResult& curvat
 
 FocalMeshes focal_meshes(PositionsRef V, FacesRef F, NormalsRef N, const CurvatureResult& curvature,
                          const FocalMeshOptions& options) {
-  if (options.threads < 0) throw InvalidInput("focal meshes: threads must be >= 0");
-  return focal_meshes(
-      detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "focal meshes"),
-      curvature, options);
+  return focal_meshes(detail::PreparedAccess::make(V, F, N, {}, "focal meshes"), curvature,
+                      options);
 }
 
 }  // namespace focal

@@ -49,7 +49,7 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted,
   o.method = Method::triangle;
   const Eigen::Index n = fitted.vertex_count();
   std::vector<char> wanted(static_cast<std::size_t>(n));
-  detail::parallel_for(n, c.threads, [&](std::int64_t i) {
+  detail::parallel_for(n, 0, [&](std::int64_t i) {
     const auto v = static_cast<std::size_t>(i);
     wanted[v] = !(fit.residual[i] <= kExactFitResidual) && (replaced.empty() || !replaced[v]);
   });
@@ -73,8 +73,7 @@ void prefer_triangles(const Context& c, const PreparedMesh& fitted,
   }
   // The whole mesh's scale (the classes' tolerances), the fitted normals, the same threads.
   const PreparedMesh sub = detail::PreparedAccess::make(
-      fitted.V(), part, fitted.normals(), {.threads = c.threads, .mean_edge_length = c.edge_length},
-      "prefer_triangles");
+      fitted.V(), part, fitted.normals(), {.mean_edge_length = c.edge_length}, "prefer_triangles");
   detail::replace_with_triangles(sub, o, wanted, fit);
 }
 
@@ -87,11 +86,11 @@ void robust_refit(const Context& c, const PreparedMesh& fitted, int rings, bool 
   if (vertices.empty()) return;
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   const detail::UnitNormals& unit = detail::unit_normals(fitted);
-  const Neighbourhoods wider = rings > 1 ? k_ring(*c.one_ring, rings, c.threads) : Neighbourhoods{};
+  const Neighbourhoods wider = rings > 1 ? k_ring(*c.one_ring, rings) : Neighbourhoods{};
   const detail::VertexFitInput in{c.mesh.V(), unit.N, unit.ok, rings > 1 ? wider : *c.one_ring,
                                   c.edge_length};
   detail::robust_fit_vertices({in, skip, gaussian ? c.edge_length * rings : 0.0}, vertices,
-                              detail::class_tolerances(paper_options(c), c.edge_length), c.threads,
+                              detail::class_tolerances(paper_options(c), c.edge_length), 0,
                               only_rejecting, fit);
 }
 
@@ -169,8 +168,8 @@ std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
   // Unit rows of its own, not the mesh's kept ones: nothing after this step reads them, and kept
   // they would stay alive through the fit and the per-triangle pass (24 B a vertex).
   std::vector<char> ok;
-  const RowMatrixX3d N = detail::unit_rows(*c.mesh.normals(), ok, c.threads);
-  const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, c.threads);
+  const RowMatrixX3d N = detail::unit_rows(*c.mesh.normals(), ok, 0);
+  const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, 0);
   const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
   if (spikes.empty()) return std::nullopt;
   return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
@@ -193,9 +192,8 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
     if (const std::optional<RowMatrixX3d> V = spike_repaired(c)) {
       RecommendedOptions o = options;
       o.mesh_wide = mesh_wide;
-      o.threads = c.threads;
       const PreparedMesh repaired = detail::PreparedAccess::make(
-          *V, mesh.F(), mesh.normals(), {.threads = c.threads, .mean_edge_length = c.edge_length},
+          *V, mesh.F(), mesh.normals(), {.mean_edge_length = c.edge_length},
           "estimate_curvature_recommended");
       return estimate(repaired, o, false);
     }
@@ -210,8 +208,8 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
     // beside the fit's result (the peak of a run at 1M).
     Eigen::VectorXd asymmetry;
     if (out.file_normals_used) {
-      asymmetry = detail::stencil_asymmetry(fitted.V(), detail::unit_normals(fitted).N, *c.one_ring,
-                                            c.threads);
+      asymmetry =
+          detail::stencil_asymmetry(fitted.V(), detail::unit_normals(fitted).N, *c.one_ring, 0);
     }
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
     // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
@@ -221,7 +219,7 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
     if (out.file_normals_used) {
       detail::CorrectedRows measures =
           corrected(c, fitted, out.crease, std::move(asymmetry), out.curvature);
-      detail::apply_corrected_rows(measures, c.threads, out.curvature);
+      detail::apply_corrected_rows(measures, 0, out.curvature);
       replaced = std::move(measures.replace);
     }
     // The 1-ring's memory is the per-triangle pass's (later steps rebuild it if they need it).
@@ -253,8 +251,7 @@ RecommendedResult estimate_curvature_recommended(PositionsRef V, FacesRef F,
                                                  const RecommendedOptions& options) {
   validate_options(options, "estimate_curvature_recommended");
   return estimate_curvature_recommended(
-      detail::PreparedAccess::make(V, F, std::move(N), {.threads = options.threads},
-                                   "estimate_curvature_recommended"),
+      detail::PreparedAccess::make(V, F, std::move(N), {}, "estimate_curvature_recommended"),
       options);
 }
 

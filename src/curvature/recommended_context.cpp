@@ -30,25 +30,18 @@ void validate_options(const RecommendedOptions& o, const char* what) {
   non_negative(o.zero_tolerance, "zero_tolerance");
   non_negative(o.umbilic_tolerance, "umbilic_tolerance");
   non_negative(o.crease_angle, "crease_angle");
-  if (o.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
 }
 
 Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options) {
-  const int threads = detail::threads_for(mesh, options.threads);
-  return {mesh,
-          options,
-          threads,
-          mesh.mean_edge_length(),
-          detail::one_ring(mesh),
+  return {mesh, options, mesh.mean_edge_length(), detail::one_ring(mesh),
           detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh),
-                                      NormalWeighting::max, threads)};
+                                      NormalWeighting::max, 0)};
 }
 
 CurvatureOptions paper_options(const Context& c) {
   CurvatureOptions o;
   o.zero_tolerance = c.options.zero_tolerance;
   o.umbilic_tolerance = c.options.umbilic_tolerance;
-  o.threads = c.threads;
   return o;
 }
 
@@ -60,7 +53,7 @@ CurvatureResult two_slit_fit(const Context& c, const PreparedMesh& normals, int 
   const detail::UnitNormals& unit = detail::unit_normals(normals);
   const PositionsRef& V = c.mesh.V();
   if (rings == 1) return detail::fit_vertices({V, unit.N, unit.ok, *c.one_ring, c.edge_length}, o);
-  const Neighbourhoods ring = k_ring(*c.one_ring, rings, c.threads);
+  const Neighbourhoods ring = k_ring(*c.one_ring, rings);
   return detail::fit_vertices({V, unit.N, unit.ok, ring, c.edge_length}, o);
 }
 
@@ -92,17 +85,16 @@ double finite_median(const Eigen::VectorXd& x) {
   return *mid;
 }
 
-JetOptions jet_options(const Context& c, int rings, int degree) {
+JetOptions jet_options(int rings, int degree) {
   JetOptions o;
   o.rings = rings;
   o.degree = degree;
   o.iterations = 1;
-  o.threads = c.threads;
   return o;
 }
 
 JetNormals local_jets(const Context& c, int rings, int degree) {
-  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, jet_options(c, rings, degree));
+  return detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, jet_options(rings, degree));
 }
 
 }  // namespace focal::detail::recommended

@@ -27,7 +27,7 @@ namespace {
 /// smoother). Rows where the wider jet fails stay.
 RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
   const std::vector<bool> boundary =
-      boundary_vertices(static_cast<int>(c.mesh.vertex_count()), c.mesh.F(), c.threads);
+      boundary_vertices(static_cast<int>(c.mesh.vertex_count()), c.mesh.F());
   std::vector<int> near;
   const Eigen::VectorXi distance = rings_to_boundary(*c.one_ring, boundary, kBoundaryJetDistance);
   for (int i = 0; i < distance.size(); ++i) {
@@ -36,7 +36,7 @@ RowMatrixX3d with_boundary_jets(const Context& c, const RowMatrixX3d& jets) {
   RowMatrixX3d out = jets;
   if (near.empty()) return out;
   const JetNormals wide = detail::jet_normals_at(c.mesh.V(), *c.one_ring, c.max,
-                                                 jet_options(c, kBoundaryJetRings, 3), near);
+                                                 jet_options(kBoundaryJetRings, 3), near);
   for (std::size_t k = 0; k < near.size(); ++k) {
     const auto row = static_cast<Eigen::Index>(k);
     if (wide.N.row(row).allFinite()) out.row(near[k]) = wide.N.row(row);
@@ -98,7 +98,7 @@ RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormal
   };
   RowMatrixX3d out(file.rows(), 3);
   std::vector<char> candidate(static_cast<std::size_t>(file.rows()));
-  detail::parallel_for(file.rows(), c.threads, [&](std::int64_t i) {
+  detail::parallel_for(file.rows(), 0, [&](std::int64_t i) {
     const Eigen::Vector3d a = file.row(i).transpose().normalized();
     out.row(i) = a.transpose();
     candidate[static_cast<std::size_t>(i)] = !a.allFinite() || may_replace(i);
@@ -110,7 +110,7 @@ RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormal
   if (at.empty()) return out;
   const Eigen::VectorXd jets_roughness = roughness_at(c, jets.N, at);
   const Eigen::VectorXd max_roughness = roughness_at(c, c.max, at);
-  detail::parallel_for(static_cast<std::int64_t>(at.size()), c.threads, [&](std::int64_t k) {
+  detail::parallel_for(static_cast<std::int64_t>(at.size()), 0, [&](std::int64_t k) {
     const int i = at[static_cast<std::size_t>(k)];
     const auto [b, rb] = positions_normal(c, jets, jets_roughness[k], max_roughness[k], i, side);
     out.row(i) = select_normal(file.row(i).transpose(), file_roughness[i], b, rb, may_replace(i))
@@ -124,7 +124,7 @@ RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, const JetNormal
 /// normal, comes from folded faces); such a normal leaves every neighbour's ray out of its fit.
 RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
   std::vector<char> turn(static_cast<std::size_t>(N.rows()), 0);
-  detail::parallel_for(N.rows(), c.threads, [&](std::int64_t i) {
+  detail::parallel_for(N.rows(), 0, [&](std::int64_t i) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     const int v = static_cast<int>(i);
     for (const int* j = c.one_ring->begin(v); j != c.one_ring->end(v); ++j) {
@@ -172,7 +172,7 @@ std::vector<char> crease_vertices(const Context& c) {
   };
   std::vector<char> crease(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
   detail::parallel_for_blocks(
-      c.mesh.vertex_count(), 1024, c.threads, [&](std::int64_t begin, std::int64_t end) {
+      c.mesh.vertex_count(), 1024, 0, [&](std::int64_t begin, std::int64_t end) {
         // Each face's normal and corners once per vertex (a face meets two others at v).
         std::vector<FaceAtVertex> faces;
         for (auto i = begin; i < end; ++i) {
@@ -227,7 +227,7 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
   } else {
     if (out.plan.rings > 1) {
       // Noisy positions: normals from wider, lower-degree jets that average the noise.
-      JetOptions o = jet_options(c, out.plan.jet_rings, out.plan.jet_degree);
+      JetOptions o = jet_options(out.plan.jet_rings, out.plan.jet_degree);
       o.iterations = out.plan.jet_iterations;
       out.N =
           turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
@@ -235,7 +235,7 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
       // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
       // first-order (rough) on irregular meshes.
       const RowMatrixX3d J = with_boundary_jets(c, jets.N);
-      out.N = select_normals(J, roughness_of(c, J), c.max, roughness_of(c, c.max), c.threads);
+      out.N = select_normals(J, roughness_of(c, J), c.max, roughness_of(c, c.max), 0);
     }
     for (Eigen::Index i = 0; i < out.N.rows(); ++i) {
       if (side > 0.0 && out.N.row(i).allFinite()) continue;  // nothing to change

@@ -42,7 +42,7 @@ bool in_noise_sample(Eigen::Index i, Eigen::Index n, double r2) {
 Eigen::VectorXd noise_at(const Context& c, const Eigen::VectorXd& r2,
                          const std::vector<int>& sample) {
   const Eigen::VectorXd r3 =
-      detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(c, 3, 3), sample);
+      detail::jet_residuals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(3, 3), sample);
   constexpr double kGrowth = 5.0625 - 1.0;  // (3/2)^4 - 1
   Eigen::VectorXd noise(static_cast<Eigen::Index>(sample.size()));
   for (Eigen::Index k = 0; k < noise.size(); ++k) {
@@ -134,7 +134,7 @@ FileComparison compare_file_normals(const Context& c, const JetNormals& jets) {
   // mesh's side.
   const double side =
       c.options.mesh_wide ? c.options.mesh_wide->side : majority_side(*file, jets.N);
-  return {side, angles_between(*file, jets.N, side, c.threads)};
+  return {side, angles_between(*file, jets.N, side, 0)};
 }
 
 RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
@@ -204,7 +204,7 @@ RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std
   const Context c = make_context(part, measured);
   // The jets of the listed vertices (detail::jet_normals_at: the bits of local_jets' rows).
   const JetNormals jets =
-      detail::jet_normals_at(part.V(), *c.one_ring, c.max, jet_options(c, 2, 3), rows);
+      detail::jet_normals_at(part.V(), *c.one_ring, c.max, jet_options(2, 3), rows);
   RecommendedStatistics out;
   out.jet_residual = jets.residual;
   // position_noise's sample, by whole-mesh index; noise_at reads r2 by part row.
@@ -226,7 +226,7 @@ RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std
     std::tie(out.along, out.against) = sides(file_rows, jets.N);
     out.angle_along.resize(m);
     out.angle_against.resize(m);
-    detail::parallel_for(m, c.threads, [&](std::int64_t k) {
+    detail::parallel_for(m, 0, [&](std::int64_t k) {
       out.angle_along[k] = angle_between(file_rows, jets.N, 1.0, k);
       out.angle_against[k] = angle_between(file_rows, jets.N, -1.0, k);
     });
@@ -273,8 +273,7 @@ int recommended_reach(const RecommendedPlan& plan) {
 
 RecommendedPlan recommended_plan(PositionsRef V, FacesRef F, const RecommendedOptions& options) {
   validate_options(options, "recommended_plan");
-  return recommended_plan(detail::PreparedAccess::make(
-                              V, F, std::nullopt, {.threads = options.threads}, "recommended_plan"),
+  return recommended_plan(detail::PreparedAccess::make(V, F, std::nullopt, {}, "recommended_plan"),
                           options);
 }
 

@@ -27,16 +27,15 @@ void validate_options(const RecommendedOptions& o, const char* what);
 struct Context {
   const PreparedMesh& mesh;
   const RecommendedOptions& options;
-  int threads;
   double edge_length;
   mutable std::shared_ptr<const Neighbourhoods> one_ring;  ///< dropped and rebuilt on demand
   RowMatrixX3d max;                                        ///< freed once the normals are chosen
 };
 
-/// The context of `mesh` with `options`: threads resolved, its 1-ring and Max's normals.
+/// The context of `mesh` with `options`: its 1-ring and Max's normals.
 Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options);
 
-/// The paper's estimator options with the recommended estimator's classes and threads.
+/// The paper's estimator options with the recommended estimator's classes.
 CurvatureOptions paper_options(const Context& c);
 
 /// The paper's per-vertex closed-form two-slit fit of the normals of `normals` (the mesh with
@@ -59,8 +58,8 @@ Eigen::VectorXd roughness_at(const Context& c, NormalsRef normals,
 /// Median of the finite entries; NaN when there are none.
 double finite_median(const Eigen::VectorXd& x);
 
-/// Jet options of `rings` rings and `degree`, one fit, the context's threads.
-JetOptions jet_options(const Context& c, int rings, int degree);
+/// Jet options of `rings` rings and `degree`, one fit.
+JetOptions jet_options(int rings, int degree);
 
 /// Jets from Max's normals: unit or NaN rows by construction, so not checked again.
 JetNormals local_jets(const Context& c, int rings, int degree);

@@ -296,9 +296,8 @@ TriangleCurvatureResult triangle_curvature(PositionsRef V, FacesRef F, NormalsRe
 TriangleCurvatureResult detail::triangle_curvature(PositionsRef V, FacesRef F, NormalsRef N,
                                                    const CurvatureOptions& options,
                                                    const TriangleFields& fields, SimdIsa isa) {
-  return triangle_curvature(
-      PreparedAccess::make(V, F, N, {.threads = options.threads}, "triangle curvature"), options,
-      fields, isa);
+  return triangle_curvature(PreparedAccess::make(V, F, N, {}, "triangle curvature"), options,
+                            fields, isa);
 }
 
 namespace {
@@ -323,8 +322,7 @@ TriangleCurvatureResult detail::triangle_curvature(const PreparedMesh& mesh,
   if (!mesh.has_normals()) throw InvalidInput("triangle curvature: the mesh has no normals");
   const UnitNormals& unit = unit_normals(mesh);
   const ClassTolerances tol = class_tolerances(options, mesh.mean_edge_length());
-  return solve_faces({mesh.V(), unit.N, unit.ok, mesh.F(), tol, fields}, isa,
-                     threads_for(mesh, options.threads));
+  return solve_faces({mesh.V(), unit.N, unit.ok, mesh.F(), tol, fields}, isa, 0);
 }
 
 namespace {
@@ -439,7 +437,6 @@ void for_each_average(const PreparedMesh& mesh, const CurvatureOptions& options,
   if (!mesh.has_normals()) throw InvalidInput("triangle curvature: the mesh has no normals");
   const PositionsRef& V = mesh.V();
   const FacesRef& F = mesh.F();
-  const int threads = detail::threads_for(mesh, options.threads);
   const detail::UnitNormals& unit_normals = detail::unit_normals(mesh);
   const RowMatrixX3d& unit = unit_normals.N;
   const std::vector<char>& ok = unit_normals.ok;
@@ -453,21 +450,20 @@ void for_each_average(const PreparedMesh& mesh, const CurvatureOptions& options,
     const std::int64_t last = std::min<std::int64_t>(V.rows(), first + kAverageBlock);
     const BlockFaces block = faces_of_block(F, inc, ok, first, last, row);
     records.resize(static_cast<std::size_t>(block.F.rows()));
-    const SolvedFaces solved{solve_faces({V, unit, ok, block.F, tol, needed, records.data()},
-                                         detail::SimdIsa::best, threads),
-                             records, row};
+    const SolvedFaces solved{
+        solve_faces({V, unit, ok, block.F, tol, needed, records.data()}, detail::SimdIsa::best, 0),
+        records, row};
     // Scratch per block of vertices, as in the per-vertex fit: no allocation per vertex.
-    detail::parallel_for_blocks(
-        last - first, 256, threads, [&](std::int64_t begin, std::int64_t end) {
-          std::vector<FacePart> parts;
-          for (auto i = first + begin; i < first + end; ++i) {
-            if (ok[static_cast<std::size_t>(i)]) {
-              body(i, std::optional<VertexAverage>(average_at_vertex(solved, inc, unit, i, parts)));
-            } else {
-              body(i, std::optional<VertexAverage>());
-            }
-          }
-        });
+    detail::parallel_for_blocks(last - first, 256, 0, [&](std::int64_t begin, std::int64_t end) {
+      std::vector<FacePart> parts;
+      for (auto i = first + begin; i < first + end; ++i) {
+        if (ok[static_cast<std::size_t>(i)]) {
+          body(i, std::optional<VertexAverage>(average_at_vertex(solved, inc, unit, i, parts)));
+        } else {
+          body(i, std::optional<VertexAverage>());
+        }
+      }
+    });
     for (int f : block.listed) row[static_cast<std::size_t>(f)] = -1;
   }
 }

@@ -49,16 +49,6 @@ void inform(const Execution& execution, const std::string& message) {
 
 bool is_baseline(Estimator e) { return e != Estimator::recommended && e != Estimator::paper; }
 
-/// The options with the execution's threads given to every step whose own count is 0.
-EstimateOptions with_threads(EstimateOptions o) {
-  const int threads = o.execution.threads;
-  if (threads < 0) throw InvalidInput("curvature: Execution::threads must be >= 0");
-  if (o.paper.threads == 0) o.paper.threads = threads;
-  if (o.recommended.threads == 0) o.recommended.threads = threads;
-  if (o.cloud.threads == 0) o.cloud.threads = threads;
-  return o;
-}
-
 /// The warnings about what the normals stage fixed or suspects.
 void report_normals(const NormalsReport& r, const Execution& execution) {
   if (r.reoriented_component_count > 0) {
@@ -147,13 +137,11 @@ void count_undefined(const PreparedMesh& mesh, const EstimateOptions& o, Estimat
   const bool lost_jets = o.estimator == Estimator::recommended && e.plan.rings == 1;
   if (rings > 1 && (e.undefined_count > 0 || lost_jets) && may_be_crowded(mesh, rings)) {
     e.crowded_count = static_cast<std::int64_t>(
-        crowded_vertices(
-            vertex_adjacency(static_cast<int>(mesh.vertex_count()), mesh.F(), mesh.threads()),
-            rings, mesh.threads())
+        crowded_vertices(vertex_adjacency(static_cast<int>(mesh.vertex_count()), mesh.F()), rings)
             .size());
     e.crowded_rings = rings;
   }
-  const Execution& execution = o.execution;
+  const Execution& execution = current_execution();
   if (e.crowded_count > 0) {
     warn(execution, std::to_string(e.crowded_count) + " vertices have more than " +
                         std::to_string(kMaxNeighbourhoodSize) + " vertices within " +
@@ -218,7 +206,7 @@ Estimate device_estimate(const PreparedMesh& mesh, PreparedNormals normals,
 }
 
 Estimate mesh_curvature(const PreparedMesh& mesh, const EstimateOptions& o) {
-  const Execution& execution = o.execution;
+  const Execution& execution = current_execution();
   if (is_baseline(o.estimator)) {
     require_cpu_only(o, "the baselines");
     if (o.tile_vertices > 0) throw InvalidInput("curvature: the baselines do not run in tiles");
@@ -239,8 +227,7 @@ Estimate mesh_curvature(const PreparedMesh& mesh, const EstimateOptions& o) {
     {
       StageReport stage(execution,
                         "curvature in tiles of " + std::to_string(o.tile_vertices) + " vertices");
-      TileEstimate t =
-          estimate_tiled(mesh, o, {.tile_vertices = o.tile_vertices, .threads = execution.threads});
+      TileEstimate t = estimate_tiled(mesh, o, {.tile_vertices = o.tile_vertices});
       e.curvature = std::move(t.curvature);
       e.crease = std::move(t.crease);
     }
@@ -282,15 +269,14 @@ void require_cloud_options(const EstimateOptions& o) {
 
 Estimate cloud_curvature(const PreparedMesh& cloud, const EstimateOptions& o) {
   require_cloud_options(o);
-  const Execution& execution = o.execution;
+  const Execution& execution = current_execution();
   Estimate e;
   if (o.tile_vertices > 0) {
     {
       StageReport stage(
           execution, "cloud curvature in tiles of " + std::to_string(o.tile_vertices) + " points");
-      TileEstimate t =
-          estimate_cloud_tiled(cloud.V(), cloud.normals(), o.cloud,
-                               {.tile_vertices = o.tile_vertices, .threads = execution.threads});
+      TileEstimate t = estimate_cloud_tiled(cloud.V(), cloud.normals(), o.cloud,
+                                            {.tile_vertices = o.tile_vertices});
       e.curvature = std::move(t.curvature);
     }
     e.undefined_count = undefined_count(e.curvature);
@@ -330,15 +316,16 @@ Estimate cloud_curvature(const PreparedMesh& cloud, const EstimateOptions& o) {
 }  // namespace
 
 Estimate curvature(const PreparedMesh& input, const EstimateOptions& options) {
-  const EstimateOptions o = with_threads(options);
-  if (o.tile_vertices < 0) throw InvalidInput("curvature: tile_vertices must be >= 0");
-  if (input.face_count() == 0) return cloud_curvature(input, o);
-  return mesh_curvature(input, o);
+  // Every step below, and every loop they start, runs with the options' execution.
+  const ExecutionScope scope(options.execution);
+  if (options.tile_vertices < 0) throw InvalidInput("curvature: tile_vertices must be >= 0");
+  if (input.face_count() == 0) return cloud_curvature(input, options);
+  return mesh_curvature(input, options);
 }
 
 Estimate curvature(const Mesh& input, const EstimateOptions& options) {
-  const PreparedMesh prepared(input.V, input.F, input.normals(),
-                              {.threads = options.execution.threads});
+  const ExecutionScope scope(options.execution);
+  const PreparedMesh prepared(input.V, input.F, input.normals());
   return curvature(prepared, options);
 }
 

@@ -98,7 +98,7 @@ ImageCurvature estimate_image_curvature(const GBuffer& gbuffer, const ImageSpace
   // Converted once, as the CUDA backend does, so that both see the same float ratio.
   const float ratio = static_cast<float>(options.discontinuity_ratio);
   if (options.window == 0) {
-    detail::parallel_for(pixels, options.threads, [&](std::int64_t i) {
+    detail::parallel_for(pixels, 0, [&](std::int64_t i) {
       const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
       image_kernel::store_pixel(out, static_cast<int>(i),
                                 image_kernel::pixel_result(view, x, y, ratio));
@@ -106,11 +106,11 @@ ImageCurvature estimate_image_curvature(const GBuffer& gbuffer, const ImageSpace
     return result;
   }
   std::vector<image_kernel::PixelOperator> ops(static_cast<std::size_t>(pixels));
-  detail::parallel_for(pixels, options.threads, [&](std::int64_t i) {
+  detail::parallel_for(pixels, 0, [&](std::int64_t i) {
     ops[static_cast<std::size_t>(i)] = image_kernel::pixel_operator(
         view, static_cast<int>(i % width), static_cast<int>(i / width), ratio);
   });
-  detail::parallel_for(pixels, options.threads, [&](std::int64_t i) {
+  detail::parallel_for(pixels, 0, [&](std::int64_t i) {
     const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
     image_kernel::store_pixel(out, static_cast<int>(i),
                               image_kernel::window_result(view, ops.data(), x, y, options.window));

@@ -36,14 +36,12 @@ void append_field(std::string& out, std::string_view text) {
 
 }  // namespace
 
-void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns, int threads) {
-  write_csv(path, columns, WriteOptions{.threads = threads});
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns) {
+  write_csv(path, columns, WriteOptions{});
 }
 
 void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
                const WriteOptions& options) {
-  const int threads = options.threads;
-  if (threads < 0) throw InvalidInput("write_csv: threads must be >= 0");
   const Eigen::Index rows = columns.empty() ? 0 : column_length(columns.front());
   for (const auto& column : columns) {
     if (column_length(column) != rows) {
@@ -71,7 +69,7 @@ void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> col
       append_field(out, columns[c].name);
     }
     out += '\n';
-    io_detail::write_lines(sink, rows, threads, append_row);
+    io_detail::write_lines(sink, rows, 0, append_row);
   });
 }
 

@@ -54,8 +54,8 @@ const std::vector<std::string>& curvature_field_names() {
 }
 
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
-                         const VectorXu8& crease, int threads) {
-  write_curvature_csv(path, fields, crease, WriteOptions{.threads = threads});
+                         const VectorXu8& crease) {
+  write_curvature_csv(path, fields, crease, WriteOptions{});
 }
 
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,

@@ -30,7 +30,7 @@ void weld_corners(Mesh& mesh, double tolerance, bool weld, int threads);
                                                             bool hashes_first);
 
 // The per-format readers, dispatched by read_mesh().
-/// `threads` as ReadOptions::threads (the mesh does not depend on it).
+/// `threads` as parallel_for's (0: the current ExecutionScope's; the mesh does not depend on it).
 [[nodiscard]] Mesh read_obj(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_ply(const std::filesystem::path& path, int threads);
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path, int threads);

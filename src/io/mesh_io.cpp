@@ -27,20 +27,19 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
 }
 
 Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
-  if (options.threads < 0) throw InvalidInput("read_mesh: threads must be >= 0");
   switch (mesh_format_from_path(path)) {
     case MeshFormat::obj:
-      return io_detail::read_obj(path, options.threads);
+      return io_detail::read_obj(path, 0);
     case MeshFormat::ply:
-      return io_detail::read_ply(path, options.threads);
+      return io_detail::read_ply(path, 0);
     case MeshFormat::off:
-      return io_detail::read_off(path, options.threads);
+      return io_detail::read_off(path, 0);
     case MeshFormat::stl: {
       if (!(options.weld_tolerance >= 0.0) || !std::isfinite(options.weld_tolerance)) {
         throw InvalidInput("read_mesh: weld_tolerance must be finite and >= 0");
       }
-      Mesh mesh = io_detail::read_stl(path, options.threads);
-      io_detail::weld_corners(mesh, options.weld_tolerance, options.weld, options.threads);
+      Mesh mesh = io_detail::read_stl(path, 0);
+      io_detail::weld_corners(mesh, options.weld_tolerance, options.weld, 0);
       return mesh;
     }
     case MeshFormat::xyz:
@@ -56,11 +55,7 @@ Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
   switch (mesh_format_from_path(path)) {
     case MeshFormat::ply:
-      write_ply(path, mesh, {},
-                {.binary = true,
-                 .comments = {},
-                 .threads = options.threads,
-                 .precision = options.precision});
+      write_ply(path, mesh, {}, {.binary = true, .comments = {}, .precision = options.precision});
       return;
     case MeshFormat::obj:
       write_obj(path, mesh, options);

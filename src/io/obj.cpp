@@ -445,39 +445,35 @@ Mesh read_obj(const std::filesystem::path& path, int threads) {
 }  // namespace io_detail
 
 void write_obj(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  if (options.threads < 0) throw InvalidInput("write_obj: threads must be >= 0");
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_obj: " + path.string()).c_str(),
-                       options.threads);
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_obj: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
     // `v x y z` lines, then `vn x y z` lines.
     const auto append_rows = [&](std::string_view keyword, const RowMatrixX3d& rows) {
-      io_detail::write_lines(sink, rows.rows(), options.threads,
-                             [&](std::string& out, std::int64_t i) {
-                               out += keyword;
-                               for (int c = 0; c < 3; ++c) {
-                                 out += ' ';
-                                 io_detail::append_real(out, rows(i, c), options.precision);
-                               }
-                               out += '\n';
-                             });
+      io_detail::write_lines(sink, rows.rows(), 0, [&](std::string& out, std::int64_t i) {
+        out += keyword;
+        for (int c = 0; c < 3; ++c) {
+          out += ' ';
+          io_detail::append_real(out, rows(i, c), options.precision);
+        }
+        out += '\n';
+      });
     };
     append_rows("v", mesh.V);
     if (normals) append_rows("vn", mesh.N);
-    io_detail::write_lines(sink, mesh.F.rows(), options.threads,
-                           [&](std::string& out, std::int64_t f) {
-                             out += 'f';
-                             for (int c = 0; c < 3; ++c) {
-                               const auto index = static_cast<std::int64_t>(mesh.F(f, c)) + 1;
-                               out += ' ';
-                               io_detail::append_number(out, index);
-                               if (normals) {
-                                 out += "//";
-                                 io_detail::append_number(out, index);
-                               }
-                             }
-                             out += '\n';
-                           });
+    io_detail::write_lines(sink, mesh.F.rows(), 0, [&](std::string& out, std::int64_t f) {
+      out += 'f';
+      for (int c = 0; c < 3; ++c) {
+        const auto index = static_cast<std::int64_t>(mesh.F(f, c)) + 1;
+        out += ' ';
+        io_detail::append_number(out, index);
+        if (normals) {
+          out += "//";
+          io_detail::append_number(out, index);
+        }
+      }
+      out += '\n';
+    });
   });
 }
 

@@ -330,22 +330,18 @@ Mesh read_off(const std::filesystem::path& path, int threads) {
 }  // namespace io_detail
 
 void write_off(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  if (options.threads < 0) throw InvalidInput("write_off: threads must be >= 0");
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str(),
-                       options.threads);
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_off: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
     std::string& header = sink.buffer();
     header += normals ? "NOFF\n" : "OFF\n";
     header += std::to_string(mesh.V.rows()) + " " + std::to_string(mesh.F.rows()) + " 0\n";
-    io_detail::write_lines(
-        sink, mesh.V.rows(), options.threads, [&](std::string& line, std::int64_t i) {
-          io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
-        });
-    io_detail::write_lines(sink, mesh.F.rows(), options.threads,
-                           [&](std::string& line, std::int64_t f) {
-                             io_detail::append_ascii_triangle(line, mesh.F, f);
-                           });
+    io_detail::write_lines(sink, mesh.V.rows(), 0, [&](std::string& line, std::int64_t i) {
+      io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
+    });
+    io_detail::write_lines(sink, mesh.F.rows(), 0, [&](std::string& line, std::int64_t f) {
+      io_detail::append_ascii_triangle(line, mesh.F, f);
+    });
   });
 }
 

@@ -44,7 +44,7 @@ bool valid_property_name(std::string_view name) {
 void validate_for_ply(const std::filesystem::path& path, const Mesh& mesh,
                       std::span<const PlyColumn> columns, const PlyWriteOptions& options) {
   const std::string what = "write_ply: " + path.string();
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str(), options.threads);
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, what.c_str());
   std::vector<std::string_view> names = {"x", "y", "z"};
   if (mesh.has_normals()) names.insert(names.end(), {"nx", "ny", "nz"});
   for (const auto& column : columns) {
@@ -213,7 +213,7 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
   std::size_t record = positions;
   for (const auto& column : columns) record += property_bytes(column.type);
   // Column by column within a block, so that each type is dispatched once per block.
-  write_fixed_records(sink, mesh.V.rows(), record, options.threads,
+  write_fixed_records(sink, mesh.V.rows(), record, 0,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         if (f32) {
                           put_positions<float>(out, record, begin, end, mesh, normals);
@@ -232,7 +232,7 @@ void write_ply_body_binary(io_detail::OutputSink& sink, const Mesh& mesh,
                           offset += property_bytes(column.type);
                         }
                       });
-  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), options.threads,
+  write_fixed_records(sink, mesh.F.rows(), 1 + 3 * sizeof(std::int32_t), 0,
                       [&](std::int64_t begin, std::int64_t end, char* out) {
                         char* p = out;
                         for (std::int64_t f = begin; f < end; ++f) {
@@ -262,7 +262,7 @@ void write_ply_columns(const std::filesystem::path& path, const Mesh& mesh,
     if (options.binary) {
       write_ply_body_binary(sink, mesh, file_columns, options);
     } else {
-      write_ply_body_ascii(sink, mesh, file_columns, options.precision, options.threads);
+      write_ply_body_ascii(sink, mesh, file_columns, options.precision, 0);
     }
   });
 }

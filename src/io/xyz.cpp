@@ -260,21 +260,18 @@ Mesh parse_xyz(const std::filesystem::path& path, std::string_view data) {
 }  // namespace io_detail
 
 void write_xyz(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options) {
-  if (options.threads < 0) throw InvalidInput("write_xyz: threads must be >= 0");
   // Read back, a .xyzrgb file's last three columns are colours: the normals would be lost.
   if (six_columns_of(path) == SixColumns::colours) {
     fail(path,
          "writing .xyzrgb is not supported (focal writes no colours; use .xyz, or .xyzn for "
          "x y z nx ny nz)");
   }
-  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_xyz: " + path.string()).c_str(),
-                       options.threads);
+  validate_mesh_arrays(mesh.V, mesh.F, mesh.N, ("write_xyz: " + path.string()).c_str());
   const bool normals = mesh.has_normals();
   io_detail::write_atomically(path, [&](io_detail::OutputSink& sink) {
-    io_detail::write_lines(
-        sink, mesh.V.rows(), options.threads, [&](std::string& line, std::int64_t i) {
-          io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
-        });
+    io_detail::write_lines(sink, mesh.V.rows(), 0, [&](std::string& line, std::int64_t i) {
+      io_detail::append_vertex_line(line, mesh, i, normals, options.precision);
+    });
   });
 }
 

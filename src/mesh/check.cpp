@@ -125,21 +125,20 @@ void check_normals(PositionsRef V, FacesRef F, NormalsRef N, const detail::Verte
 MeshFindings find_problems(const PreparedMesh& mesh) {
   const PositionsRef& V = mesh.V();
   const FacesRef& F = mesh.F();
-  const int threads = mesh.threads();
   const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
   // One topology pass serves the statistics and the orientation report (each computed its own).
   // It also builds the 1-ring from its sorted edge sides, which the estimators ask for next:
   // kept on the mesh, it is not built a second time.
   Neighbourhoods one_ring;
   const detail::MeshTopology topology =
-      detail::mesh_topology(*incidence, F, detail::TopologyDetail::statistics, threads, &one_ring);
+      detail::mesh_topology(*incidence, F, detail::TopologyDetail::statistics, 0, &one_ring);
   detail::PreparedAccess::offer_one_ring(mesh, std::move(one_ring));
-  const OrientationReport report = detail::orientation_report_from(V, F, topology, threads);
+  const OrientationReport report = detail::orientation_report_from(V, F, topology, 0);
   MeshFindings out;
   out.non_finite_vertex_count =
-      parallel_count(V.rows(), threads, [&](std::int64_t i) { return !V.row(i).allFinite(); });
+      parallel_count(V.rows(), 0, [&](std::int64_t i) { return !V.row(i).allFinite(); });
   // Both in one pass over the faces.
-  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, threads);
+  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, 0);
   out.repeated_index_face_count = static_cast<int>(degenerate.repeated_index);
   out.degenerate_face_count = static_cast<int>(degenerate.zero_area);
   out.duplicate_face_count = static_cast<int>(topology.duplicate_face_count);
@@ -151,7 +150,7 @@ MeshFindings find_problems(const PreparedMesh& mesh) {
   out.boundary_edge_count = static_cast<int>(topology.boundary_edge_count);
   out.component_count = topology.components.count;
   if (mesh.has_normals()) {
-    check_normals(V, F, mesh.N(), *incidence, topology, report, threads, out);
+    check_normals(V, F, mesh.N(), *incidence, topology, report, 0, out);
   }
   return out;
 }
@@ -188,8 +187,8 @@ std::string MeshFindings::summary() const {
   return s;
 }
 
-MeshFindings check_mesh(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, int threads) {
-  return check_mesh(detail::PreparedAccess::make(V, F, N, {.threads = threads}, "check_mesh"));
+MeshFindings check_mesh(PositionsRef V, FacesRef F, std::optional<NormalsRef> N) {
+  return check_mesh(detail::PreparedAccess::make(V, F, N, {}, "check_mesh"));
 }
 
 MeshFindings check_mesh(const PreparedMesh& mesh) {

@@ -59,13 +59,12 @@ Eigen::VectorXi offsets_from_counts(const std::vector<int>& counts, const char* 
 
 }  // namespace
 
-Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F, int threads) {
+Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F) {
   // The parallel test first; the serial one only to name the first bad face.
-  if (vertex_count < 0 || !detail::face_indices_in_range(vertex_count, F, threads)) {
+  if (vertex_count < 0 || !detail::face_indices_in_range(vertex_count, F, 0)) {
     detail::check_face_indices(vertex_count, F, "vertex_adjacency");
   }
-  return detail::vertex_adjacency_from(detail::vertex_face_incidence(vertex_count, F, threads), F,
-                                       threads);
+  return detail::vertex_adjacency_from(detail::vertex_face_incidence(vertex_count, F, 0), F, 0);
 }
 
 Neighbourhoods detail::vertex_adjacency_from(const VertexFaces& inc, FacesRef F, int threads) {
@@ -157,7 +156,7 @@ constexpr int kRingBlocks = 2048;
 
 }  // namespace
 
-Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
+Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k) {
   if (k < 1) throw InvalidInput("k_ring: k must be at least 1, got " + std::to_string(k));
   check_csr(one_ring, "k_ring");
   if (k == 1) return one_ring;
@@ -168,8 +167,8 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
   };
   std::vector<std::vector<int>> block_rings(static_cast<std::size_t>(blocks));
   std::vector<int> counts(static_cast<std::size_t>(n));
-  detail::PerThread<BfsScratch> scratch(threads);
-  detail::parallel_for(blocks, threads, [&](std::int64_t b) {
+  detail::PerThread<BfsScratch> scratch(0);
+  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
     BfsScratch& s = scratch.local();
     s.prepare(n);
     auto& out = block_rings[static_cast<std::size_t>(b)];
@@ -180,7 +179,7 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
   Neighbourhoods result;
   result.offsets = offsets_from_counts(counts, "k_ring");
   result.indices.resize(result.offsets[n]);
-  detail::parallel_for(blocks, threads, [&](std::int64_t b) {
+  detail::parallel_for(blocks, 0, [&](std::int64_t b) {
     auto& ring = block_rings[static_cast<std::size_t>(b)];
     std::copy(ring.begin(), ring.end(), result.indices.data() + result.offsets[block_begin(b)]);
     std::vector<int>().swap(ring);  // frees memory early: the result is as large again
@@ -188,15 +187,15 @@ Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads) {
   return result;
 }
 
-std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k, int threads) {
+std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k) {
   if (k < 1) throw InvalidInput("crowded_vertices: k must be at least 1, got " + std::to_string(k));
   check_csr(one_ring, "crowded_vertices");
   const int n = one_ring.vertex_count();
   if (k == 1) return {};
   std::vector<std::uint8_t> crowded(static_cast<std::size_t>(n), 0);
-  detail::PerThread<BfsScratch> scratch(threads);
-  detail::PerThread<std::vector<int>> rings(threads);
-  detail::parallel_for(n, threads, [&](std::int64_t v) {
+  detail::PerThread<BfsScratch> scratch(0);
+  detail::PerThread<std::vector<int>> rings(0);
+  detail::parallel_for(n, 0, [&](std::int64_t v) {
     BfsScratch& s = scratch.local();
     s.prepare(n);
     std::vector<int>& ring = rings.local();
@@ -211,14 +210,14 @@ std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k, int thr
   return result;
 }
 
-std::vector<bool> boundary_vertices(int vertex_count, FacesRef F, int threads) {
+std::vector<bool> boundary_vertices(int vertex_count, FacesRef F) {
   detail::check_face_indices(vertex_count, F, "boundary_vertices");
-  const auto inc = detail::vertex_face_incidence(vertex_count, F, threads);
+  const auto inc = detail::vertex_face_incidence(vertex_count, F, 0);
   // Bytes, not std::vector<bool>: neighbouring bits of a vector<bool> share a word, so writing
   // them from different threads would race.
   std::vector<std::uint8_t> flags(static_cast<std::size_t>(vertex_count), 0);
-  detail::PerThread<std::vector<detail::EdgeSide>> scratch(threads);
-  detail::parallel_for(vertex_count, threads, [&](std::int64_t v) {
+  detail::PerThread<std::vector<detail::EdgeSide>> scratch(0);
+  detail::parallel_for(vertex_count, 0, [&](std::int64_t v) {
     auto& sides = scratch.local();
     detail::collect_edge_sides(F, inc, v, sides);
     bool boundary = false;

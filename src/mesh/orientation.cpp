@@ -64,18 +64,17 @@ struct FaceTally {
 
 }  // namespace
 
-OrientationReport orientation_report(PositionsRef V, FacesRef F, int threads) {
+OrientationReport orientation_report(PositionsRef V, FacesRef F) {
   return orientation_report(
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "orientation_report"));
+      detail::PreparedAccess::make(V, F, std::nullopt, {}, "orientation_report"));
 }
 
 OrientationReport orientation_report(const PreparedMesh& mesh) {
-  const int threads = mesh.threads();
   return detail::orientation_report_from(
       mesh.V(), mesh.F(),
       detail::mesh_topology(*detail::incidence(mesh), mesh.F(), detail::TopologyDetail::orientation,
-                            threads),
-      threads);
+                            0),
+      0);
 }
 
 // Signed volumes are taken per component about its vertex centroid: for a surface far from the
@@ -230,10 +229,10 @@ std::vector<std::uint8_t> consistent_flips(const FaceLinks& links, std::size_t f
 
 }  // namespace
 
-ConsistentFaces orient_consistently(int vertex_count, FacesRef F, int threads) {
+ConsistentFaces orient_consistently(int vertex_count, FacesRef F) {
   detail::check_face_indices(vertex_count, F, "orient_consistently");
-  const auto inc = detail::vertex_face_incidence(vertex_count, F, threads);
-  const FaceLinks links = face_links(vertex_count, F, inc, threads);
+  const auto inc = detail::vertex_face_incidence(vertex_count, F, 0);
+  const FaceLinks links = face_links(vertex_count, F, inc, 0);
   const auto face_count = static_cast<std::size_t>(F.rows());
   const std::vector<std::uint8_t> flip = consistent_flips(links, face_count);
 

@@ -17,14 +17,13 @@ namespace focal {
 struct PreparedMesh::Geometry {
   PositionsRef V;
   FacesRef F;
-  int threads;
   std::recursive_mutex mutex;
   std::shared_ptr<const detail::VertexFaces> incidence;
   std::shared_ptr<const Neighbourhoods> one_ring;      ///< kept once one_ring() was called
   std::shared_ptr<const Neighbourhoods> offered_ring;  ///< offer_one_ring's, until first asked for
   std::optional<double> mean_edge_length;
 
-  Geometry(PositionsRef v, FacesRef f, int t) : V(std::move(v)), F(std::move(f)), threads(t) {}
+  Geometry(PositionsRef v, FacesRef f) : V(std::move(v)), F(std::move(f)) {}
 };
 
 // The normals of one PreparedMesh and what is built with them.
@@ -66,7 +65,6 @@ const FacesRef& PreparedMesh::F() const { return geometry_->F; }
 bool PreparedMesh::has_normals() const { return local_->N.has_value(); }
 Eigen::Index PreparedMesh::vertex_count() const { return geometry_->V.rows(); }
 Eigen::Index PreparedMesh::face_count() const { return geometry_->F.rows(); }
-int PreparedMesh::threads() const { return geometry_->threads; }
 
 const NormalsRef& PreparedMesh::N() const {
   if (!local_->N) throw InvalidInput("PreparedMesh::N: the mesh has no normals");
@@ -85,7 +83,7 @@ const Neighbourhoods& PreparedMesh::one_ring() const {
 double PreparedMesh::mean_edge_length() const {
   Geometry& g = *geometry_;
   const std::lock_guard lock(g.mutex);
-  if (!g.mean_edge_length) g.mean_edge_length = focal::mean_edge_length(g.V, g.F, g.threads);
+  if (!g.mean_edge_length) g.mean_edge_length = focal::mean_edge_length(g.V, g.F);
   return *g.mean_edge_length;
 }
 
@@ -98,13 +96,12 @@ namespace detail {
 
 PreparedMesh PreparedAccess::make(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
                                   const PrepareOptions& options, const char* what) {
-  if (options.threads < 0) throw InvalidInput(std::string(what) + ": threads must be >= 0");
   if (!(options.mean_edge_length >= 0.0 && std::isfinite(options.mean_edge_length))) {
     throw InvalidInput(std::string(what) + ": mean_edge_length must be finite and >= 0");
   }
   check_normal_rows(V.rows(), N, what);
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), what, options.threads);
-  auto geometry = std::make_shared<PreparedMesh::Geometry>(V, F, options.threads);
+  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), what);
+  auto geometry = std::make_shared<PreparedMesh::Geometry>(V, F);
   if (options.mean_edge_length > 0.0) geometry->mean_edge_length = options.mean_edge_length;
   return {std::move(geometry), std::move(N)};
 }
@@ -113,8 +110,7 @@ std::shared_ptr<const VertexFaces> PreparedAccess::incidence(const PreparedMesh&
   PreparedMesh::Geometry& g = *mesh.geometry_;
   const std::lock_guard lock(g.mutex);
   if (!g.incidence) {
-    g.incidence =
-        std::make_shared<const VertexFaces>(vertex_face_incidence(g.V.rows(), g.F, g.threads));
+    g.incidence = std::make_shared<const VertexFaces>(vertex_face_incidence(g.V.rows(), g.F, 0));
   }
   return g.incidence;
 }
@@ -130,8 +126,7 @@ std::shared_ptr<const Neighbourhoods> PreparedAccess::one_ring(const PreparedMes
   const std::lock_guard lock(g.mutex);
   if (g.one_ring) return g.one_ring;
   if (g.offered_ring) return std::exchange(g.offered_ring, nullptr);
-  return std::make_shared<const Neighbourhoods>(
-      vertex_adjacency_from(*incidence(mesh), g.F, g.threads));
+  return std::make_shared<const Neighbourhoods>(vertex_adjacency_from(*incidence(mesh), g.F, 0));
 }
 
 void PreparedAccess::offer_one_ring(const PreparedMesh& mesh, Neighbourhoods&& ring) {
@@ -145,7 +140,7 @@ const UnitNormals& PreparedAccess::unit_normals(const PreparedMesh& mesh) {
   const std::lock_guard lock(l.mutex);
   if (!l.unit) {
     UnitNormals u;
-    u.N = unit_rows(mesh.N(), u.ok, mesh.threads());
+    u.N = unit_rows(mesh.N(), u.ok);
     l.unit = std::move(u);
   }
   return *l.unit;

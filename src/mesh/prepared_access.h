@@ -34,12 +34,6 @@ struct UnitNormals {
   std::vector<char> ok;  ///< #V: the row was finite and not zero
 };
 
-/// `requested` when positive, else the mesh's PrepareOptions::threads: the threads of a function
-/// given a PreparedMesh and a `threads` option of its own (0 = the mesh's).
-inline int threads_for(const PreparedMesh& mesh, int requested) {
-  return requested > 0 ? requested : mesh.threads();
-}
-
 struct PreparedAccess {
   /// A PreparedMesh whose validation messages name `what` (the function that prepares it).
   static PreparedMesh make(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,

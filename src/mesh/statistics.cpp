@@ -262,9 +262,8 @@ DegenerateFaces degenerate_faces(PositionsRef V, FacesRef F, int threads) {
 
 }  // namespace detail
 
-MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads) {
-  const PreparedMesh mesh =
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "mesh_statistics");
+MeshStatistics mesh_statistics(PositionsRef V, FacesRef F) {
+  const PreparedMesh mesh = detail::PreparedAccess::make(V, F, std::nullopt, {}, "mesh_statistics");
   MeshStatistics stats;
   stats.vertex_count = static_cast<int>(V.rows());
   stats.face_count = static_cast<int>(F.rows());
@@ -273,10 +272,10 @@ MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads) {
     stats.max_corner = V.colwise().maxCoeff().transpose();
   }
   stats.mean_edge_length = mesh.mean_edge_length();
-  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, threads);
+  const detail::DegenerateFaces degenerate = detail::degenerate_faces(V, F, 0);
   stats.degenerate_face_count = static_cast<int>(degenerate.repeated_index + degenerate.zero_area);
-  const detail::MeshTopology t = detail::mesh_topology(*detail::incidence(mesh), F,
-                                                       detail::TopologyDetail::statistics, threads);
+  const detail::MeshTopology t =
+      detail::mesh_topology(*detail::incidence(mesh), F, detail::TopologyDetail::statistics, 0);
   stats.component_count = t.components.count;
   stats.edge_count = static_cast<int>(t.edge_count);
   stats.boundary_edge_count = static_cast<int>(t.boundary_edge_count);

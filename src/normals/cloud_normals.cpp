@@ -192,10 +192,10 @@ double highest_vote(PositionsRef V, const RowMatrixX3d& N, std::vector<int> memb
 
 }  // namespace
 
-RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours, int threads) {
+RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours) {
   check_sizes(V, neighbours, "pca_normals");
   RowMatrixX3d N(V.rows(), 3);
-  detail::parallel_for(V.rows(), threads, [&](std::int64_t i64) {
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t i64) {
     const int i = static_cast<int>(i64);
     N.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
     if (neighbours.size(i) < 2 || !V.row(i).allFinite()) return;
@@ -311,7 +311,6 @@ void check_jet_options(PositionsRef V, const Neighbourhoods& neighbours,
     throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
                        std::to_string(options.jet_degree));
   }
-  if (options.threads < 0) throw InvalidInput("cloud_normals: threads must be >= 0");
 }
 
 /// Whether cloud_jets_sided turns point i's PCA normal `n` over: towards its row of `side`.
@@ -327,8 +326,7 @@ JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
   if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
-  const JetOptions jet{
-      .rings = 1, .degree = options.jet_degree, .iterations = 2, .threads = options.threads};
+  const JetOptions jet{.rings = 1, .degree = options.jet_degree, .iterations = 2};
   return detail::jet_normals_from(V, neighbours, N, jet, detail::SimdIsa::best,
                                   copy_of ? &copy_of->permutation.order : nullptr);
 }
@@ -338,11 +336,11 @@ JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
 JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
                               const CloudNormalOptions& options, const CloudCopy* copy_of) {
   check_jet_options(V, neighbours, options);
-  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
+  RowMatrixX3d N = pca_normals(V, neighbours);
   if (options.viewpoint) {
     orient_towards_viewpoint(V, *options.viewpoint, N);
   } else {
-    detail::orient_normals_mst(V, neighbours, N, options.threads, copy_of);
+    detail::orient_normals_mst(V, neighbours, N, 0, copy_of);
   }
   return jets_from_start(V, neighbours, options, std::move(N), copy_of);
 }
@@ -353,8 +351,8 @@ JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighb
   if (options.viewpoint) return cloud_jets(V, neighbours, options, copy_of);
   check_jet_options(V, neighbours, options);
   if (side.rows() != V.rows()) throw InvalidInput("cloud_jets_sided: side does not have #V rows");
-  RowMatrixX3d N = pca_normals(V, neighbours, options.threads);
-  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+  RowMatrixX3d N = pca_normals(V, neighbours);
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     if (turned_to_side(N.row(i), side, i)) N.row(i) *= -1.0;
   });
   return jets_from_start(V, neighbours, options, std::move(N), copy_of);
@@ -365,10 +363,10 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
                                const CloudCopy* copy_of) {
   if (options.viewpoint) return;  // cloud_jets_sided was cloud_jets
   // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
-  const RowMatrixX3d pca = pca_normals(V, neighbours, options.threads);
+  const RowMatrixX3d pca = pca_normals(V, neighbours);
   RowMatrixX3d mst = pca;
-  detail::orient_normals_mst(V, neighbours, mst, options.threads, copy_of);
-  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+  detail::orient_normals_mst(V, neighbours, mst, 0, copy_of);
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
     const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();
     // Only finite jets: an undefined one is the same NaN row whatever its start's sign.

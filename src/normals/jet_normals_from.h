@@ -13,7 +13,7 @@ namespace focal::detail {
 
 /// jet_normals of the mesh whose positions are V and 1-ring `one_ring`, the first fit of each
 /// vertex in the frame of `start`, whose rows must be unit or non-finite (not checked: Max's
-/// normals are, by construction). options.threads is used as given. The fits run side by side
+/// normals are, by construction). The fits run side by side
 /// in the lanes of `isa`'s kernel (the same bits for every instruction set); std::nullopt: one
 /// vertex at a time, the reference the lanes are tested against. `sort_rows`: null, or V and
 /// one_ring are a permuted copy of a cloud (copy row j is cloud row (*sort_rows)[j]; a cloud's

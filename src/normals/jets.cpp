@@ -155,25 +155,17 @@ void validate_options(const JetOptions& o) {
   if (o.degree < 1 || o.degree > kMaxDegree)
     throw InvalidInput("jet_normals: degree must be in [1, 4], got " + std::to_string(o.degree));
   if (o.iterations < 1) throw InvalidInput("jet_normals: iterations must be >= 1");
-  if (o.threads < 0) throw InvalidInput("jet_normals: threads must be >= 0");
 }
 
 void validate(PositionsRef V, FacesRef F, const JetOptions& o) {
-  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "jet_normals", o.threads);
+  validate_mesh_arrays(V, F, RowMatrixX3d(0, 3), "jet_normals");
   validate_options(o);
 }
 
-/// The options with threads resolved for `mesh`.
-JetOptions for_mesh(const PreparedMesh& mesh, const JetOptions& options) {
-  JetOptions o = options;
-  o.threads = detail::threads_for(mesh, options.threads);
-  return o;
-}
-
 /// Max's normals of a prepared mesh, on its incidence: the jets' starting frames.
-RowMatrixX3d max_normals(const PreparedMesh& mesh, int threads) {
+RowMatrixX3d max_normals(const PreparedMesh& mesh) {
   return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh),
-                                     NormalWeighting::max, threads);
+                                     NormalWeighting::max, 0);
 }
 
 void validate_start(PositionsRef V, NormalsRef start) {
@@ -205,21 +197,20 @@ void for_each_jet(PositionsRef V, const Neighbourhoods& one, NormalsRef start, c
   const JetInput in{V,        one, start, o, top_degree_kernel(isa, o.degree), batch_width(isa),
                     sort_rows};
   const std::int64_t n = vertices ? static_cast<std::int64_t>(vertices->size()) : V.rows();
-  detail::PerThread<JetScratch> scratch(o.threads);
-  detail::parallel_for_blocks(
-      n, vertices ? 64 : 256, o.threads, [&](std::int64_t begin, std::int64_t end) {
-        JetScratch& s = scratch.local();
-        int v[kMaxLanes];
-        LocalJet jets[kMaxLanes];
-        for (std::int64_t first = begin; first < end; first += in.width) {
-          const int count = static_cast<int>(std::min<std::int64_t>(in.width, end - first));
-          for (int l = 0; l < count; ++l)
-            v[l] = vertices ? (*vertices)[static_cast<std::size_t>(first + l)]
-                            : static_cast<int>(first + l);
-          fit_batch(in, v, count, s, jets);
-          for (int l = 0; l < count; ++l) body(first + l, jets[l]);
-        }
-      });
+  detail::PerThread<JetScratch> scratch(0);
+  detail::parallel_for_blocks(n, vertices ? 64 : 256, 0, [&](std::int64_t begin, std::int64_t end) {
+    JetScratch& s = scratch.local();
+    int v[kMaxLanes];
+    LocalJet jets[kMaxLanes];
+    for (std::int64_t first = begin; first < end; first += in.width) {
+      const int count = static_cast<int>(std::min<std::int64_t>(in.width, end - first));
+      for (int l = 0; l < count; ++l)
+        v[l] = vertices ? (*vertices)[static_cast<std::size_t>(first + l)]
+                        : static_cast<int>(first + l);
+      fit_batch(in, v, count, s, jets);
+      for (int l = 0; l < count; ++l) body(first + l, jets[l]);
+    }
+  });
 }
 
 /// Row k of `out` from `jet`.
@@ -280,23 +271,21 @@ void store_jet_curvature(const LocalJet& jet, int i, double zero_tolerance, Curv
 
 JetNormals jet_normals(const PreparedMesh& mesh, const JetOptions& options) {
   validate_options(options);
-  const JetOptions o = for_mesh(mesh, options);
-  return collect_normals(mesh.V(), *detail::one_ring(mesh), max_normals(mesh, o.threads), o,
-                         nullptr, SimdIsa::best);
+  const JetOptions& o = options;
+  return collect_normals(mesh.V(), *detail::one_ring(mesh), max_normals(mesh), o, nullptr,
+                         SimdIsa::best);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const JetOptions& options) {
   validate_options(options);
-  return jet_normals(
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "jet_normals"),
-      options);
+  return jet_normals(detail::PreparedAccess::make(V, F, std::nullopt, {}, "jet_normals"), options);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring,
                        const JetOptions& options) {
   validate(V, F, options);
-  return collect_normals(V, one_ring, vertex_normals(V, F, NormalWeighting::max, options.threads),
-                         options, nullptr, SimdIsa::best);
+  return collect_normals(V, one_ring, vertex_normals(V, F, NormalWeighting::max), options, nullptr,
+                         SimdIsa::best);
 }
 
 JetNormals jet_normals(PositionsRef V, FacesRef F, const Neighbourhoods& one_ring, NormalsRef start,
@@ -333,12 +322,12 @@ JetNormals detail::jet_normals_at(PositionsRef V, const Neighbourhoods& one_ring
 CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   validate_options(options);
-  const JetOptions o = for_mesh(mesh, options);
+  const JetOptions& o = options;
   const PositionsRef& V = mesh.V();
   CurvatureResult r = detail::unwritten_result(V.rows());
   const double zero = default_zero_tolerance / mesh.mean_edge_length();
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
-  const RowMatrixX3d start = max_normals(mesh, o.threads);
+  const RowMatrixX3d start = max_normals(mesh);
   for_each_jet(V, *one, start, o, nullptr, SimdIsa::best, [&](std::int64_t i, const LocalJet& jet) {
     if (jet.degree < 2) {
       r.rays_used[i] = r.rays_excluded[i] = 0;
@@ -352,9 +341,8 @@ CurvatureResult jet_curvature(const PreparedMesh& mesh, const JetOptions& option
 CurvatureResult jet_curvature(PositionsRef V, FacesRef F, const JetOptions& options) {
   if (options.degree < 2) throw InvalidInput("jet_curvature: degree must be >= 2");
   validate_options(options);
-  return jet_curvature(
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "jet_normals"),
-      options);
+  return jet_curvature(detail::PreparedAccess::make(V, F, std::nullopt, {}, "jet_normals"),
+                       options);
 }
 
 }  // namespace focal

@@ -242,15 +242,13 @@ void gather_normals(PositionsRef V, FacesRef F, const detail::VertexFaces& inc, 
 
 }  // namespace
 
-RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F, NormalWeighting weighting, int threads) {
-  return vertex_normals(
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = threads}, "vertex_normals"),
-      weighting);
+RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F, NormalWeighting weighting) {
+  return vertex_normals(detail::PreparedAccess::make(V, F, std::nullopt, {}, "vertex_normals"),
+                        weighting);
 }
 
 RowMatrixX3d vertex_normals(const PreparedMesh& mesh, NormalWeighting weighting) {
-  return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh), weighting,
-                                     mesh.threads());
+  return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh), weighting, 0);
 }
 
 namespace detail {
@@ -275,9 +273,8 @@ RowMatrixX3d vertex_normals_from(PositionsRef V, FacesRef F, const VertexFaces& 
 
 }  // namespace detail
 
-double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N, int threads) {
-  const PreparedMesh mesh =
-      detail::PreparedAccess::make(V, F, N, {.threads = threads}, "fraction_against_faces");
+double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N) {
+  const PreparedMesh mesh = detail::PreparedAccess::make(V, F, N, {}, "fraction_against_faces");
   // NaN rows (no face, or a vanishing sum) drop out through the finiteness test below.
   const RowMatrixX3d face_normals = vertex_normals(mesh, NormalWeighting::area);
   std::int64_t counted = 0;

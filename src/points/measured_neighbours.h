@@ -28,11 +28,11 @@ struct OutlierMeasures {
 };
 
 struct MeasuredNeighbours {
-  Neighbourhoods neighbours;  ///< nearest_neighbours(V, k, excluded, threads), the same lists
+  Neighbourhoods neighbours;  ///< nearest_neighbours(V, k, excluded), the same lists
   OutlierMeasures measures;
 };
 
-/// nearest_neighbours(V, k, excluded, threads) of a cloud whose rows were permuted: ties ordered
+/// nearest_neighbours(V, k, excluded) of a cloud whose rows were permuted: ties ordered
 /// by tie_rows[row] (#V: each row's index before the permutation) instead of by row, so that
 /// every list is, entry by entry, the permuted cloud's image of the list its point gets in the
 /// cloud's own order. Empty: by row (nearest_neighbours itself). With tie rows, V is taken to be
@@ -48,11 +48,11 @@ MeasuredNeighbours measured_nearest_neighbours(PositionsRef V, int k,
                                                const std::vector<char>& excluded, int threads,
                                                const std::vector<int>& tie_rows = {});
 
-/// outlier_points(V, neighbours, ratio, threads) from `reach`, the measures of those lists.
+/// outlier_points(V, neighbours, ratio) from `reach`, the measures of those lists.
 std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
                                  const std::vector<double>& reach, double ratio, int threads);
 
-/// off_surface_points(V, neighbours, ratio, threads) from `measures` of those lists.
+/// off_surface_points(V, neighbours, ratio) from `measures` of those lists.
 std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
                                      const OutlierMeasures& measures, double ratio, int threads);
 

@@ -199,9 +199,7 @@ void detail::check_threads(int threads) {
   if (threads < 0) throw InvalidInput("neighbours: threads must be >= 0");
 }
 
-Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads) {
-  return nearest_neighbours(V, k, {}, threads);
-}
+Neighbourhoods nearest_neighbours(PositionsRef V, int k) { return nearest_neighbours(V, k, {}); }
 
 namespace {
 
@@ -260,9 +258,8 @@ Neighbourhoods nearest(PositionsRef V, int k, const std::vector<char>& excluded,
 
 }  // namespace
 
-Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded,
-                                  int threads) {
-  return nearest(V, k, excluded, threads, nullptr, {});
+Neighbourhoods nearest_neighbours(PositionsRef V, int k, const std::vector<char>& excluded) {
+  return nearest(V, k, excluded, 0, nullptr, {});
 }
 
 namespace detail {
@@ -282,28 +279,27 @@ MeasuredNeighbours measured_nearest_neighbours(PositionsRef V, int k,
 
 }  // namespace detail
 
-Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count, int threads) {
-  return radius_neighbours(V, radius, max_count, {}, threads);
+Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count) {
+  return radius_neighbours(V, radius, max_count, {});
 }
 
 Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
-                                 const std::vector<char>& excluded, int threads) {
+                                 const std::vector<char>& excluded) {
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     throw InvalidInput("neighbours: radius must be finite and > 0, got " + std::to_string(radius));
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
-  check_threads(threads);
-  return within_radii(V, excluded, max_count, threads, [radius](int) { return radius; });
+  return within_radii(V, excluded, max_count, 0, [radius](int) { return radius; });
 }
 
 Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, int max_count,
-                                          const std::vector<char>& excluded, int threads) {
+                                          const std::vector<char>& excluded) {
   if (!(scale > 0.0) || !std::isfinite(scale)) {
     throw InvalidInput("neighbours: the adaptive radius scale must be finite and > 0, got " +
                        std::to_string(scale));
   }
   if (max_count < 0) throw InvalidInput("neighbours: max_count must be >= 0");
-  const Neighbourhoods knn = nearest_neighbours(V, k, excluded, threads);
+  const Neighbourhoods knn = nearest_neighbours(V, k, excluded);
   const int n = knn.vertex_count();
   std::vector<double> reach(static_cast<std::size_t>(n), NAN);  // to the k-th nearest
   for (int i = 0; i < n; ++i) {
@@ -311,7 +307,7 @@ Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, i
       reach[static_cast<std::size_t>(i)] = (V.row(*(knn.end(i) - 1)) - V.row(i)).norm();
   }
   std::vector<double> radius(static_cast<std::size_t>(n), 0.0);
-  detail::parallel_for_blocks(n, 1024, threads, [&](std::int64_t begin, std::int64_t end) {
+  detail::parallel_for_blocks(n, 1024, 0, [&](std::int64_t begin, std::int64_t end) {
     std::vector<double> around;
     for (std::int64_t i = begin; i < end; ++i) {
       const int p = static_cast<int>(i);
@@ -324,7 +320,7 @@ Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale, i
       radius[static_cast<std::size_t>(i)] = scale * *middle;
     }
   });
-  return within_radii(V, excluded, max_count, threads,
+  return within_radii(V, excluded, max_count, 0,
                       [&radius](int row) { return radius[static_cast<std::size_t>(row)]; });
 }
 

@@ -34,14 +34,12 @@ void check_lists(const char* test, PositionsRef V, const Neighbourhoods& neighbo
 
 }  // namespace
 
-std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
-                                 int threads) {
+std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio) {
   check_ratio("outlier_points", ratio);
-  check_threads(threads);
   check_lists("outlier_points", V, neighbours);
   const int n = neighbours.vertex_count();
   std::vector<double> reach(static_cast<std::size_t>(n), NAN);
-  detail::parallel_for(n, threads, [&](std::int64_t i) {
+  detail::parallel_for(n, 0, [&](std::int64_t i) {
     const int p = static_cast<int>(i);
     if (neighbours.size(p) == 0) return;
     double sum = 0.0;
@@ -50,7 +48,7 @@ std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbour
     }
     reach[static_cast<std::size_t>(i)] = sum / neighbours.size(p);
   });
-  return detail::outlier_points(V, neighbours, reach, ratio, threads);
+  return detail::outlier_points(V, neighbours, reach, ratio, 0);
 }
 
 std::vector<char> detail::outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
@@ -142,12 +140,11 @@ std::vector<char> off_surface(PositionsRef V, const Neighbourhoods& neighbours, 
 
 }  // namespace
 
-std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours, double ratio,
-                                     int threads) {
+std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
+                                     double ratio) {
   check_ratio("off_surface_points", ratio);
-  check_threads(threads);
   check_lists("off_surface_points", V, neighbours);
-  return off_surface(V, neighbours, ratio, threads,
+  return off_surface(V, neighbours, ratio, 0,
                      [&](int p) { return plane_offset(V, neighbours, p, -1); });
 }
 

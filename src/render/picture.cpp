@@ -59,7 +59,7 @@ struct PanelContent {
 
 void check_options(PositionsRef V, FacesRef F, NormalsRef N,
                    const Eigen::Ref<const Eigen::VectorXd>& field, const FieldPictureOptions& o) {
-  validate_mesh_arrays(V, F, N, "render_field_picture", o.threads);
+  validate_mesh_arrays(V, F, N, "render_field_picture");
   const auto rows = std::to_string(V.rows());
   if (N.rows() != V.rows())
     throw InvalidInput("render_field_picture: N must have " + rows + " rows");
@@ -90,8 +90,7 @@ void check_options(PositionsRef V, FacesRef F, NormalsRef N,
         throw InvalidInput("render_field_picture: a focal mesh must have the base mesh's " + rows +
                            " vertices");
       }
-      validate_mesh_arrays(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3), "render_field_picture",
-                           o.threads);
+      validate_mesh_arrays(g->mesh.V, g->mesh.F, RowMatrixX3d(0, 3), "render_field_picture");
     }
   }
 }
@@ -196,10 +195,10 @@ constexpr int kSplatNeighbours = 8;
 constexpr double kSplatRadiusPerMeanDistance = 0.7;
 
 /// Mean distance of each point to its 8 nearest (NaN for points with no neighbour).
-Eigen::VectorXd mean_neighbour_distances(PositionsRef V, int threads) {
+Eigen::VectorXd mean_neighbour_distances(PositionsRef V) {
   Eigen::VectorXd mean =
       Eigen::VectorXd::Constant(V.rows(), std::numeric_limits<double>::quiet_NaN());
-  const Neighbourhoods knn = nearest_neighbours(V, kSplatNeighbours, threads);
+  const Neighbourhoods knn = nearest_neighbours(V, kSplatNeighbours);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     const auto begin = knn.offsets[i], end = knn.offsets[i + 1];
     if (begin == end) continue;
@@ -212,10 +211,10 @@ Eigen::VectorXd mean_neighbour_distances(PositionsRef V, int threads) {
 
 /// Splat radius per point: `radius` for all, or (radius 0) 0.7 x the mean distance to the 8
 /// nearest; a point without neighbours gets 1% of the bounding box diagonal.
-std::vector<float> splat_radii(PositionsRef V, double radius, int threads) {
+std::vector<float> splat_radii(PositionsRef V, double radius) {
   std::vector<float> out(static_cast<std::size_t>(V.rows()), static_cast<float>(radius));
   if (radius > 0.0) return out;
-  const Eigen::VectorXd mean = mean_neighbour_distances(V, threads);
+  const Eigen::VectorXd mean = mean_neighbour_distances(V);
   const double fallback = 0.01 * bounding_box_diagonal(V);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     const double r =
@@ -252,7 +251,7 @@ PanelContent splat_panel(PositionsRef V, NormalsRef N, const std::vector<float>&
                          const FieldPictureOptions& o) {
   PanelContent p;
   p.attributes = {render_detail::to_floats(V), splat_normals(N, V.rows()), colours,
-                  splat_radii(V, o.splat_radius, o.threads)};
+                  splat_radii(V, o.splat_radius)};
   p.indices = drawable_points(V);
   p.splats = true;
   return p;

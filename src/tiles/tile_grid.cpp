@@ -47,9 +47,9 @@ TileGridBox grow_tile_grid_box(const TileGridBox& box, PositionsRef P) {
   return out;
 }
 
-std::vector<std::int32_t> tile_grid_cells(PositionsRef P, const TileGridBox& box, int threads) {
+std::vector<std::int32_t> tile_grid_cells(PositionsRef P, const TileGridBox& box) {
   std::vector<std::int32_t> out(static_cast<std::size_t>(P.rows()));
-  detail::parallel_for(P.rows(), threads, [&](std::int64_t i) {
+  detail::parallel_for(P.rows(), 0, [&](std::int64_t i) {
     out[static_cast<std::size_t>(i)] = cell_of(P.row(i).transpose(), box);
   });
   return out;
@@ -80,12 +80,12 @@ TileGrid cut_tile_grid(std::span<const std::int64_t> counts, int tile_vertices) 
 }
 
 std::vector<std::int32_t> tile_grid_tiles(PositionsRef P, const TileGridBox& box,
-                                          std::span<const std::int32_t> cell_tile, int threads) {
+                                          std::span<const std::int32_t> cell_tile) {
   if (static_cast<std::int64_t>(cell_tile.size()) != kTileGridCells) {
     throw InvalidInput("tile_grid_tiles: " + std::to_string(cell_tile.size()) +
                        " cells, expected " + std::to_string(kTileGridCells));
   }
-  std::vector<std::int32_t> out = tile_grid_cells(P, box, threads);
+  std::vector<std::int32_t> out = tile_grid_cells(P, box);
   for (std::int32_t& t : out) t = cell_tile[static_cast<std::size_t>(t)];
   return out;
 }

@@ -151,16 +151,15 @@ Tiling partition_mesh(PositionsRef V, FacesRef F, int halo_rings, const TileOpti
   if (halo_rings < 1) throw InvalidInput("partition_mesh: halo_rings must be >= 1");
   if (options.tile_vertices < 1) throw InvalidInput("partition_mesh: tile_vertices must be >= 1");
   detail::check_face_indices(V.rows(), F, "partition_mesh");
-  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, options.threads);
-  const std::vector<int> order = detail::morton_order(V, options.threads);
+  const detail::VertexFaces inc = detail::vertex_face_incidence(V.rows(), F, 0);
+  const std::vector<int> order = detail::morton_order(V, 0);
   Tiling out;
   out.halo_rings = halo_rings;
   // Tiles in parallel, each thread with its own marks (a tile's stamp is its index, so marks
   // are never cleared): 8 bytes per vertex and face per thread, allocated on first use.
-  std::vector<std::unique_ptr<Marks>> marks(
-      static_cast<std::size_t>(detail::thread_count(options.threads)));
-  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), options.threads,
-                   out.tiles, [&](int t, std::vector<int> owned) {
+  std::vector<std::unique_ptr<Marks>> marks(static_cast<std::size_t>(detail::thread_count(0)));
+  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), 0, out.tiles,
+                   [&](int t, std::vector<int> owned) {
                      auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
                      if (!m) {
                        m = std::make_unique<Marks>(
@@ -206,16 +205,15 @@ TileMesh extract_tile(PositionsRef V, FacesRef F, std::optional<NormalsRef> N, c
 }
 
 TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
-                           const EstimateOptions& options, int threads) {
+                           const EstimateOptions& options) {
   const std::optional<NormalsRef> N =
       tile.N ? std::optional<NormalsRef>(*tile.N) : std::optional<NormalsRef>();
-  const PreparedMesh mesh(tile.V, tile.F, N,
-                          {.threads = threads, .mean_edge_length = choices.mean_edge_length});
+  const PreparedMesh mesh(tile.V, tile.F, N, {.mean_edge_length = choices.mean_edge_length});
   Estimate e = estimate(mesh, options_for_part(options, choices));
   return {std::move(e.curvature), std::move(e.crease)};
 }
 
-std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending, int threads) {
+std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending) {
   std::vector<char> out(x.size(), 0);
   if (ascending.empty() || x.empty()) return out;
   for (std::size_t k = 1; k < ascending.size(); ++k) {
@@ -232,7 +230,7 @@ std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending,
     const auto b = static_cast<std::size_t>(id - lo);
     bits[b / 64] |= std::uint64_t{1} << (b % 64);
   }
-  detail::parallel_for(static_cast<std::int64_t>(x.size()), threads, [&](std::int64_t i) {
+  detail::parallel_for(static_cast<std::int64_t>(x.size()), 0, [&](std::int64_t i) {
     const int v = x[static_cast<std::size_t>(i)];
     if (v < lo || v > hi) return;
     const auto b = static_cast<std::size_t>(v - lo);
@@ -244,7 +242,7 @@ std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending,
 RecommendedStatistics tile_statistics(const TileMesh& tile, const std::vector<int>& ids,
                                       const std::vector<int>& owned,
                                       Eigen::Index whole_vertex_count, double mean_edge_length,
-                                      const EstimateOptions& options, int threads) {
+                                      const EstimateOptions& options) {
   if (options.estimator != Estimator::recommended) {
     throw InvalidInput("tile_statistics: measures the recommended estimator's choices only");
   }
@@ -256,7 +254,7 @@ RecommendedStatistics tile_statistics(const TileMesh& tile, const std::vector<in
         "which a tile cannot decide");
   }
   const PreparedMesh mesh(tile.V, tile.F, NormalsRef(*tile.N),
-                          {.threads = threads, .mean_edge_length = mean_edge_length});
+                          {.mean_edge_length = mean_edge_length});
   // The rows fixed as the whole mesh's are (filled, made unit: per row, from its faces).
   const PreparedNormals prepared = prepare_normals(mesh, options);
   const PreparedMesh fit = prepared.N ? mesh.with_normals(NormalsRef(*prepared.N)) : mesh;
@@ -283,8 +281,8 @@ TileEstimate estimate_tiled(const PreparedMesh& mesh, const EstimateOptions& opt
       partition_mesh(mesh.V(), F, estimate_reach(options_for_part(options, choices)), tiles);
   TileEstimate out{detail::unwritten_result(mesh.vertex_count()), {}};
   for (const Tile& tile : tiling.tiles) {
-    const TileEstimate part = estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile),
-                                            choices, options, tiles.threads);
+    const TileEstimate part =
+        estimate_tile(extract_tile(mesh.V(), F, mesh.normals(), tile), choices, options);
     scatter_rows(part, tile.owned, tile.vertices, out);
   }
   return out;
@@ -297,13 +295,13 @@ Tiling partition_cloud(PositionsRef V, const Neighbourhoods& neighbours, int hal
   if (neighbours.vertex_count() != V.rows()) {
     throw InvalidInput("partition_cloud: the neighbourhoods are not V's");
   }
-  const std::vector<int> order = detail::morton_order(V, options.threads);
+  const std::vector<int> order = detail::morton_order(V, 0);
   Tiling out;
   out.halo_rings = halo_depth;
   std::vector<std::unique_ptr<std::vector<int>>> marks(
-      static_cast<std::size_t>(detail::thread_count(options.threads)));
-  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), options.threads,
-                   out.tiles, [&](int t, std::vector<int> owned) {
+      static_cast<std::size_t>(detail::thread_count(0)));
+  for_each_tile_of(order, static_cast<std::size_t>(options.tile_vertices), 0, out.tiles,
+                   [&](int t, std::vector<int> owned) {
                      auto& m = marks[static_cast<std::size_t>(detail::worker_slot())];
                      if (!m) m = std::make_unique<std::vector<int>>(order.size(), -1);
                      return make_cloud_tile(std::move(owned), neighbours, halo_depth, t, *m);

@@ -62,7 +62,7 @@ int main() {
   const focal::Estimate e = focal::estimate(prepared, {.estimator = focal::Estimator::paper});
   check(!e.N.has_value() && e.curvature.k1 == c.k1, "estimate(paper): other k1 or normals");
   const focal::RecommendedResult r =
-      focal::estimate_curvature_recommended(mesh.V, mesh.F, mesh.normals(), {.threads = 1});
+      focal::estimate_curvature_recommended(mesh.V, mesh.F, mesh.normals());
   check(r.curvature.k1.size() == 12 && r.N.rows() == 12, "recommended: wrong shapes");
   const focal::FocalMeshes f = focal::focal_meshes(prepared.with_normals(r.N), r.curvature);
   check(f.gamma1.mesh.V.rows() == 12, "focal meshes: wrong shapes");

@@ -19,6 +19,6 @@ struct EdgeLengthSums {
   std::vector<double> sums;
   std::vector<std::int64_t> counts;
 };
-[[nodiscard]] EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F, int threads = 0);
+[[nodiscard]] EdgeLengthSums edge_length_sums(PositionsRef V, FacesRef F);
 
 }  // namespace focal

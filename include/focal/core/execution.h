@@ -1,7 +1,9 @@
 #pragma once
 /// \file execution.h
-/// How a call runs, apart from what it computes: threads, progress, messages and cancellation,
-/// in one struct that the front door (focal/curvature.h) takes as EstimateOptions::execution.
+/// How a call runs, apart from what it computes: thread count, progress, messages, cancellation,
+/// in one struct that the front door (focal/curvature.h) takes as EstimateOptions::execution,
+/// and that an ExecutionScope sets for every focal call made on the calling thread (the
+/// functions below the front door take no thread count of their own).
 /// Nothing here changes a result: every field gives the same bits for any setting.
 
 #include <atomic>
@@ -18,18 +20,48 @@ struct Progress {
 };
 
 struct Execution {
-  /// Worker threads. 0: FOCAL_NUM_THREADS if set, else every CPU this process may run on.
-  /// Results are the same for any count.
+  /// The most threads that work on one parallel loop. 0: the enclosing ExecutionScope's, else
+  /// FOCAL_NUM_THREADS if set, else every CPU this process may run on. Results are the same
+  /// for any count.
   int threads = 0;
   /// Called on the calling thread as each stage begins and ends (none: nothing is reported).
-  std::function<void(const Progress&)> progress;
+  std::function<void(const Progress&)> progress{};
   /// Called on the calling thread with each warning about the input or a choice made on it (a
   /// sentence without the file's name, which a caller that knows it puts before it).
-  std::function<void(const std::string&)> warning;
+  std::function<void(const std::string&)> warning{};
   /// Called on the calling thread with what the estimator decided (its plan), for a verbose log.
-  std::function<void(const std::string&)> info;
+  std::function<void(const std::string&)> info{};
   /// When set, read between stages: true stops the call with Cancelled.
   const std::atomic<bool>* cancel = nullptr;
 };
+
+/// Makes a copy of `execution` the calling thread's current one (current_execution) for the
+/// scope's lifetime; every focal call on this thread (and the parallel loops it starts on other
+/// worker threads) then runs with its settings:
+///
+///     focal::ExecutionScope scope({.threads = 4});
+///     auto normals = focal::vertex_normals(V, F);  // on 4 threads
+///
+/// Scopes nest: the innermost one wins, and a field it leaves at its default (a count of 0, no
+/// callback, no cancel flag) is taken from the enclosing scope. The enclosing one is current
+/// again when the inner one ends. No other thread is affected. Create and destroy scopes on one
+/// thread in nested order (as locals).
+class ExecutionScope {
+ public:
+  /// \throw InvalidInput when the count is negative.
+  explicit ExecutionScope(const Execution& execution);
+  ~ExecutionScope();
+  ExecutionScope(const ExecutionScope&) = delete;
+  ExecutionScope& operator=(const ExecutionScope&) = delete;
+
+ private:
+  Execution execution_;
+  const Execution* enclosing_;
+};
+
+/// The calling thread's current Execution: that of its innermost ExecutionScope, or the
+/// defaults (all zero, no callbacks) outside every scope. Inside a parallel loop's body, that of
+/// the thread that started the loop.
+[[nodiscard]] const Execution& current_execution();
 
 }  // namespace focal

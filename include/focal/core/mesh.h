@@ -52,15 +52,13 @@ struct Mesh {
 };
 
 /// Throws InvalidInput unless F indexes V (every index in [0, #V)) and, when N is non-empty,
-/// N has #V rows. `what` names the caller in the message. Checked in parallel on `threads`
-/// threads (0: FOCAL_NUM_THREADS if set, else all hardware threads).
-void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what,
-                          int threads = 0);
+/// N has #V rows. `what` names the caller in the message. Checked in parallel.
+void validate_mesh_arrays(PositionsRef V, FacesRef F, NormalsRef N, const char* what);
 
 /// Mean length of the triangle edges (each undirected edge once per incident face). Edges with a
-/// NaN or infinite length are left out; 0 when no edge is left. Summed in parallel on `threads`
-/// threads (as validate_mesh_arrays), with the same result for any count.
-[[nodiscard]] double mean_edge_length(PositionsRef V, FacesRef F, int threads = 0);
+/// NaN or infinite length are left out; 0 when no edge is left. Summed in parallel, with the same
+/// result for any thread count.
+[[nodiscard]] double mean_edge_length(PositionsRef V, FacesRef F);
 
 /// Length of the diagonal of the axis-aligned bounding box of the rows of V whose coordinates are
 /// all finite; 0 when there are none.

@@ -107,7 +107,6 @@ struct CloudOptions {
   /// (above) takes its lists back to its own rows only when they are kept: the lists are not
   /// taken back for callers that do not read them.
   bool keep_neighbours = true;
-  int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
 };
 
 /// The fields and what they were computed from.
@@ -150,7 +149,7 @@ struct CloudCurvature {
                                                   const CloudOptions& options = {});
 
 /// The neighbourhoods CloudOptions select (k nearest or radius).
-/// \throw InvalidInput when k < 0, radius < 0 or threads < 0.
+/// \throw InvalidInput when k < 0 or radius < 0.
 [[nodiscard]] Neighbourhoods cloud_neighbourhoods(PositionsRef V, const CloudOptions& options);
 
 /// The two halves of estimate_cloud_curvature, for tiles (focal/tiles/tiles.h): the plan, which

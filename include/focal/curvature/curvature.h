@@ -49,9 +49,6 @@ struct CurvatureOptions {
   double zero_tolerance = default_zero_tolerance;  // 1e-3 (core/point_class.h)
   /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
   double umbilic_tolerance = default_umbilic_tolerance;  // 1e-2
-  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-  /// PrepareOptions::threads.
-  int threads = 0;
 };
 
 /// Estimates the curvature fields of a triangle mesh from its vertex normals: the paper's method.

@@ -84,8 +84,8 @@ struct EstimateOptions {
   /// normals do not come from the mesh). false: the faces are taken as they are, e.g. a tile's,
   /// cut from the faces that MeshWideChoices::F oriented over the whole mesh.
   bool orient_faces = true;
-  /// Threads, progress, messages and cancellation of focal::curvature (focal/curvature.h); its
-  /// threads are those of every step whose own option is 0.
+  /// Thread count, progress, messages and cancellation of focal::curvature (focal/curvature.h),
+  /// current for the whole call (an ExecutionScope).
   Execution execution{};
 };
 

@@ -15,9 +15,6 @@ struct FocalMeshOptions {
   double max_distance = 0.0;
   /// Leave out faces with a vertex at infinity (or undefined) instead of keeping them clamped.
   bool drop_faces_at_infinity = false;
-  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-  /// PrepareOptions::threads.
-  int threads = 0;
 };
 
 /// Builds both focal meshes from the base mesh, its normals (made unit) and its curvature fields.

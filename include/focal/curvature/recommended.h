@@ -79,9 +79,6 @@ struct RecommendedOptions {
   double zero_tolerance = default_zero_tolerance;
   /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
   double umbilic_tolerance = default_umbilic_tolerance;
-  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-  /// PrepareOptions::threads.
-  int threads = 0;
   /// The per-mesh choices, when given, instead of measuring them on this mesh: a tile takes
   /// recommended_mesh_wide() of the whole mesh (with PrepareOptions::mean_edge_length, the scale
   /// they are measured in).

@@ -11,8 +11,8 @@
 /// The roots l_j = -1 / k_j are the focal depths; the slit at depth l_j runs along
 /// (u_x + l_j s_x, v_x + l_j t_x) (Appendix B, eq. 18).
 
-#include "focal/curvature/curvature.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/curvature.h"
 
 namespace focal {
 
@@ -25,11 +25,12 @@ struct TriangleCurvatureResult {
   Eigen::VectorXd lambda1;  ///< focal depth -1 / k1 along the face normal (inf where k1 = 0)
   Eigen::VectorXd lambda2;  ///< focal depth -1 / k2
   RowMatrixX3d d1, d2;      ///< unit principal directions (d1 of k1), tangent to the face normal
-  RowMatrixX3d slit1, slit2; ///< unit slit directions at depths lambda1 and lambda2 (slit1 is along d2)
+  RowMatrixX3d slit1,
+      slit2;  ///< unit slit directions at depths lambda1 and lambda2 (slit1 is along d2)
   RowMatrixX3d face_normal;  ///< the unit mean of the three vertex normals (the frame's z axis)
   /// 2x2 shape operator M = G X^-1 in the face frame, row-major (m00, m01, m10, m11) per face.
   Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> shape_operator;
-  VectorXu8 point_class;     ///< PointClass codes from A, B and the discriminant
+  VectorXu8 point_class;  ///< PointClass codes from A, B and the discriminant
 };
 
 /// Which fields of TriangleCurvatureResult triangle_curvature fills. A field not asked for is
@@ -49,7 +50,7 @@ struct TriangleFields {
 /// (the same values in the fields it fills). Faces with zero area in the ray frame (C = 0), a
 /// vertex normal outside the face normal's hemisphere or non-finite input are `undefined` with
 /// NaN values. Each face's row is written once, by the thread that computes it. Reads
-/// options.zero_tolerance, umbilic_tolerance and threads (0: the mesh's).
+/// options.zero_tolerance and umbilic_tolerance.
 /// \throw InvalidInput when the mesh has no normals.
 [[nodiscard]] TriangleCurvatureResult triangle_curvature(const PreparedMesh& mesh,
                                                          const CurvatureOptions& options = {},

@@ -46,7 +46,6 @@ struct ImageSpaceOptions {
   /// averaged (weighted by the triplets' relative area), and k1, k2, d1, d2 are the eigen-pairs
   /// of the mean. 0 = none: the pixel's own characteristic equation. In [0, 16].
   int window = 0;
-  int threads = 0;  ///< CPU threads; 0: FOCAL_NUM_THREADS or all hardware threads
 };
 
 /// Per-pixel fields, width * height each (3 per pixel for d1, d2), in the units of the
@@ -70,10 +69,9 @@ struct ImageCurvature {
 [[nodiscard]] ImageCurvature estimate_image_curvature(const GBuffer& gbuffer,
                                                       const ImageSpaceOptions& options = {});
 
-/// The same on CUDA device `device`, one thread per pixel, the same per-pixel function
-/// (options.threads is ignored). Agrees with the CPU reference up to float rounding (fused
-/// multiply-adds on the device).
-/// \throw DeviceError without the CUDA backend or the device, or on a CUDA error;
+/// The same on CUDA device `device`, one thread per pixel, the same per-pixel function. Agrees with
+/// the CPU reference up to float rounding (fused multiply-adds on the device). \throw DeviceError
+/// without the CUDA backend or the device, or on a CUDA error;
 ///        InvalidInput as estimate_image_curvature.
 [[nodiscard]] ImageCurvature estimate_image_curvature_cuda(const GBuffer& gbuffer,
                                                            const ImageSpaceOptions& options = {},

@@ -15,11 +15,11 @@ namespace focal {
 
 /// One CSV row per vertex, in input order; class as a word, NaN as `nan`. With `crease` (#V
 /// flags, Estimate::crease) a last column `crease` of 0 and 1; empty: no such column. The rows
-/// are formatted on `threads` threads (0: the default), the same bytes for any count.
+/// are formatted in parallel, the same bytes for any thread count.
 /// \throw InvalidInput when `crease` is neither empty nor of the fields' length.
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,
-                         const VectorXu8& crease = {}, int threads = 0);
-/// write_curvature_csv with the options' threads and precision (Precision::float32: each number
+                         const VectorXu8& crease = {});
+/// write_curvature_csv with the options' precision (Precision::float32: each number
 /// as the shortest text of the float nearest to it; `nan` stays `nan`, class words and crease
 /// flags are unchanged).
 void write_curvature_csv(const std::filesystem::path& path, const CurvatureResult& fields,

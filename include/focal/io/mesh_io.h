@@ -44,9 +44,6 @@ enum class MeshFormat { obj, ply, off, stl, xyz, pcd, las };
 [[nodiscard]] MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
 struct ReadOptions {
-  /// Threads of the parallel passes (binary PLY, OBJ, OFF): 0 for FOCAL_NUM_THREADS if set, else
-  /// all hardware threads. The mesh read does not depend on it.
-  int threads = 0;
   /// STL: weld facet corners into shared vertices (false: every corner is its own vertex, in file
   /// order, as the file stores them; no triangle then shares an edge).
   bool weld = true;
@@ -65,8 +62,7 @@ struct ReadOptions {
 /// materials, lines (`l`, `p`) and free-form geometry are ignored.
 /// \throw IoError naming the file and the line, byte offset or element index of the problem,
 /// also for a missing file, a path that is not a regular file (a directory, FIFO, device or
-/// socket) or an unreadable path; InvalidInput for negative threads or a negative or non-finite
-/// weld_tolerance.
+/// socket) or an unreadable path; InvalidInput for a negative or non-finite weld_tolerance.
 [[nodiscard]] Mesh read_mesh(const std::filesystem::path& path, const ReadOptions& options = {});
 
 /// A binary PLY triangle mesh read a range or a set of records at a time, never whole: the input
@@ -138,9 +134,6 @@ struct VertexProperty {
 struct PlyWriteOptions {
   bool binary = true;                 ///< binary little endian (default) or ascii
   std::vector<std::string> comments;  ///< `comment` lines in the header
-  /// Threads of the checks and of the binary encoding: 0 for FOCAL_NUM_THREADS if set, else all
-  /// hardware threads. The bytes written do not depend on it.
-  int threads = 0;
   /// float32: positions, normals and `float64` properties written as `float` (the converted
   /// values, see Precision); other property types are unchanged.
   Precision precision = Precision::float64;
@@ -148,9 +141,6 @@ struct PlyWriteOptions {
 
 /// Options of the text writers (CSV, OBJ, OFF, point-cloud text) and of write_mesh.
 struct WriteOptions {
-  /// Threads of the CSV formatting and of binary PLY (write_mesh): 0 for FOCAL_NUM_THREADS if
-  /// set, else all hardware threads. The bytes written do not depend on it.
-  int threads = 0;
   /// float32: every real number (coordinates, normals, CSV numbers) written as the float nearest
   /// to it (Precision); PLY as `float` properties.
   Precision precision = Precision::float64;
@@ -185,7 +175,7 @@ void write_xyz(const std::filesystem::path& path, const Mesh& mesh,
                const WriteOptions& options = {});
 
 /// Writes a mesh in the format named by the extension (.ply binary, .obj, .off; .xyz and the
-/// other point-cloud text extensions: write_xyz), with the options' precision and threads.
+/// other point-cloud text extensions: write_xyz), with the options' precision.
 /// \throw IoError for .stl (it cannot keep shared vertices), .pcd, .las and unknown extensions.
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const WriteOptions& options = {});
@@ -198,11 +188,10 @@ struct CsvColumn {
   std::variant<Eigen::VectorXd, std::vector<std::string>> values;
 };
 
-/// Writes a header line with the column names, then one row per element, the rows formatted on
-/// `threads` threads (0: the default; the bytes are the same for any count).
-/// \throw InvalidInput when the columns differ in length or threads < 0; IoError on write failure.
-void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,
-               int threads = 0);
+/// Writes a header line with the column names, then one row per element, the rows formatted in
+/// parallel (the bytes are the same for any thread count).
+/// \throw InvalidInput when the columns differ in length; IoError on write failure.
+void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns);
 /// write_csv with the numbers in the options' precision (Precision::float32: the shortest text of
 /// the float nearest to each number; `nan`, `inf`, `-inf` as above).
 void write_csv(const std::filesystem::path& path, std::span<const CsvColumn> columns,

@@ -61,9 +61,8 @@ struct MeshFindings {
 
 /// check_mesh of the arrays. \param V #V x 3 positions (NaN and infinities allowed). \param F
 /// #F x 3 triangles. \param N #V x 3 normals as given, or std::nullopt when there are none.
-/// \param threads 0: FOCAL_NUM_THREADS if set, else all hardware threads.
 /// \throw InvalidInput when F indexes outside V or N does not have #V rows.
 [[nodiscard]] MeshFindings check_mesh(PositionsRef V, FacesRef F,
-                                      std::optional<NormalsRef> N = std::nullopt, int threads = 0);
+                                      std::optional<NormalsRef> N = std::nullopt);
 
 }  // namespace focal

@@ -7,8 +7,8 @@
 /// corners of a common face; its incident faces are the faces having both as corners, each once
 /// (also a face with a repeated index, such as (a, a, b) for the edge {a, b}).
 ///
-/// All functions gather per vertex in a fixed order: results do not depend on the thread count.
-/// `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware threads.
+/// All functions gather per vertex in a fixed order: results do not depend on the thread count
+/// (that of the current ExecutionScope, focal/core/execution.h).
 
 #include <vector>
 
@@ -31,7 +31,7 @@ struct Neighbourhoods {
 /// never the vertex itself (degenerate faces with repeated indices add no self-loops).
 /// \throw InvalidInput when vertex_count < 0, F indexes outside [0, vertex_count), or the lists
 /// would not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F, int threads = 0);
+[[nodiscard]] Neighbourhoods vertex_adjacency(int vertex_count, FacesRef F);
 
 /// The most vertices a neighbourhood of two or more rings may hold (the vertex itself not
 /// counted). A vertex with more within its rings, such as every corner of a polygon of thousands
@@ -51,18 +51,17 @@ inline constexpr int kMaxNeighbourhoodSize = 1024;
 /// \throw InvalidInput when k < 1, `one_ring` is not a valid CSR (offsets not starting at 0,
 /// decreasing, not ending at indices.size(), or an index outside [0, #V)), or the result would
 /// not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k, int threads = 0);
+[[nodiscard]] Neighbourhoods k_ring(const Neighbourhoods& one_ring, int k);
 
 /// The vertices (ascending) whose k-ring has more than kMaxNeighbourhoodSize vertices, those
 /// k_ring() leaves empty; none for k = 1. O(#V x kMaxNeighbourhoodSize) at most.
 /// \throw InvalidInput as k_ring().
-[[nodiscard]] std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k,
-                                                int threads = 0);
+[[nodiscard]] std::vector<int> crowded_vertices(const Neighbourhoods& one_ring, int k);
 
 /// #V flags: true for vertices on a boundary edge (an edge with exactly one incident face).
 /// Vertices only on non-manifold edges (3+ faces) are not boundary vertices.
 /// \throw InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
-[[nodiscard]] std::vector<bool> boundary_vertices(int vertex_count, FacesRef F, int threads = 0);
+[[nodiscard]] std::vector<bool> boundary_vertices(int vertex_count, FacesRef F);
 
 /// Per-vertex ring distance to the nearest boundary vertex (0 on the boundary), capped at
 /// `max_rings` + 1 for vertices farther away or in components without boundary.
@@ -94,6 +93,6 @@ struct MeshStatistics {
 
 /// Counts of the mesh's connectivity and quality; linear time, parallel per vertex.
 /// \throw InvalidInput when F indexes outside V.
-[[nodiscard]] MeshStatistics mesh_statistics(PositionsRef V, FacesRef F, int threads = 0);
+[[nodiscard]] MeshStatistics mesh_statistics(PositionsRef V, FacesRef F);
 
 }  // namespace focal

@@ -7,8 +7,8 @@
 /// edge is a pair of distinct vertices of a common face, and its incident faces are the faces
 /// having both as corners. A face with a repeated vertex index has no orientation along its edges.
 ///
-/// `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-/// PrepareOptions::threads. Results do not depend on it.
+/// Parallel on the current ExecutionScope's thread count (focal/core/execution.h); results do not
+/// depend on it.
 
 #include <vector>
 
@@ -39,7 +39,7 @@ struct OrientationReport {
 
 /// Connected components of the faces and the orientation of each.
 /// \throw InvalidInput when F indexes outside V.
-[[nodiscard]] OrientationReport orientation_report(PositionsRef V, FacesRef F, int threads = 0);
+[[nodiscard]] OrientationReport orientation_report(PositionsRef V, FacesRef F);
 
 /// orientation_report of a prepared mesh, on its kept vertex-face incidence.
 [[nodiscard]] OrientationReport orientation_report(const PreparedMesh& mesh);
@@ -65,6 +65,6 @@ struct ConsistentFaces {
 /// not decide inside from outside: follow with orientation_report and orient_outward for that.
 /// Linear time (the search is serial).
 /// \throw InvalidInput when vertex_count < 0 or F indexes outside [0, vertex_count).
-[[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F, int threads = 0);
+[[nodiscard]] ConsistentFaces orient_consistently(int vertex_count, FacesRef F);
 
 }  // namespace focal

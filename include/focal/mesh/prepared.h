@@ -13,7 +13,7 @@
 /// with_normals(), share what is built for V and F. Nothing built changes a result: every function
 /// gives the same bits with a PreparedMesh as with its arrays, for any thread count.
 /// Its const functions may be called from several threads at once: each thing is built once,
-/// under a lock.
+/// under a lock, with the ExecutionScope (focal/core/execution.h) of the call that needs it.
 ///
 /// V, F and N are viewed, not copied: they must outlive the PreparedMesh (and its copies) and
 /// stay unchanged. Pass arrays in the layout of the views (row-major `n x 3` doubles, int32
@@ -28,9 +28,6 @@
 namespace focal {
 
 struct PrepareOptions {
-  /// Threads of what the PreparedMesh builds, and of every function given it whose own `threads`
-  /// option is 0. 0: FOCAL_NUM_THREADS if set, else all hardware threads.
-  int threads = 0;
   /// The mean edge length to use instead of measuring it (0: measured): a tile of a larger mesh
   /// (focal/tiles/tiles.h) takes the whole mesh's, so that the scale of its classes, Gaussian
   /// weights and noise estimate is the whole mesh's. Must be finite and >= 0.
@@ -46,7 +43,7 @@ class PreparedMesh {
   /// Validates the arrays once. \param V #V x 3 positions (NaN and infinities allowed: the
   /// estimators flag the vertices they touch). \param F #F x 3 triangles. \param N #V x 3
   /// normals as given (need not be unit), or std::nullopt when there are none.
-  /// \throw InvalidInput when F indexes outside V, N does not have #V rows, threads < 0 or
+  /// \throw InvalidInput when F indexes outside V, N does not have #V rows, or
   /// mean_edge_length is negative or not finite.
   PreparedMesh(PositionsRef V, FacesRef F, std::optional<NormalsRef> N = std::nullopt,
                const PrepareOptions& options = {});
@@ -64,8 +61,6 @@ class PreparedMesh {
   [[nodiscard]] std::optional<NormalsRef> normals() const;
   [[nodiscard]] Eigen::Index vertex_count() const;
   [[nodiscard]] Eigen::Index face_count() const;
-  /// PrepareOptions::threads as given (0: the default).
-  [[nodiscard]] int threads() const;
 
   /// The 1-ring (vertex_adjacency), built on first call and kept.
   [[nodiscard]] const Neighbourhoods& one_ring() const;

@@ -32,8 +32,7 @@ namespace focal {
 
 /// #V x 3 unit normals by PCA over each point and its neighbours; the sign is arbitrary.
 /// \throw InvalidInput when the neighbourhoods do not have #V points.
-[[nodiscard]] RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours,
-                                       int threads = 0);
+[[nodiscard]] RowMatrixX3d pca_normals(PositionsRef V, const Neighbourhoods& neighbours);
 
 /// Flips rows of N (in place) to one consistent side per connected component of the neighbour
 /// graph, as described above. NaN rows are left as they are and break the graph.
@@ -57,7 +56,6 @@ struct CloudNormalOptions {
   int jet_degree = 3;
   /// Orientation: towards this point when given, else by the minimum spanning tree.
   std::optional<Eigen::Vector3d> viewpoint{};
-  int threads = 0;  ///< 0: FOCAL_NUM_THREADS if set, else all hardware threads
 };
 
 /// Estimated and oriented normals of a cloud over the given neighbourhoods.

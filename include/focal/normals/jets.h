@@ -35,9 +35,6 @@ struct JetOptions {
   int rings = 2;       ///< neighbourhood of the fit in rings (>= 1)
   int degree = 2;      ///< degree of the height polynomial, 1 to 4
   int iterations = 2;  ///< fits per vertex (>= 1); each refits in the previous fit's frame
-  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-  /// PrepareOptions::threads.
-  int threads = 0;
 };
 
 /// Normals from jets, and how well the jets fit.
@@ -51,7 +48,7 @@ struct JetNormals {
 };
 
 /// Jet normals of every vertex, from the mesh's kept incidence (and 1-ring, when kept).
-/// \throw InvalidInput when rings < 1, degree outside [1, 4], iterations < 1 or threads < 0.
+/// \throw InvalidInput when rings < 1, degree outside [1, 4], or iterations < 1.
 [[nodiscard]] JetNormals jet_normals(const PreparedMesh& mesh, const JetOptions& options = {});
 
 /// Jet normals of the arrays. \throw also InvalidInput when F indexes outside V.

@@ -7,8 +7,8 @@
 /// from outside. A face is degenerate when it repeats an index or has numerically zero area:
 /// |(b - a) x (c - a)| <= 1e-14 L^2 with L its longest edge (scale invariant).
 ///
-/// `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware threads; with a PreparedMesh, its
-/// PrepareOptions::threads. Results do not depend on it.
+/// Parallel on the current ExecutionScope's thread count (focal/core/execution.h); results do not
+/// depend on it.
 
 #include "focal/core/mesh.h"
 #include "focal/mesh/prepared.h"
@@ -33,8 +33,7 @@ enum class NormalWeighting {
 /// opposite faces), get a NaN row (never a silent zero).
 /// \throw InvalidInput when F indexes outside V.
 [[nodiscard]] RowMatrixX3d vertex_normals(PositionsRef V, FacesRef F,
-                                          NormalWeighting weighting = NormalWeighting::angle,
-                                          int threads = 0);
+                                          NormalWeighting weighting = NormalWeighting::angle);
 
 /// vertex_normals of a prepared mesh, on its kept vertex-face incidence.
 [[nodiscard]] RowMatrixX3d vertex_normals(const PreparedMesh& mesh,
@@ -45,7 +44,6 @@ enum class NormalWeighting {
 /// Vertices whose area-weighted normal vanishes (see vertex_normals) are not counted. NaN when no
 /// vertex qualifies.
 /// \throw InvalidInput when F indexes outside V or N does not have #V rows.
-[[nodiscard]] double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N,
-                                            int threads = 0);
+[[nodiscard]] double fraction_against_faces(PositionsRef V, FacesRef F, NormalsRef N);
 
 }  // namespace focal

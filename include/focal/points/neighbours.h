@@ -7,8 +7,7 @@
 /// Each list is sorted by distance, ties broken by the smaller index, and never holds the point
 /// itself. Points with a NaN or infinite coordinate are left out of the tree: their lists are
 /// empty and they are in no list. Queries run in parallel and gather per point: the lists do not
-/// depend on the thread count. `threads`: 0 for FOCAL_NUM_THREADS if set, else all hardware
-/// threads.
+/// depend on the thread count (that of the current ExecutionScope, focal/core/execution.h).
 ///
 /// A kNN neighbourhood adapts to the local density by itself (its radius is the distance to the
 /// k-th neighbour, about sqrt(k / (pi rho)) at density rho), which is why focal's cloud estimators
@@ -22,36 +21,34 @@ namespace focal {
 
 /// The k nearest other points of every point (fewer where the cloud has fewer than k + 1 finite
 /// points). Exactly equal positions (duplicates) are neighbours at distance 0.
-/// \throw InvalidInput when k < 1, threads < 0 or the lists would not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k, int threads = 0);
+/// \throw InvalidInput when k < 1 or the lists would not fit 32-bit offsets.
+[[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k);
 
 /// The same, leaving out the points flagged in `excluded` (#V flags, or empty for none) as
 /// non-finite ones are: their lists are empty and they are in no list.
 /// \throw InvalidInput as above, or when `excluded` is neither empty nor #V long.
 [[nodiscard]] Neighbourhoods nearest_neighbours(PositionsRef V, int k,
-                                                const std::vector<char>& excluded, int threads = 0);
+                                                const std::vector<char>& excluded);
 
 /// Every other point within Euclidean distance `radius` (inclusive), at most `max_count` of them
 /// (the nearest; 0 = no limit).
-/// \throw InvalidInput when radius is not finite and positive, max_count < 0, threads < 0 or
-/// the lists would not fit 32-bit offsets.
-[[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count = 0,
-                                               int threads = 0);
+/// \throw InvalidInput when radius is not finite and positive, max_count < 0 or the
+/// lists would not fit 32-bit offsets.
+[[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count = 0);
 
 /// The same, leaving out the points flagged in `excluded` (as nearest_neighbours).
 [[nodiscard]] Neighbourhoods radius_neighbours(PositionsRef V, double radius, int max_count,
-                                               const std::vector<char>& excluded, int threads = 0);
+                                               const std::vector<char>& excluded);
 
 /// Neighbourhoods whose radius follows the local density: point i gets every other point within
 /// scale x r_i (inclusive, at most `max_count`, the nearest; 0 = no limit), r_i the median, over
 /// i and its k nearest, of their distances to their own k-th nearest (smoothed, so that one
 /// sparse or dense spot does not set a radius of its own). Flags in `excluded` as
 /// nearest_neighbours. Lists sorted by (distance, index): identical for any thread count.
-/// \throw InvalidInput when k < 1, scale is not finite and > 0, max_count < 0 or threads < 0.
+/// \throw InvalidInput when k < 1, scale is not finite and > 0, or max_count < 0.
 [[nodiscard]] Neighbourhoods adaptive_radius_neighbours(PositionsRef V, int k, double scale,
                                                         int max_count,
-                                                        const std::vector<char>& excluded = {},
-                                                        int threads = 0);
+                                                        const std::vector<char>& excluded = {});
 
 /// Statistical outliers (#V flags): points whose mean distance to their neighbours is more than
 /// `ratio` times the median of their neighbours' own mean distances. Measured against the
@@ -59,10 +56,9 @@ namespace focal {
 /// are), so that a cloud whose density varies (a scan sparser far from the scanner) loses no
 /// point for being in its sparse part: an isolated point off the surface is far from its
 /// neighbours, which are close to theirs. Points with an empty list are not flagged.
-/// \throw InvalidInput when ratio is not finite and > 1, threads < 0, or the neighbourhoods
-/// are not V's.
+/// \throw InvalidInput when ratio is not finite and > 1, or the neighbourhoods are not V's.
 [[nodiscard]] std::vector<char> outlier_points(PositionsRef V, const Neighbourhoods& neighbours,
-                                               double ratio, int threads = 0);
+                                               double ratio);
 
 /// Points off their neighbours' surface (#V flags): the distance of a point to the
 /// least-squares plane of its neighbours (the point itself not in the fit) is more than `ratio`
@@ -77,10 +73,9 @@ namespace focal {
 /// not a point off the surface's edge within its tangent plane. Points with fewer than 3
 /// neighbours are not flagged; an RMS below 1e-9 x the mean neighbour distance counts as that
 /// (exactly flat neighbourhoods).
-/// \throw InvalidInput when ratio is not finite and > 1, threads < 0, or the neighbourhoods
-/// are not V's.
+/// \throw InvalidInput when ratio is not finite and > 1, or the neighbourhoods are not V's.
 [[nodiscard]] std::vector<char> off_surface_points(PositionsRef V, const Neighbourhoods& neighbours,
-                                                   double ratio, int threads = 0);
+                                                   double ratio);
 
 /// The mean over finite points of the distance to their nearest other point (0 when no point
 /// has a neighbour): the sampling spacing of a cloud, the scale of its class tolerances as the

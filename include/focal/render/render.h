@@ -157,9 +157,6 @@ struct FieldPictureOptions {
   std::optional<FocalMeshes> focal_meshes;
   /// Multisampling (samples per pixel, clamped to what the driver offers; 1 or less for none).
   int samples = 4;
-  /// Threads of the checks on the arrays: 0 for FOCAL_NUM_THREADS if set, else all hardware
-  /// threads.
-  int threads = 0;
 };
 
 /// A picture of a per-vertex scalar field on a mesh: Lambert shading under a headlight (ambient

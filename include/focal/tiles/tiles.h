@@ -30,8 +30,6 @@ namespace focal {
 struct TileOptions {
   /// Owned vertices per tile, at most (a tile also holds its halo). >= 1.
   int tile_vertices = 1 << 20;
-  /// 0: FOCAL_NUM_THREADS if set, else all hardware threads.
-  int threads = 0;
 };
 
 /// One tile: global ids, ascending.
@@ -78,7 +76,7 @@ struct TileEstimate {
 /// mesh (options_for_part is applied here). Rows of every tile vertex; those of its owned
 /// vertices are the whole mesh's.
 [[nodiscard]] TileEstimate estimate_tile(const TileMesh& tile, const MeshWideChoices& choices,
-                                         const EstimateOptions& options, int threads = 0);
+                                         const EstimateOptions& options);
 
 /// The recommended estimator's recommended_statistics of a tile's owned vertices (rows `owned`,
 /// whole-mesh ids `ids`, one per tile vertex), on the tile's normals prepared as the estimate
@@ -90,16 +88,14 @@ struct TileEstimate {
 /// closed components are oriented (prepare_normals), which a tile cannot decide.
 [[nodiscard]] RecommendedStatistics tile_statistics(
     const TileMesh& tile, const std::vector<int>& ids, const std::vector<int>& owned,
-    Eigen::Index whole_vertex_count, double mean_edge_length, const EstimateOptions& options,
-    int threads = 0);
+    Eigen::Index whole_vertex_count, double mean_edge_length, const EstimateOptions& options);
 
 /// Whether each id of `x` is one of `ascending` (ids >= 0, ascending): the set operations of a
 /// tile's halo rounds when the mesh is streamed from its file (python/focal/stream.py: which
 /// face records have a corner on the ring's frontier, which faces and vertices are new). A
-/// bitmap over the span of `ascending` (span / 8 bytes), looked up on `threads` threads.
+/// bitmap over the span of `ascending` (span / 8 bytes), looked up in parallel.
 /// \throw InvalidInput when `ascending` is not ascending or holds a negative id.
-[[nodiscard]] std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending,
-                                       int threads = 0);
+[[nodiscard]] std::vector<char> ids_in(std::span<const int> x, std::span<const int> ascending);
 
 /// The whole estimate, tile by tile in this process: the same bits as estimate(mesh, options)
 /// .curvature and .crease, with the memory of the largest tile in place of the whole mesh's.
@@ -197,8 +193,7 @@ struct TileGridBox {
 /// axis of zero extent: part 0; positions outside the box: the nearest part), the cell the Morton
 /// code of the parts (x in bit 0, y in bit 1, z in bit 2 of each triple); a row with a non-finite
 /// coordinate: the last cell, kTileGridCells - 1.
-[[nodiscard]] std::vector<std::int32_t> tile_grid_cells(PositionsRef P, const TileGridBox& box,
-                                                        int threads = 0);
+[[nodiscard]] std::vector<std::int32_t> tile_grid_cells(PositionsRef P, const TileGridBox& box);
 
 /// The tiles of the grid's cells.
 struct TileGrid {
@@ -216,7 +211,6 @@ struct TileGrid {
 /// The tile of each row of P: cell_tile[tile_grid_cells(P, box)].
 /// \throw InvalidInput when cell_tile has not kTileGridCells entries.
 [[nodiscard]] std::vector<std::int32_t> tile_grid_tiles(PositionsRef P, const TileGridBox& box,
-                                                        std::span<const std::int32_t> cell_tile,
-                                                        int threads = 0);
+                                                        std::span<const std::int32_t> cell_tile);
 
 }  // namespace focal

@@ -101,17 +101,15 @@ CurvatureResult cohen_steiner_morvan_2003(PositionsRef V, FacesRef F,
                                           const CurvatureOptions& options) {
   if (options.rings < 1)
     throw InvalidInput("CSM03: rings must be >= 1, got " + std::to_string(options.rings));
-  const PreparedMesh mesh =
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "CSM03");
+  const PreparedMesh mesh = detail::PreparedAccess::make(V, F, std::nullopt, {}, "CSM03");
   const EdgeTensors edges = edge_tensors(V, F);
   const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
   const detail::VertexFaces& inc = *incidence;
   const Neighbourhoods centres =
-      options.rings > 1 ? k_ring(*detail::one_ring(mesh), options.rings - 1, options.threads)
-                        : Neighbourhoods{};
+      options.rings > 1 ? k_ring(*detail::one_ring(mesh), options.rings - 1) : Neighbourhoods{};
   const detail::ClassTolerances tol = detail::class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult r = detail::undefined_result(V.rows(), options.threads);
-  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+  CurvatureResult r = detail::undefined_result(V.rows(), 0);
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     thread_local std::vector<int> faces;
     neighbourhood_faces(inc, centres, options.rings, static_cast<int>(i), faces);
     Eigen::Matrix3d T = Eigen::Matrix3d::Zero();

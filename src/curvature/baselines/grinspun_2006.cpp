@@ -71,16 +71,15 @@ Eigen::Matrix3d face_operator(PositionsRef V, FacesRef F, const focal::detail::V
 }  // namespace
 
 CurvatureResult grinspun_2006(PositionsRef V, FacesRef F, const CurvatureOptions& options) {
-  const PreparedMesh mesh = focal::detail::PreparedAccess::make(
-      V, F, std::nullopt, {.threads = options.threads}, "GGRZ06");
+  const PreparedMesh mesh = focal::detail::PreparedAccess::make(V, F, std::nullopt, {}, "GGRZ06");
   const auto incidence = focal::detail::incidence(mesh);
   const focal::detail::VertexFaces& inc = *incidence;
   std::vector<FaceFrame> frames(static_cast<std::size_t>(F.rows()));
-  focal::detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
+  focal::detail::parallel_for(F.rows(), 0, [&](std::int64_t f) {
     frames[static_cast<std::size_t>(f)] = face_frame(V, F, f);
   });
   std::vector<Eigen::Matrix3d> face_S(static_cast<std::size_t>(F.rows()));
-  focal::detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
+  focal::detail::parallel_for(F.rows(), 0, [&](std::int64_t f) {
     face_S[static_cast<std::size_t>(f)] =
         frames[static_cast<std::size_t>(f)].area > 0.0
             ? face_operator(V, F, inc, frames, static_cast<int>(f))
@@ -88,8 +87,8 @@ CurvatureResult grinspun_2006(PositionsRef V, FacesRef F, const CurvatureOptions
   });
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  focal::detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+  CurvatureResult result = focal::detail::undefined_result(V.rows(), 0);
+  focal::detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     double area = 0.0;
     for (int k = inc.begin(i); k < inc.end(i); ++k) {

@@ -167,7 +167,7 @@ CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d
   const PositionsRef& V = mesh.V();
   const FacesRef& F = mesh.F();
   std::vector<Measures> face(static_cast<std::size_t>(F.rows()));
-  focal::detail::parallel_for(F.rows(), options.threads, [&](std::int64_t f) {
+  focal::detail::parallel_for(F.rows(), 0, [&](std::int64_t f) {
     std::array<Eigen::Vector3d, 3> x, n;
     for (int c = 0; c < 3; ++c) {
       x[c] = V.row(F(f, c));
@@ -177,9 +177,9 @@ CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d
   });
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
+  CurvatureResult result = focal::detail::undefined_result(V.rows(), 0);
   const auto radius_of = [&](std::int64_t i) { return radius[i]; };
-  ball::for_each_ball(mesh, radius_of, max_rings, options.threads,
+  ball::for_each_ball(mesh, radius_of, max_rings, 0,
                       [&](std::int64_t i, const std::vector<int>& faces) {
                         const Eigen::Vector3d normal = u.row(i);
                         if (!(radius[i] > 0.0) || !normal.allFinite()) return;
@@ -193,8 +193,7 @@ CurvatureResult corrected_curvature(const PreparedMesh& mesh, const RowMatrixX3d
 
 CurvatureResult lachaud_2020(PositionsRef V, FacesRef F, std::optional<NormalsRef> N,
                              const BallOptions& ball, const CurvatureOptions& options) {
-  const PreparedMesh mesh =
-      focal::detail::PreparedAccess::make(V, F, N, {.threads = options.threads}, "LRTC20");
+  const PreparedMesh mesh = focal::detail::PreparedAccess::make(V, F, N, {}, "LRTC20");
   const double r = ball::radius(ball, 1.0, mesh.mean_edge_length(), "LRTC20");
   return detail::corrected_curvature(mesh, corrected_normals(mesh, N),
                                      Eigen::VectorXd::Constant(V.rows(), r), INT_MAX, options);

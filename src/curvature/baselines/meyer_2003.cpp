@@ -100,15 +100,13 @@ detail::Principal2 fit_directions(PositionsRef V, int i, const TangentFrame& fra
 }  // namespace
 
 CurvatureResult meyer_2003(PositionsRef V, FacesRef F, const CurvatureOptions& options) {
-  const PreparedMesh mesh =
-      detail::PreparedAccess::make(V, F, std::nullopt, {.threads = options.threads}, "MDSB03");
+  const PreparedMesh mesh = detail::PreparedAccess::make(V, F, std::nullopt, {}, "MDSB03");
   const std::shared_ptr<const detail::VertexFaces> incidence = detail::incidence(mesh);
   const detail::VertexFaces& inc = *incidence;
-  const std::vector<bool> boundary =
-      boundary_vertices(static_cast<int>(V.rows()), F, options.threads);
+  const std::vector<bool> boundary = boundary_vertices(static_cast<int>(V.rows()), F);
   const detail::ClassTolerances tol = detail::class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult r = detail::undefined_result(V.rows(), options.threads);
-  detail::parallel_for(V.rows(), options.threads, [&](std::int64_t i) {
+  CurvatureResult r = detail::undefined_result(V.rows(), 0);
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     thread_local std::vector<EdgeWeight> edges;
     edges.clear();
     VertexSums s;

@@ -130,14 +130,13 @@ std::optional<PatchCurvature> patch_curvature(const Moments& m, const Eigen::Vec
 
 CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball,
                           const CurvatureOptions& options) {
-  const PreparedMesh mesh = focal::detail::PreparedAccess::make(
-      V, F, std::nullopt, {.threads = options.threads}, "YLHP06");
+  const PreparedMesh mesh = focal::detail::PreparedAccess::make(V, F, std::nullopt, {}, "YLHP06");
   const double r = ball::radius(ball, 4.0, mesh.mean_edge_length(), "YLHP06");
   const auto incidence = focal::detail::incidence(mesh);
   const focal::detail::ClassTolerances tol =
       focal::detail::class_tolerances(options, mesh.mean_edge_length());
-  CurvatureResult result = focal::detail::undefined_result(V.rows(), options.threads);
-  ball::for_each_ball(mesh, r, options.threads, [&](std::int64_t i, const std::vector<int>& faces) {
+  CurvatureResult result = focal::detail::undefined_result(V.rows(), 0);
+  ball::for_each_ball(mesh, r, 0, [&](std::int64_t i, const std::vector<int>& faces) {
     const Moments m = ball_moments(V, F, faces, V.row(i), r);
     const Eigen::Vector3d orientation = area_normal(V, F, *incidence, i);
     if (!(m.area > 0.0) || !(r > 0.0) || !(orientation.norm() > 0.0)) return;
