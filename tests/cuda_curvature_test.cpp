@@ -105,7 +105,7 @@ double median(std::vector<double> v) {
 Comparison compare(const CurvatureResult& want, const CurvatureResult& got, double h,
                    const CurvatureOptions& o) {
   Comparison c;
-  const double zero = o.zero_tolerance / h;
+  const double zero = o.tolerances.zero / h;
   for (Eigen::Index i = 0; i < want.k1.size(); ++i) {
     EXPECT_EQ(got.rays_used[i], want.rays_used[i]) << "vertex " << i;
     EXPECT_EQ(got.rays_excluded[i], want.rays_excluded[i]) << "vertex " << i;
@@ -113,7 +113,7 @@ Comparison compare(const CurvatureResult& want, const CurvatureResult& got, doub
       ++c.class_mismatches;
       const double kappa = std::max(std::abs(want.k1[i]), std::abs(want.k2[i]));
       if (!std::isfinite(kappa) ||
-          !near_class_threshold(want.k1[i], want.k2[i], zero, o.umbilic_tolerance, 1e-5 * kappa)) {
+          !near_class_threshold(want.k1[i], want.k2[i], zero, o.tolerances.umbilic, 1e-5 * kappa)) {
         ++c.unexplained_class_mismatches;
       }
     }

@@ -151,7 +151,7 @@ TEST(Curvature, InvalidArgumentsThrow) {
   o.rings = 0;
   EXPECT_THROW((void)estimate_curvature(m.V, m.F, m.N, o), InvalidInput);
   o = {};
-  o.zero_tolerance = -1;
+  o.tolerances.zero = -1;
   EXPECT_THROW((void)estimate_curvature(m.V, m.F, m.N, o), InvalidInput);
 }
 
@@ -260,8 +260,8 @@ TEST_P(Accuracy, ErrorBoundedAndConverging) {
   RecordProperty("rms_coarse", text(coarse.rms));
   RecordProperty("rms_fine", text(fine.rms));
   RecordProperty("median_d1_angle_fine", text(fine.median_angle));
-  // The error as a fraction of the largest curvature (docs/notes/estimator-log.md quotes it for estimated
-  // normals on irregular meshes).
+  // The error as a fraction of the largest curvature (docs/notes/estimator-log.md quotes it for
+  // estimated normals on irregular meshes).
   RecordProperty("rms_over_kappa_coarse", text(coarse.rms / coarse.kappa));
   RecordProperty("rms_over_kappa_fine", text(fine.rms / fine.kappa));
   if (coarse.rms < 1e-12) {  // exact up to rounding (cylinder): nothing to converge

@@ -169,7 +169,7 @@ TEST(TriangleCurvature, TheLaneKernelIsTheSharedFormulaOnScalarsBitForBit) {
     const TriangleCurvatureResult t = triangle_curvature(m.V, m.F, m.N);
     std::vector<char> ok;
     const RowMatrixX3d unit = detail::unit_rows(m.N, ok);
-    const double zero = CurvatureOptions{}.zero_tolerance / mean_edge_length(m.V, m.F);
+    const double zero = CurvatureOptions{}.tolerances.zero / mean_edge_length(m.V, m.F);
     int undefined = 0;
     for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
       kernels::Vec3<double> p[3], n[3];
@@ -200,7 +200,7 @@ TEST(TriangleCurvature, TheLaneKernelIsTheSharedFormulaOnScalarsBitForBit) {
       ASSERT_TRUE(same_row(t.slit1, f, d.slit1) && same_row(t.slit2, f, d.slit2)) << f;
       ASSERT_TRUE(same_row(t.face_normal, f, e.frame.n)) << f;
       ASSERT_EQ(t.point_class[f],
-                kernels::classify(e.k1, e.k2, zero, CurvatureOptions{}.umbilic_tolerance))
+                kernels::classify(e.k1, e.k2, zero, CurvatureOptions{}.tolerances.umbilic))
           << f;
     }
     EXPECT_LT(undefined, m.F.rows() / 10);

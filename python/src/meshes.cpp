@@ -77,15 +77,14 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   p.levenberg_marquardt.initial_angles = nb::cast<int>(o["lm_initial_angles"]);
   p.levenberg_marquardt.max_iterations = nb::cast<int>(o["lm_max_iterations"]);
   p.levenberg_marquardt.tolerance = nb::cast<double>(o["lm_tolerance"]);
-  p.zero_tolerance = nb::cast<double>(o["zero_tolerance"]);
-  p.umbilic_tolerance = nb::cast<double>(o["umbilic_tolerance"]);
+  p.tolerances.zero = nb::cast<double>(o["zero_tolerance"]);
+  p.tolerances.umbilic = nb::cast<double>(o["umbilic_tolerance"]);
   focal::RecommendedOptions& r = e.recommended;
   r.noise_for_two_rings = nb::cast<double>(o["noise_for_two_rings"]);
   r.noise_for_three_rings = nb::cast<double>(o["noise_for_three_rings"]);
   r.file_agreement = nb::cast<double>(o["file_agreement"]);
   r.outlier_disagreement = nb::cast<double>(o["outlier_disagreement"]);
-  r.zero_tolerance = p.zero_tolerance;
-  r.umbilic_tolerance = p.umbilic_tolerance;
+  r.tolerances = p.tolerances;
   e.execution.threads = nb::cast<int>(o["threads"]);
   if (o.contains("device")) {
     e.device = parse_enum(nb::cast<std::string>(o["device"]), "device", devices);
@@ -93,8 +92,7 @@ focal::EstimateOptions estimate_options(const nb::dict& o) {
   if (o.contains("tile_vertices")) e.tile_vertices = nb::cast<int>(o["tile_vertices"]);
   if (o.contains("cloud")) {
     e.cloud = cloud_options_from(nb::cast<nb::dict>(o["cloud"]));
-    e.cloud.zero_tolerance = p.zero_tolerance;
-    e.cloud.umbilic_tolerance = p.umbilic_tolerance;
+    e.cloud.tolerances = p.tolerances;
   }
   return e;
 }
@@ -129,10 +127,10 @@ nb::dict default_options() {
   d["lm_initial_angles"] = p.levenberg_marquardt.initial_angles;
   d["lm_max_iterations"] = p.levenberg_marquardt.max_iterations;
   d["lm_tolerance"] = p.levenberg_marquardt.tolerance;
-  d["zero_tolerance"] = p.zero_tolerance;
-  d["umbilic_tolerance"] = p.umbilic_tolerance;
-  d["recommended_zero_tolerance"] = r.zero_tolerance;
-  d["recommended_umbilic_tolerance"] = r.umbilic_tolerance;
+  d["zero_tolerance"] = p.tolerances.zero;
+  d["umbilic_tolerance"] = p.tolerances.umbilic;
+  d["recommended_zero_tolerance"] = r.tolerances.zero;
+  d["recommended_umbilic_tolerance"] = r.tolerances.umbilic;
   d["noise_for_two_rings"] = r.noise_for_two_rings;
   d["noise_for_three_rings"] = r.noise_for_three_rings;
   d["file_agreement"] = r.file_agreement;

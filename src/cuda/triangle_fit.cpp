@@ -32,8 +32,8 @@ TriangleInput triangle_input(PositionsRef V, FacesRef F, NormalsRef N,
     for (int c = 0; c < 3; ++c) in.F[3 * f + c] = F(f, c);
   }
   // The thresholds of triangle_curvature (detail::class_tolerances), rounded to float.
-  in.zero_tolerance = static_cast<float>(options.zero_tolerance / mean_edge_length(V, F));
-  in.umbilic_tolerance = static_cast<float>(options.umbilic_tolerance);
+  in.zero_tolerance = static_cast<float>(options.tolerances.zero / mean_edge_length(V, F));
+  in.umbilic_tolerance = static_cast<float>(options.tolerances.umbilic);
   return in;
 }
 

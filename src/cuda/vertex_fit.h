@@ -37,8 +37,8 @@ inline void validate_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N,
   }
   if (o.rings < 1) throw InvalidInput(who + "rings must be >= 1, got " + std::to_string(o.rings));
   if (!(o.gaussian_width >= 0.0)) throw InvalidInput(who + "gaussian_width must be >= 0");
-  if (!(o.zero_tolerance >= 0.0)) throw InvalidInput(who + "zero_tolerance must be >= 0");
-  if (!(o.umbilic_tolerance >= 0.0)) throw InvalidInput(who + "umbilic_tolerance must be >= 0");
+  if (!(o.tolerances.zero >= 0.0)) throw InvalidInput(who + "zero_tolerance must be >= 0");
+  if (!(o.tolerances.umbilic >= 0.0)) throw InvalidInput(who + "umbilic_tolerance must be >= 0");
   if (N.rows() != V.rows()) {
     throw InvalidInput(who + std::to_string(N.rows()) + " normals for " + std::to_string(V.rows()) +
                        " vertices (normals are required; estimate them with vertex_normals)");
@@ -121,8 +121,8 @@ PreparedVertexFit<T> prepare_vertex_fit(PositionsRef V, FacesRef F, NormalsRef N
   q.gaussian = options.weighting == RayWeighting::gaussian;
   q.inverse_two_width_squared = static_cast<T>(0.5 / (width * width) * unit * unit);
   q.curvature_unit = static_cast<T>(1.0 / unit);
-  q.zero_tolerance = static_cast<T>(options.zero_tolerance / h);
-  q.umbilic_tolerance = static_cast<T>(options.umbilic_tolerance);
+  q.zero_tolerance = static_cast<T>(options.tolerances.zero / h);
+  q.umbilic_tolerance = static_cast<T>(options.tolerances.umbilic);
   q.min_relative_determinant = static_cast<T>(min_relative_determinant<T>());
   return p;
 }

@@ -274,8 +274,9 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   if (out.file_normals_used) out.N = *N;
   // The corrected step (step 5) on clean positions, and only where no point was left out as an
-  // outlier: outliers too near the surface to be flagged (docs/notes/points-log.md, "Outliers") enter
-  // the local triangulations, and the corrected measures, unlike the robust fit, take them in.
+  // outlier: outliers too near the surface to be flagged (docs/notes/points-log.md, "Outliers")
+  // enter the local triangulations, and the corrected measures, unlike the robust fit, take them
+  // in.
   out.corrected = out.k == default_cloud_neighbours &&
                   std::find(out.outlier.begin(), out.outlier.end(), 1) == out.outlier.end();
   return out;
@@ -312,8 +313,7 @@ void fit_plan(PositionsRef V, CloudCurvature& out, const CloudOptions& options, 
   CurvatureOptions fit;
   fit.solver = options.solver;
   fit.levenberg_marquardt = options.levenberg_marquardt;
-  fit.zero_tolerance = options.zero_tolerance;
-  fit.umbilic_tolerance = options.umbilic_tolerance;
+  fit.tolerances = options.tolerances;
   detail::validate_curvature_options(fit);
   // A spacing of 0 (a single point, or all duplicates) would make every |k| "not zero"; 1 keeps
   // the tolerance finite, and such points are undefined anyway (fewer than two rays).
@@ -391,8 +391,8 @@ CloudCurvature plan_on_copy(PositionsRef V, std::optional<NormalsRef> N, Positio
 /// cloud's rows. The lists, the tests and the fit read each point's neighbours' rows: on a cloud
 /// whose rows come in no spatial order (scanners' and generators' files often do) each read
 /// is a cache miss, on the copy mostly a hit.
-/// The same bits (docs/notes/points-log.md, "The whole cloud in Morton order"): every list is that of the
-/// cloud's own order renamed, in the same order (ties by the cloud's rows,
+/// The same bits (docs/notes/points-log.md, "The whole cloud in Morton order"): every list is that
+/// of the cloud's own order renamed, in the same order (ties by the cloud's rows,
 /// detail::nearest_neighbours); mean_spacing sums, and the jets sum each neighbourhood, in the
 /// cloud's row order; the MST runs over the cloud in its own order (adaptive_plan's copy_of);
 /// every other step reads a point's own and its list's rows only.

@@ -30,8 +30,8 @@ void detail::validate_curvature_options(const CurvatureOptions& o) {
   if (o.rings < 1)
     throw InvalidInput("curvature: rings must be >= 1, got " + std::to_string(o.rings));
   if (!(o.gaussian_width >= 0.0)) throw InvalidInput("curvature: gaussian_width must be >= 0");
-  if (!(o.zero_tolerance >= 0.0)) throw InvalidInput("curvature: zero_tolerance must be >= 0");
-  if (!(o.umbilic_tolerance >= 0.0))
+  if (!(o.tolerances.zero >= 0.0)) throw InvalidInput("curvature: zero_tolerance must be >= 0");
+  if (!(o.tolerances.umbilic >= 0.0))
     throw InvalidInput("curvature: umbilic_tolerance must be >= 0");
 }
 

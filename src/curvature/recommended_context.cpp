@@ -27,8 +27,8 @@ void validate_options(const RecommendedOptions& o, const char* what) {
   non_negative(o.noise_for_three_rings, "noise_for_three_rings");
   non_negative(o.file_agreement, "file_agreement");
   non_negative(o.outlier_disagreement, "outlier_disagreement");
-  non_negative(o.zero_tolerance, "zero_tolerance");
-  non_negative(o.umbilic_tolerance, "umbilic_tolerance");
+  non_negative(o.tolerances.zero, "zero_tolerance");
+  non_negative(o.tolerances.umbilic, "umbilic_tolerance");
   non_negative(o.crease_angle, "crease_angle");
 }
 
@@ -40,8 +40,7 @@ Context make_context(const PreparedMesh& mesh, const RecommendedOptions& options
 
 CurvatureOptions paper_options(const Context& c) {
   CurvatureOptions o;
-  o.zero_tolerance = c.options.zero_tolerance;
-  o.umbilic_tolerance = c.options.umbilic_tolerance;
+  o.tolerances = c.options.tolerances;
   return o;
 }
 

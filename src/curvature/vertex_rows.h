@@ -46,7 +46,7 @@ struct ClassTolerances {
 };
 
 inline ClassTolerances class_tolerances(const CurvatureOptions& options, double edge_length) {
-  return {options.zero_tolerance / edge_length, options.umbilic_tolerance};
+  return {options.tolerances.zero / edge_length, options.tolerances.umbilic};
 }
 
 /// Stores one vertex's principal curvatures and directions (2D in `frame`).

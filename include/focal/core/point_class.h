@@ -22,10 +22,20 @@ enum class PointClass : std::uint8_t {
 /// Lower-case name of a class (`elliptic`, ..., `undefined`).
 [[nodiscard]] std::string_view class_name(PointClass c);
 
-/// Default of CurvatureOptions::zero_tolerance (and of jet_curvature's classes): |k| x (mean
-/// edge length) at or below it counts as zero, a curvature radius over 1000 edge lengths.
+/// Default of Tolerances::zero (and of jet_curvature's classes): |k| x (mean edge length) at or
+/// below it counts as zero, a curvature radius over 1000 edge lengths.
 inline constexpr double default_zero_tolerance = 1e-3;
-/// Default of CurvatureOptions::umbilic_tolerance: k1 - k2 <= 1e-2 max(|k1|, |k2|) is umbilic.
+/// Default of Tolerances::umbilic: k1 - k2 <= 1e-2 max(|k1|, |k2|) is umbilic.
 inline constexpr double default_umbilic_tolerance = 1e-2;
+
+/// The tolerances of the classes, one struct shared by every estimator's options
+/// (CurvatureOptions, RecommendedOptions, CloudOptions).
+struct Tolerances {
+  /// A principal curvature counts as zero when |k| x (mean edge length, or a cloud's mean
+  /// spacing) <= zero: scale-free, so the classes do not depend on the units of the input.
+  double zero = default_zero_tolerance;
+  /// k1 - k2 <= umbilic x max(|k1|, |k2|) is umbilic.
+  double umbilic = default_umbilic_tolerance;
+};
 
 }  // namespace focal

@@ -21,7 +21,7 @@ namespace focal::baselines {
 /// (2 pi at interior vertices, pi on the boundary), k1,2 = H +- sqrt(max(H^2 - K, 0)), and the
 /// principal directions from their least-squares fit of a curvature tensor with trace 2H to the
 /// normal curvatures 2 (x_i - x_j).n / |x_i - x_j|^2 of the edges, weighted by each edge's share
-/// of the Voronoi area. Uses options.zero_tolerance and umbilic_tolerance.
+/// of the Voronoi area. Uses options.tolerances.
 /// \throw InvalidInput when F indexes outside V.
 [[nodiscard]] CurvatureResult meyer_2003(PositionsRef V, FacesRef F,
                                          const CurvatureOptions& options = {});
@@ -32,7 +32,7 @@ namespace focal::baselines {
 /// faces), beta(e) the signed dihedral angle (positive on convex edges). The eigenvector of T
 /// closest to the vertex normal is dropped; the other two eigenvalues are the principal
 /// curvatures, each belonging to the other's eigenvector (the normal cycle's tensor is rotated
-/// by 90 degrees). Uses options.rings, zero_tolerance and umbilic_tolerance.
+/// by 90 degrees). Uses options.rings and options.tolerances.
 /// \throw InvalidInput when F indexes outside V or options.rings < 1.
 [[nodiscard]] CurvatureResult cohen_steiner_morvan_2003(PositionsRef V, FacesRef F,
                                                         const CurvatureOptions& options = {});
@@ -59,7 +59,7 @@ struct BallOptions {
 /// \param N #V x 3 outward normals (normalised per row), or std::nullopt for Max's (1999)
 ///        face-weighted normals.
 /// Ball: default radius 1 mean edge length (docs/METHOD.md, "Baselines"). Uses
-/// options.zero_tolerance and umbilic_tolerance.
+/// options.tolerances.
 /// \throw InvalidInput when F indexes outside V, N has not #V rows, or the radius is negative or
 /// not finite.
 [[nodiscard]] CurvatureResult lachaud_2020(PositionsRef V, FacesRef F,
@@ -78,7 +78,7 @@ struct BallOptions {
 /// tangent eigenvector of C with the smaller eigenvalue. Error O(r^2) from the truncated
 /// expansion plus O(h^2 / r^2) from the discretisation (h the edge length). Positions only.
 /// Ball: default radius 4 mean edge lengths (docs/METHOD.md, "Baselines"). Uses
-/// options.zero_tolerance and umbilic_tolerance.
+/// options.tolerances.
 /// \throw InvalidInput when F indexes outside V or the radius is negative or not finite.
 [[nodiscard]] CurvatureResult yang_2006(PositionsRef V, FacesRef F, const BallOptions& ball = {},
                                         const CurvatureOptions& options = {});
@@ -91,7 +91,7 @@ struct BallOptions {
 /// interpolated from the edge midpoints (positive on a sphere with outward normals). A vertex
 /// averages the operators of its incident faces by area, each rotated by the smallest rotation
 /// taking its face normal to the area-weighted vertex normal. Positions only. Uses
-/// options.zero_tolerance and umbilic_tolerance.
+/// options.tolerances.
 /// \throw InvalidInput when F indexes outside V.
 [[nodiscard]] CurvatureResult grinspun_2006(PositionsRef V, FacesRef F,
                                             const CurvatureOptions& options = {});

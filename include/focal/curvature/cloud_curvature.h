@@ -91,8 +91,9 @@ struct CloudOptions {
   CloudNormalOptions normals{};
   Solver solver = Solver::closed_form;
   LevenbergMarquardtOptions levenberg_marquardt{};
-  double zero_tolerance = default_zero_tolerance;        ///< x mean spacing; see CurvatureOptions
-  double umbilic_tolerance = default_umbilic_tolerance;  ///< see CurvatureOptions
+  /// The classes' tolerances (core/point_class.h); the zero tolerance in units of the cloud's
+  /// mean spacing.
+  Tolerances tolerances{};
   /// Points whose mean distance to their 16 nearest exceeds this many times their neighbours'
   /// median of the same are outliers, left out (points/neighbours.h, outlier_points); 0 keeps
   /// every point. See default_outlier_ratio.

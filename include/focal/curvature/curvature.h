@@ -43,12 +43,8 @@ struct CurvatureOptions {
   /// Width s of the Gaussian weights; 0 = the mesh's mean edge length times `rings`.
   double gaussian_width = 0.0;
   LevenbergMarquardtOptions levenberg_marquardt;
-  /// A principal curvature counts as zero for the classification when |k| x (mean edge length)
-  /// <= zero_tolerance: scale-free, so results do not depend on the units of the mesh. At the
-  /// default a curvature radius over 1000 edge lengths is "flat" in that direction.
-  double zero_tolerance = default_zero_tolerance;  // 1e-3 (core/point_class.h)
-  /// k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
-  double umbilic_tolerance = default_umbilic_tolerance;  // 1e-2
+  /// The classes' tolerances (core/point_class.h).
+  Tolerances tolerances{};
 };
 
 /// Estimates the curvature fields of a triangle mesh from its vertex normals: the paper's method.

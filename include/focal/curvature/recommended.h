@@ -75,10 +75,8 @@ struct RecommendedOptions {
   /// 60 degrees: above the 46 degrees that faces of the coarsest suite meshes (spacing 0.8 /
   /// max |curvature|) turn between neighbours on smooth surfaces.
   double crease_angle = 1.0471975511965976;  // 60 degrees
-  /// Classes, as CurvatureOptions: |k| x mean edge length <= zero_tolerance is zero ...
-  double zero_tolerance = default_zero_tolerance;
-  /// ... and k1 - k2 <= umbilic_tolerance * max(|k1|, |k2|) is umbilic.
-  double umbilic_tolerance = default_umbilic_tolerance;
+  /// The classes' tolerances (core/point_class.h).
+  Tolerances tolerances{};
   /// The per-mesh choices, when given, instead of measuring them on this mesh: a tile takes
   /// recommended_mesh_wide() of the whole mesh (with PrepareOptions::mean_edge_length, the scale
   /// they are measured in).

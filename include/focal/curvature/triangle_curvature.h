@@ -50,7 +50,7 @@ struct TriangleFields {
 /// (the same values in the fields it fills). Faces with zero area in the ray frame (C = 0), a
 /// vertex normal outside the face normal's hemisphere or non-finite input are `undefined` with
 /// NaN values. Each face's row is written once, by the thread that computes it. Reads
-/// options.zero_tolerance and umbilic_tolerance.
+/// options.tolerances.
 /// \throw InvalidInput when the mesh has no normals.
 [[nodiscard]] TriangleCurvatureResult triangle_curvature(const PreparedMesh& mesh,
                                                          const CurvatureOptions& options = {},
