@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import focal
+from test_clouds import sphere_points
 
 
 def same(a, b):
@@ -14,15 +15,8 @@ def same(a, b):
     return a.shape == b.shape and bool(np.all((a == b) | (np.isnan(a) & np.isnan(b))))
 
 
-def sphere_points(n=3000, radius=2.0, seed=4):
-    rng = np.random.default_rng(seed)
-    N = rng.normal(size=(n, 3))
-    N /= np.linalg.norm(N, axis=1, keepdims=True)
-    return radius * N, N
-
-
 def test_a_cloud_is_the_cloud_estimate_with_the_command_lines_default():
-    P, _ = sphere_points()
+    P, _ = sphere_points(n=3000, seed=4)
     c = focal.curvature(P)  # F None: a point cloud, normals estimated
     # k=0 is the library's adaptive default in both calls: the same fit, bit for bit.
     d = focal.cloud_curvature(P, k=0)
