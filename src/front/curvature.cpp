@@ -194,7 +194,7 @@ Estimate device_estimate(const PreparedMesh& mesh, PreparedNormals normals,
   }
   Estimate e;
   e.normals_report = normals.report;
-  const RowMatrixX3i& F = normals.F ? *normals.F : RowMatrixX3i(mesh.F());
+  const FacesRef F = normals.F ? FacesRef(*normals.F) : mesh.F();
   if (normals.N) {
     e.curvature = estimate_curvature_cuda(mesh.V(), F, *normals.N, o.paper);
   } else {
