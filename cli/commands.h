@@ -12,6 +12,7 @@ void add_generate_command(CLI::App& app, const Log& log);
 void add_curvature_command(CLI::App& app, const Log& log);
 void add_focal_mesh_command(CLI::App& app, const Log& log);
 void add_normals_command(CLI::App& app, const Log& log);
+void add_smooth_command(CLI::App& app, const Log& log);
 void add_eval_command(CLI::App& app, const Log& log);
 void add_render_command(CLI::App& app, const Log& log);
 void add_devices_command(CLI::App& app, const Log& log);

@@ -32,6 +32,7 @@ int run(int argc, char** argv) {
   focal::cli::add_curvature_command(app, log);
   focal::cli::add_focal_mesh_command(app, log);
   focal::cli::add_normals_command(app, log);
+  focal::cli::add_smooth_command(app, log);
   focal::cli::add_eval_command(app, log);
   focal::cli::add_render_command(app, log);
   focal::cli::add_devices_command(app, log);
@@ -44,6 +45,7 @@ int run(int argc, char** argv) {
       "  focal focal-mesh mesh.ply -o prefix   # prefix.focal1.ply, prefix.focal2.ply\n"
       "  focal curvature scan.xyz -o fields.csv --k 16   # point clouds (no faces) too\n"
       "  focal normals scan.xyz -o scan-normals.ply      # estimated, oriented normals\n"
+      "  focal smooth scan.ply -o scan-smooth.ply        # denoised onto the fitted surface\n"
       "  focal eval --markdown eval.md         # every estimator against analytic truth\n"
       "  focal render mesh.ply -o mesh-H.png --field H   # a picture of H\n"
       "  focal devices                      # the GPUs the CUDA backend can use\n"
@@ -62,7 +64,7 @@ int run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr,
                  "Error: %s\nUsage: focal [-v] "
-                 "info|generate|curvature|focal-mesh|normals|eval|render|devices ... "
+                 "info|generate|curvature|focal-mesh|normals|smooth|eval|render|devices ... "
                  "(see focal -h)\n",
                  focal::cli::one_line(e.what()).c_str());
     return kUsageError;

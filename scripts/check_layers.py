@@ -13,7 +13,7 @@ import re
 import sys
 
 # Lowest first: a folder may include itself and the folders before it.
-LAYERS = ["core", "kernels", "io", "mesh", "points", "normals", "curvature", "tiles", "cuda",
+LAYERS = ["core", "kernels", "io", "mesh", "points", "normals", "curvature", "smoothing", "tiles", "cuda",
           "image_space", "front", "surfaces", "evaluation", "render"]
 
 # The core library's folders, the first of LAYERS; the rest are libraries of their own on top of

@@ -29,6 +29,7 @@
 #include "focal/curvature/focal_mesh.h"
 #include "focal/curvature/cloud_curvature.h"
 #include "focal/curvature/baselines.h"
+#include "focal/smoothing/smooth.h"
 #include "focal/tiles/tiles.h"
 #include "focal/cuda/device.h"
 #include "focal/cuda/curvature.h"

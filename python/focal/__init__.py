@@ -86,3 +86,8 @@ __all__ = [
 
 # Point clouds (focal._clouds, docs/POINTS.md).
 __all__ += ["cloud_curvature", "cloud_normals"]
+
+# Denoising (focal._smoothing, docs/SMOOTH.md).
+from ._smoothing import Smoothed, smooth  # noqa: E402
+
+__all__ += ["Smoothed", "smooth"]

@@ -25,6 +25,7 @@ void bind_image_space(nb::module_& m);
 void bind_tiles(nb::module_& m);
 void bind_clouds(nb::module_& m);
 void bind_streaming(nb::module_& m);
+void bind_smoothing(nb::module_& m);
 }  // namespace focal_python
 
 namespace {
@@ -68,6 +69,7 @@ NB_MODULE(_focal_ext, m) {
   focal_python::bind_render(m);
   focal_python::bind_image_space(m);
   focal_python::bind_tiles(m);
+  focal_python::bind_smoothing(m);
   focal_python::bind_clouds(m);
   focal_python::bind_streaming(m);
 }

@@ -1,0 +1,392 @@
+// focal::smooth (focal/smoothing/smooth.h): passes of robust local surface fits
+// (smoothing/surface_fit.h) over mesh rings or cloud neighbours, kept while the measured noise
+// falls.
+#include "focal/smoothing/smooth.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/parallel.h"
+#include "focal/core/error.h"
+#include "focal/curvature/recommended.h"
+#include "focal/mesh/neighbourhood.h"
+#include "focal/normals/cloud_normals.h"
+#include "focal/points/neighbours.h"
+#include "mesh/prepared_access.h"
+#include "mesh/topology.h"
+#include "normals/jet_points.h"
+#include "normals/vertex_normals_from.h"
+#include "smoothing/creases.h"
+#include "smoothing/surface_fit.h"
+
+namespace focal {
+namespace {
+
+using detail::smoothing::FitScratch;
+using detail::smoothing::LocalSurface;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Cloud neighbours of a fit on clean clouds, and above kCloudNoisyNeighbours' noise.
+constexpr int kCloudNeighbours = 16;
+constexpr int kCloudNoisyNeighbours = 64;
+/// Cloud position noise (median residual / mean spacing) above which fits take
+/// kCloudNoisyNeighbours (the cloud default's threshold, docs/METHOD.md).
+constexpr double kCloudNoisy = 0.03;
+/// Mesh rings of a fit where the recommended plan keeps the 1-ring (clean or slightly noisy):
+/// a quadric over 2 rings (about 19 points) averages the noise, 1 ring (7) too few.
+constexpr int kCleanRings = 2;
+/// No point is an outlier of a fit within this many mean edge lengths of it (reject_far_points'
+/// floor): clean surfaces' truncation residuals are far below it (O(h^3) relative), a spike of
+/// the evaluations is 2 edges.
+constexpr double kOutlierFloor = 0.05;
+
+/// A point lies within the noise of a side's surface: within this many of its fit's residuals.
+constexpr double kOnSideResiduals = 1.5;
+
+/// A crease point's move onto its sides' planes is at most this many of their fits' residuals
+/// (the noise: uniform noise of amplitude a has an RMS of a / sqrt(3), and moves up to a).
+constexpr double kMaxCreaseMove = 4.0;
+
+/// Where each point's neighbourhood comes from: a mesh's rings, or a cloud's lists.
+struct Neighbours {
+  const Neighbourhoods* one_ring = nullptr;
+  int rings = 0;
+  const Neighbourhoods* lists = nullptr;
+  bool oriented = true;  ///< frame normals on one side (meshes); clouds compare lines
+  /// The input's normals (Max's, or the cloud's), which group a crease's sides in every pass:
+  /// the fitted normals of a pass that rounded a crease would round it further in the next.
+  const RowMatrixX3d* sides_of = nullptr;
+};
+
+struct Scratch {
+  std::vector<std::uint64_t> in_ring;
+  std::vector<int> ring, side[detail::smoothing::kMaxSides];
+  std::vector<Eigen::Vector3d> normals;  ///< crease_sides' scratch
+  FitScratch fit;
+};
+
+void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
+  if (nb.one_ring) {
+    detail::jets::gather_ring(*nb.one_ring, i, nb.rings, s.in_ring, nullptr, s.ring);
+  } else {
+    s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
+  }
+}
+
+/// One pass: every point's surface, in the frame of its row of `frames`.
+struct Pass {
+  RowMatrixX3d V, N;
+  Eigen::VectorXd residual;
+  std::vector<char> outlier;  ///< the point itself lay far off its surface
+  VectorXu8 crease;           ///< on several sides of a crease
+  int crease_points = 0, unfitted = 0;
+};
+
+/// The surface of point i: over its whole neighbourhood; or, where its neighbours' normals fall
+/// into sides of a crease (keep_creases), each side's surface, the point moved onto the one it
+/// lies on, or onto the planes of all it lies on (the crease line, a corner). A point lies on
+/// the sides its nearest neighbours are members of. Returns whether it is on several sides.
+bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
+                const SmoothOptions& o, double floor, int i, Scratch& s, LocalSurface& out) {
+  using namespace detail::smoothing;
+  neighbourhood_of(nb, i, s);
+  Eigen::Vector3d mean[kMaxSides];
+  const int sides = o.keep_creases && nb.sides_of->row(i).allFinite()
+                        ? crease_sides(*nb.sides_of, i, s.ring, std::cos(o.crease_angle),
+                                       nb.oriented, s.side, mean, s.normals)
+                        : 0;
+  if (sides < 2) {
+    const bool one = sides == 1;
+    out = fit_local_surface(
+        V, i, one ? mean[0] : Eigen::Vector3d(frames.row(i).transpose()), one ? s.side[0] : s.ring,
+        one ? side_degree(s.side[0].size(), o.degree) : o.degree, o.robust, floor, s.fit);
+    return false;
+  }
+  const Eigen::Vector3d ni = nb.sides_of->row(i).transpose();
+  // The sides the point lies on: those its nearest neighbours (1-ring) are members of.
+  int nearest = 0;
+  for (int k = 1; k < sides; ++k) {
+    if (std::abs(ni.dot(mean[k])) > std::abs(ni.dot(mean[nearest]))) nearest = k;
+  }
+  const int* near_begin = nb.one_ring ? nb.one_ring->begin(i) : nb.lists->begin(i);
+  const int* near_end =
+      nb.one_ring ? nb.one_ring->end(i) : std::min(nb.lists->end(i), near_begin + kSideNeighbours);
+  // ... and whose mean normal its own normal is within 3/4 of the sides' widest angle of (a
+  // point beside the crease has a neighbour on the crease that may have been counted to the
+  // other side, but its own normal is that of its side).
+  double widest = 1.0;
+  for (int a = 0; a < sides; ++a) {
+    for (int b = a + 1; b < sides; ++b) widest = std::min(widest, mean[a].dot(mean[b]));
+  }
+  const double cos_on = std::cos(0.75 * std::acos(std::clamp(widest, -1.0, 1.0)));
+  LocalSurface fit[kMaxSides];
+  const LocalSurface* on[kMaxSides];
+  int count = 0;
+  for (int k = 0; k < sides; ++k) {
+    const auto& members = s.side[k];
+    bool meets = false;
+    for (const int* j = near_begin; j != near_end && !meets; ++j) {
+      meets = std::binary_search(members.begin(), members.end(), *j);
+    }
+    if (!meets) continue;
+    fit[k] = fit_local_surface(V, i, mean[k], members, side_degree(members.size(), o.degree),
+                               o.robust, floor, s.fit);
+    // A noisy own normal may lean to one side: the point is on the other too when it lies
+    // within the noise of that side's surface.
+    const double along = nb.oriented ? ni.dot(mean[k]) : std::abs(ni.dot(mean[k]));
+    const bool close = std::abs(fit[k].height) <= kOnSideResiduals * fit[k].residual;
+    if (fit[k].ok && (along >= cos_on || close)) on[count++] = &fit[k];
+  }
+  if (count < 2) {
+    // One side, or none met (only crease points around): the side of the point's own normal.
+    const int k = count == 1 ? static_cast<int>(on[0] - fit) : nearest;
+    out = count == 1
+              ? fit[k]
+              : fit_local_surface(V, i, mean[k], s.side[k], side_degree(s.side[k].size(), o.degree),
+                                  o.robust, floor, s.fit);
+    return false;
+  }
+  // A point on a crease moves onto the sides' planes, as far as its noise lets it: a move
+  // beyond kMaxCreaseMove residuals (a side's surface extrapolated, or sides met by mistake)
+  // takes the side of its own normal instead.
+  const Eigen::Vector3d p = V.row(i).transpose();
+  const Eigen::Vector3d moved = onto_planes(p, on, count);
+  double residual = 0.0;
+  for (int k = 0; k < count; ++k) residual = std::max(residual, on[k]->residual);
+  if (!((moved - p).norm() <= std::max(kMaxCreaseMove * residual, floor))) {
+    out = fit_local_surface(V, i, mean[nearest], s.side[nearest],
+                            side_degree(s.side[nearest].size(), o.degree), o.robust, floor, s.fit);
+    return false;
+  }
+  out = *on[0];
+  out.point = moved;
+  out.residual = residual;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  out.centre_rejected = true;
+  for (int k = 0; k < count; ++k) {
+    normal += on[k]->normal;
+    out.centre_rejected = out.centre_rejected && on[k]->centre_rejected;
+  }
+  out.normal = normal.normalized();
+  out.ok = out.point.allFinite() && out.normal.allFinite();
+  return true;
+}
+
+Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
+              const SmoothOptions& o, double scale) {
+  const double floor = kOutlierFloor * scale;
+  const Eigen::Index n = V.rows();
+  Pass p;
+  p.V.resize(n, 3);
+  p.N.resize(n, 3);
+  p.residual.resize(n);
+  p.outlier.assign(static_cast<std::size_t>(n), 0);
+  p.crease = VectorXu8::Zero(n);
+  detail::PerThread<Scratch> scratch(0);
+  detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
+    Scratch& s = scratch.local();
+    for (std::int64_t k = begin; k < end; ++k) {
+      const int i = static_cast<int>(k);
+      LocalSurface f;
+      if (frames.row(i).allFinite() && V.row(i).allFinite()) {
+        p.crease[i] = surface_of(V, frames, nb, o, floor, i, s, f);
+      }
+      if (!f.ok) {
+        p.V.row(i) = V.row(i);
+        p.N.row(i).setConstant(kNaN);
+        p.residual[i] = kNaN;
+        continue;
+      }
+      p.V.row(i) = f.point.transpose();
+      p.N.row(i) = f.normal.transpose();
+      p.residual[i] = f.residual;
+      p.outlier[static_cast<std::size_t>(i)] = f.centre_rejected;
+    }
+  });
+  for (Eigen::Index i = 0; i < n; ++i) {
+    p.crease_points += p.crease[i];
+    p.unfitted += !std::isfinite(p.residual[i]);
+  }
+  return p;
+}
+
+double median_of(const Eigen::VectorXd& x) {
+  std::vector<double> v;
+  v.reserve(static_cast<std::size_t>(x.size()));
+  for (const double e : x) {
+    if (std::isfinite(e)) v.push_back(e);
+  }
+  if (v.empty()) return kNaN;
+  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), middle, v.end());
+  return *middle;
+}
+
+void validate(const SmoothOptions& o) {
+  const auto fail = [](const std::string& what) { throw InvalidInput("smooth: " + what); };
+  if (o.iterations < 0) fail("iterations must be >= 0, got " + std::to_string(o.iterations));
+  if (!(o.min_noise_fall > 0.0 && o.min_noise_fall <= 1.0))
+    fail("min_noise_fall must be in (0, 1]");
+  if (o.rings < 0) fail("rings must be >= 0, got " + std::to_string(o.rings));
+  if (o.neighbours < 0 || o.neighbours > kMaxNeighbourhoodSize)
+    fail("neighbours must be in [0, " + std::to_string(kMaxNeighbourhoodSize) + "]");
+  if (o.degree < 1 || o.degree > 4)
+    fail("degree must be in [1, 4], got " + std::to_string(o.degree));
+  if (!(o.crease_angle > 0.0 && o.crease_angle < 3.14159265358979))
+    fail("crease_angle must be in (0, pi) radians");
+}
+
+void check_cancel(const Execution& e, int pass) {
+  if (e.cancel != nullptr && e.cancel->load())
+    throw Cancelled("smooth: cancelled before pass " + std::to_string(pass + 1));
+}
+
+/// Turns each normal to the majority side of `reference` (rows compared where both are finite).
+void to_side_of(NormalsRef reference, RowMatrixX3d& N) {
+  std::int64_t along = 0, against = 0;
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    const double d = N.row(i).dot(reference.row(i));
+    along += d > 0.0;
+    against += d < 0.0;
+  }
+  if (against > along) N = -N;
+}
+
+/// The result of a pass as the smoothing's result.
+void keep(const Pass& p, SmoothResult& out) {
+  out.V = p.V;
+  out.N = p.N;
+  out.crease = p.crease;
+  out.crease_points = p.crease_points;
+  out.unfitted = p.unfitted;
+}
+
+/// The passes over `V` from `frames` (unit rows, NaN: not moved) with the neighbourhoods of `nb`,
+/// `scale` the mean edge length or spacing. Pass t fits P_t (measuring its noise r_t) and gives
+/// P_t+1 with its normals. Automatic stop: P_t is kept while r_t <= min_noise_fall x r_t-1; the
+/// first P_t that is not stops the passes with P_t-1 (P_0, the input, but for the first pass's
+/// outliers, which are moved whatever the noise).
+SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, const SmoothOptions& o,
+                 double scale, bool refine_frames) {
+  const Execution& e = current_execution();
+  SmoothResult out;
+  out.V = V;
+  out.crease = VectorXu8::Zero(V.rows());
+  const bool automatic = o.iterations == 0;
+  const int passes = automatic ? kMaxSmoothIterations + 1 : o.iterations;
+  if (refine_frames) {
+    // Noisy input: Max's normals tilt with the faces (beyond 45 degrees under noise of an edge),
+    // and a quadric over a tilted frame fits the surface badly; the first pass then runs in the
+    // frame of a first fit's normals (the recommended jets' second fit, recommended.h).
+    const Pass first = run_pass(V, frames, nb, o, scale);
+    for (Eigen::Index i = 0; i < V.rows(); ++i) {
+      if (first.N.row(i).allFinite()) frames.row(i) = first.N.row(i);
+    }
+  }
+  Pass next;  // the last pass: P_t+1 and its normals
+  for (int t = 0; t < passes; ++t) {
+    check_cancel(e, t);
+    if (e.progress) e.progress({"smooth", static_cast<double>(t) / passes});
+    Pass p = run_pass(t == 0 ? V : PositionsRef(next.V), frames, nb, o, scale);
+    const double noise = median_of(p.residual) / scale;
+    if (t == 0) {
+      out.N = p.N;
+      out.unfitted = p.unfitted;
+      for (const char c : p.outlier) out.outliers_moved += c;
+      if (automatic) {
+        // The outliers move at once; the rest once the next pass shows the noise fell.
+        for (Eigen::Index i = 0; i < V.rows(); ++i) {
+          if (p.outlier[static_cast<std::size_t>(i)]) out.V.row(i) = p.V.row(i);
+        }
+      }
+    } else if (automatic) {
+      if (!(noise <= o.min_noise_fall * out.noise.back())) break;
+      keep(next, out);  // P_t is kept
+      out.iterations = t;
+    }
+    out.noise.push_back(noise);
+    // Rows without a fit keep their frame (and are not moved) in the next pass.
+    for (Eigen::Index i = 0; i < V.rows(); ++i) {
+      if (p.N.row(i).allFinite()) frames.row(i) = p.N.row(i);
+    }
+    next = std::move(p);
+  }
+  if (!automatic) {
+    keep(next, out);
+    out.iterations = passes;
+  }
+  if (e.progress) e.progress({"smooth", 1.0});
+  return out;
+}
+
+/// Max's normals of the mesh's faces (unit; NaN at vertices in no face).
+RowMatrixX3d face_normals(const PreparedMesh& mesh) {
+  return detail::vertex_normals_from(mesh.V(), mesh.F(), *detail::incidence(mesh),
+                                     NormalWeighting::max, 0);
+}
+
+SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
+  const double h = mesh.mean_edge_length();
+  const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
+  const RecommendedPlan plan = recommended_plan(mesh.with_normals(std::nullopt));
+  const int rings = o.rings > 0 ? o.rings : plan.rings > 1 ? plan.jet_rings : kCleanRings;
+  Neighbours nb;
+  nb.one_ring = one.get();
+  nb.rings = rings;
+  RowMatrixX3d max = face_normals(mesh);
+  nb.sides_of = &max;
+  SmoothResult out = run(mesh.V(), max, nb, o, h, plan.jet_iterations > 1);
+  out.rings = rings;
+  if (const auto N = mesh.normals()) to_side_of(*N, out.N);
+  return out;
+}
+
+SmoothResult smooth_cloud(const PreparedMesh& cloud, const SmoothOptions& o) {
+  const PositionsRef& V = cloud.V();
+  int k = o.neighbours;
+  Neighbourhoods lists = nearest_neighbours(V, k > 0 ? k : kCloudNeighbours);
+  const double spacing = mean_spacing(V, lists);
+  RowMatrixX3d frames = pca_normals(V, lists);
+  orient_normals_mst(V, lists, frames);
+  Neighbours nb;
+  nb.lists = &lists;
+  nb.oriented = false;
+  const RowMatrixX3d input_frames = frames;
+  nb.sides_of = &input_frames;
+  if (k == 0) {
+    // The noise of the 16-neighbour fits decides the neighbourhood, as in the cloud default.
+    SmoothOptions measure = o;
+    measure.iterations = 1;
+    const Pass p = run_pass(V, frames, nb, measure, spacing);
+    k = median_of(p.residual) / spacing > kCloudNoisy ? kCloudNoisyNeighbours : kCloudNeighbours;
+    if (k != kCloudNeighbours) lists = nearest_neighbours(V, k);
+  }
+  SmoothResult out = run(V, std::move(frames), nb, o, spacing, false);
+  out.neighbours = k;
+  if (const auto N = cloud.normals()) to_side_of(*N, out.N);
+  return out;
+}
+
+}  // namespace
+
+SmoothResult smooth(const PreparedMesh& mesh, const SmoothOptions& options) {
+  const ExecutionScope scope(options.execution);
+  validate(options);
+  if (mesh.vertex_count() == 0) return {};
+  return mesh.face_count() == 0 ? smooth_cloud(mesh, options) : smooth_mesh(mesh, options);
+}
+
+SmoothResult smooth(const Mesh& mesh, const SmoothOptions& options) {
+  const ExecutionScope scope(options.execution);
+  validate(options);
+  return smooth(PreparedMesh(mesh), options);
+}
+
+}  // namespace focal

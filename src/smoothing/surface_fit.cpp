@@ -1,0 +1,233 @@
+// The robust local surface of smoothing/surface_fit.h.
+#include "smoothing/surface_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "kernels/eigen.h"
+#include "kernels/local_shape.h"
+
+namespace focal::detail::smoothing {
+namespace {
+
+using jets::coefficient_count;
+using jets::terms_stride;
+using kernels::eigen_of;
+
+/// The fitted height at scaled coordinates (x, y): sum c_k x^(t-b) y^b over the monomials
+/// by degree t, then by the power b of y (jet_fit.cpp's numbering).
+double height_at(const double* c, int degree, double x, double y) {
+  double xs[jets::kMaxDegree + 1], ys[jets::kMaxDegree + 1];
+  xs[0] = ys[0] = 1.0;
+  for (int t = 1; t <= degree; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
+  double height = 0.0;
+  int k = 0;
+  for (int t = 0; t <= degree; ++t) {
+    for (int b = 0; b <= t; ++b, ++k) height += c[k] * xs[t - b] * ys[b];
+  }
+  return height;
+}
+
+/// The least-squares fit of `degree` to `points` (one lane of the scalar kernel) into s.batch.c.
+/// False when the system is not well posed.
+bool fit_points(int degree, const jets::Points& points, FitScratch& s) {
+  jets::JetBatch& b = s.batch;
+  const int n = static_cast<int>(points.size());
+  b.points[0] = points.data();
+  b.count[0] = b.points_max = n;
+  s.terms.resize(static_cast<std::size_t>(n) * terms_stride(degree));
+  b.terms = s.terms.data();
+  jets::top_degree_kernel(std::nullopt, degree)(b);
+  return b.solved[0];
+}
+
+/// Each point's residual against the fit in s.batch.c into s.misfit (scaled units).
+void misfits(int degree, FitScratch& s) {
+  s.misfit.resize(s.points.size());
+  for (std::size_t p = 0; p < s.points.size(); ++p) {
+    const jets::Point& q = s.points[p];
+    s.misfit[p] = q.z - height_at(s.batch.c, degree, q.x, q.y);
+  }
+}
+
+/// Refits s.points flagged in s.keep; the residuals of all points against it into s.misfit.
+bool fit_kept(int degree, FitScratch& s) {
+  s.kept_points.clear();
+  for (std::size_t p = 0; p < s.points.size(); ++p) {
+    if (s.keep[p]) s.kept_points.push_back(s.points[p]);
+  }
+  // The origin (the point itself) may be gone: the fit is then of the others' surface.
+  if (!fit_points(degree, s.kept_points, s)) return false;
+  misfits(degree, s);
+  return true;
+}
+
+/// Whether a least-squares fit's residuals hint at outliers: one beyond kSuspectScales robust
+/// scales (and the floor). Gaussian residuals pass it in most fits; a point far off, or two
+/// that bend the fit towards them (masking each other), do not.
+bool suspect(const std::vector<double>& misfit, double floor) {
+  std::vector<double> magnitude(misfit.size());
+  double largest = 0.0;
+  for (std::size_t p = 0; p < misfit.size(); ++p) {
+    magnitude[p] = std::abs(misfit[p]);
+    largest = std::max(largest, magnitude[p]);
+  }
+  const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
+  std::nth_element(magnitude.begin(), middle, magnitude.end());
+  return largest > std::max(kSuspectScales * 1.4826 * *middle, floor);
+}
+
+/// Whether the point itself (the origin) lies beyond kSuspectScales robust scales (and the
+/// floor) off the surface of the others: a spike that bends the least-squares fit towards it
+/// can leave every residual of that fit within bounds. s.batch.c and s.misfit stay the
+/// least-squares fit's.
+bool centre_off(int degree, double floor, FitScratch& s) {
+  const int m = coefficient_count(degree);
+  double c[jets::kMaxCoefficients];
+  std::copy(s.batch.c, s.batch.c + m, c);
+  s.saved_misfit = s.misfit;
+  s.keep.assign(s.points.size(), 1);
+  s.keep[0] = 0;
+  bool off = false;
+  if (fit_kept(degree, s)) {
+    // The others' residuals alone set the scale.
+    const double centre = std::abs(s.misfit[0]);
+    std::vector<double>& magnitude = s.magnitude;
+    magnitude.clear();
+    for (std::size_t p = 1; p < s.misfit.size(); ++p) magnitude.push_back(std::abs(s.misfit[p]));
+    if (!magnitude.empty()) {
+      const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
+      std::nth_element(magnitude.begin(), middle, magnitude.end());
+      off = centre > std::max(kSuspectScales * 1.4826 * *middle, floor);
+    }
+  }
+  std::copy(c, c + m, s.batch.c);
+  s.misfit.swap(s.saved_misfit);
+  s.keep.assign(s.points.size(), 1);
+  return off;
+}
+
+/// A start that outliers do not bend: the fit without the point itself (at the origin), then
+/// concentration steps of least trimmed squares (Rousseeuw and Van Driessen 2006), each fit
+/// over the kTrimmedShare of the points nearest the previous one; the residuals of all points
+/// against the last into s.misfit.
+bool trimmed_start(int degree, FitScratch& s) {
+  const std::size_t n = s.points.size();
+  const std::size_t m = static_cast<std::size_t>(coefficient_count(degree));
+  const std::size_t h = std::max(m + 1, static_cast<std::size_t>(kTrimmedShare * n));
+  if (h >= n) return true;
+  // The first concentration step starts from the others' surface: the point itself, the one
+  // whose place is in question, out of it.
+  s.keep.assign(n, 1);
+  s.keep[0] = 0;
+  if (!fit_kept(degree, s)) return false;
+  std::vector<double> magnitude(n);
+  for (int step = 0; step < kTrimSteps; ++step) {
+    for (std::size_t p = 0; p < n; ++p) magnitude[p] = std::abs(s.misfit[p]);
+    std::vector<double> sorted = magnitude;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(h - 1),
+                     sorted.end());
+    const double cut = sorted[h - 1];
+    std::size_t taken = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+      s.keep[p] = magnitude[p] < cut && taken < h;
+      taken += s.keep[p];
+    }
+    for (std::size_t p = 0; p < n && taken < h; ++p) {
+      if (!s.keep[p] && magnitude[p] == cut) s.keep[p] = 1, ++taken;
+    }
+    if (!fit_kept(degree, s)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int reject_far_points(const std::vector<double>& misfit, double floor, std::vector<char>& keep) {
+  std::vector<double> magnitude(misfit.size());
+  for (std::size_t p = 0; p < misfit.size(); ++p) magnitude[p] = std::abs(misfit[p]);
+  const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
+  std::nth_element(magnitude.begin(), middle, magnitude.end());
+  const double cut = std::max(kOutlierScales * 1.4826 * *middle, floor);
+  keep.assign(misfit.size(), 1);
+  int rejected = 0;
+  for (std::size_t p = 0; p < misfit.size(); ++p) {
+    if (std::abs(misfit[p]) > cut) keep[p] = 0, ++rejected;
+  }
+  return rejected;
+}
+
+namespace {
+
+/// The surface of the fit in s (its coefficients, the kept points' residuals) around V.row(i).
+LocalSurface surface_of_fit(PositionsRef V, int i, const kernels::Frame<double>& frame,
+                            double scale, int degree, const FitScratch& s) {
+  LocalSurface out;
+  const jets::JetBatch& b = s.batch;
+  double ssr = 0.0;
+  int kept = 0;
+  for (std::size_t p = 0; p < s.points.size(); ++p) {
+    if (s.keep[p]) ssr += s.misfit[p] * s.misfit[p], ++kept;
+  }
+  const int m = coefficient_count(degree);
+  out.centre_rejected = !s.keep[0];
+  out.kept = kept;
+  out.residual = kept > m ? std::sqrt(ssr / (kept - m)) * scale : 0.0;
+  out.height = b.c[0] * scale;
+  const Eigen::Vector3d n = eigen_of(frame.n);
+  out.point = V.row(i).transpose() + out.height * n;
+  out.normal = (n - b.c[1] * eigen_of(frame.x) - b.c[2] * eigen_of(frame.y)).normalized();
+  // A fitted point beyond the neighbourhood's radius is the extrapolation of an ill-posed fit
+  // (points nearly on a curve after rejection), not a surface through them.
+  out.ok =
+      out.point.allFinite() && out.normal.allFinite() && std::abs(out.height) <= scale && kept > m;
+  return out;
+}
+
+/// The robust refit of s.points from the least-squares fit in s: a trimmed start, then rounds
+/// of rejection. False where a fit on the way is not well posed.
+bool robust_refit(int degree, double scaled_floor, FitScratch& s) {
+  if (!trimmed_start(degree, s)) return false;
+  std::vector<char> previous(s.points.size(), 0);
+  for (int round = 0; round < kRejectionRounds; ++round) {
+    reject_far_points(s.misfit, scaled_floor, s.keep);
+    if (s.keep == previous) break;
+    if (!fit_kept(degree, s)) return false;
+    previous = s.keep;
+  }
+  s.keep = previous;
+  return true;
+}
+
+}  // namespace
+
+LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
+                               const std::vector<int>& ring, int degree, bool robust, double floor,
+                               FitScratch& s) {
+  const kernels::Frame<double> frame = kernels::frame_of(kernels::vec3_of(n));
+  const double scale = jets::gather_points(V, i, frame, ring, s.points);
+  if (!(scale > 0.0) || !fit_points(degree, s.points, s)) return {};
+  misfits(degree, s);
+  s.keep.assign(s.points.size(), 1);
+  const double scaled_floor = floor / scale;
+  if (!robust || !(suspect(s.misfit, scaled_floor) || centre_off(degree, scaled_floor, s))) {
+    return surface_of_fit(V, i, frame, scale, degree, s);
+  }
+  // The least-squares fit, kept for where the robust one is not well posed.
+  const int m = coefficient_count(degree);
+  double c[jets::kMaxCoefficients];
+  std::copy(s.batch.c, s.batch.c + m, c);
+  s.saved_misfit = s.misfit;
+  if (robust_refit(degree, scaled_floor, s)) {
+    const LocalSurface out = surface_of_fit(V, i, frame, scale, degree, s);
+    if (out.ok) return out;
+  }
+  std::copy(c, c + m, s.batch.c);
+  s.misfit.swap(s.saved_misfit);
+  s.keep.assign(s.points.size(), 1);
+  return surface_of_fit(V, i, frame, scale, degree, s);
+}
+
+}  // namespace focal::detail::smoothing
