@@ -90,6 +90,16 @@ std::optional<Quadric> fit_quadric(const std::vector<Eigen::Vector3d>& points) {
 
 }  // namespace
 
+Eigen::Vector3d ring_polygon_normal(PositionsRef V, FacesRef F, const VertexFaces& faces, int i) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int a = faces.begin(i); a < faces.end(i); ++a) {
+    const int f = faces.faces[static_cast<std::size_t>(a)];
+    const Eigen::Vector3d p = V.row(F(f, 0)).transpose();
+    sum += (V.row(F(f, 1)).transpose() - p).cross(V.row(F(f, 2)).transpose() - p);
+  }
+  return sum.normalized();
+}
+
 OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::VectorXd& deviation,
                        int i, double radius, const Eigen::Vector3d& reference) {
   std::vector<int> points;
@@ -142,9 +152,20 @@ OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::
     if (!(std::abs(slope) > 1e-6)) break;
     t -= h / slope;
   }
-  const Eigen::Vector3d foot = x + t * m;
+  Eigen::Vector3d foot = x + t * m;
+  // A vertex that left its ring (moved along a wrong direction, folding its faces) goes back
+  // onto the quadric at its 1-ring's centroid.
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
+    const Eigen::Vector3d d = (V.row(*j).transpose() - centre) / radius;
+    c += Eigen::Vector2d(d.dot(t1), d.dot(t2));
+  }
+  c /= static_cast<double>(ring.end(i) - ring.begin(i));
+  const Eigen::Vector2d drift = foot.head<2>() - c;
+  if (drift.norm() > 1.0) foot = Eigen::Vector3d(c.x(), c.y(), q->at(c.x(), c.y()));
   if (!foot.allFinite()) return {};
-  return {-t, centre + radius * (foot.x() * t1 + foot.y() * t2 + foot.z() * n), q->misfit};
+  const double height = std::copysign((x - foot).norm(), x.z() - q->at(x.x(), x.y()));
+  return {height, centre + radius * (foot.x() * t1 + foot.y() * t2 + foot.z() * n), q->misfit};
 }
 
 SpikeScreen spike_screen(PositionsRef V, const Neighbourhoods& one_ring,
@@ -180,8 +201,18 @@ PositionSpikes position_spikes(PositionsRef V, FacesRef F, const Neighbourhoods&
     if (!(std::abs(screen.deviation[i]) > kSpikeScreen)) continue;
     const int v = static_cast<int>(i);
     if (!interior(F, one_ring, faces, v)) continue;
-    const OffSurface off = off_surface(V, one_ring, screen.deviation, v, screen.radius[i],
-                                       reference.row(i).transpose());
+    // The frame of the judgement: the reference normal or the 1-ring polygon's, whichever
+    // quadric fits its points better. A vertex moved sideways folds its faces and tilts the
+    // reference (Max's normal: measured 125 degrees off), not the polygon; a spike beside this
+    // one tilts the polygon (up to 75 degrees on strips), not the reference.
+    const OffSurface by_reference = off_surface(V, one_ring, screen.deviation, v, screen.radius[i],
+                                                reference.row(i).transpose());
+    const OffSurface by_polygon = off_surface(V, one_ring, screen.deviation, v, screen.radius[i],
+                                              ring_polygon_normal(V, F, faces, v));
+    const OffSurface& off =
+        by_polygon.misfit < by_reference.misfit || !std::isfinite(by_reference.misfit)
+            ? by_polygon
+            : by_reference;
     const double height = std::abs(off.height);
     if (height > kPositionSpikeOffset && height > kSpikeOverMisfit * off.misfit) {
       out.vertices.push_back(v);

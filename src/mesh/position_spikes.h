@@ -17,19 +17,19 @@ namespace focal::detail {
 /// leave-one-out fit. Measured (docs/notes/estimator-log.md, "Spikes without normals"): at most
 /// 0.094 on clean meshes (8 surfaces, regular and irregular, 850 to 16000 vertices, strips,
 /// graded), 0.33 on the capped cylinder's rims, 0.76 at a cube's corners; spikes of 2 mean edges
-/// 0.68 to 2.4.
+/// 0.68 (20:1 strips) to 2.8.
 constexpr double kSpikeScreen = 0.6;
 
 /// Height off the leave-one-out quadric (in ring radii) beyond which a screened vertex is a
 /// spike: the limit of the spike repair on trusted normals (spike_repair.h). Clean meshes'
-/// leave-one-out heights measure at most 0.18 (the 850-vertex helix tube).
+/// leave-one-out heights measure at most 0.174 (the 850-vertex helix tube).
 constexpr double kPositionSpikeOffset = 0.75;
 
 /// How many times the quadric's RMS misfit a spike's height must exceed: a spike sits off a
 /// smooth surface, a corner or a crease off a surface that no quadric fits. Measured
 /// (docs/notes/estimator-log.md, "Spikes without normals"): a cube's corners 1.6 (height 0.71,
-/// misfit 0.46); spikes of 2 mean edges at least 14 (the 850-vertex helix tube), 40 to 10^5
-/// elsewhere.
+/// misfit 0.46, in the first fit; they leave too few points for the second); spikes of 2 mean
+/// edges at least 14.5 (the 850-vertex helix tube), 40 to 10^5 elsewhere.
 constexpr double kSpikeOverMisfit = 4.0;
 
 /// Rings that a repaired position (position_spikes) reads: its 2-ring's positions and whether
@@ -53,16 +53,23 @@ struct SpikeScreen {
 SpikeScreen spike_screen(PositionsRef V, const Neighbourhoods& one_ring,
                          const RowMatrixX3d& reference, int threads);
 
+/// The unit sum of the cross products of vertex i's faces (twice their vector area): at an
+/// interior vertex the normal of its 1-ring's polygon, which p_i does not move or tilt (Max's
+/// normal can: a vertex moved sideways folds its faces). NaN where the sum is zero.
+Eigen::Vector3d ring_polygon_normal(PositionsRef V, FacesRef F, const VertexFaces& faces, int i);
+
 /// Stage 2 of position_spikes at vertex i: how far (in units of `radius`, signed along
 /// `reference`, a normal at i) p_i lies off the quadric height fitted over the plane of
 /// `reference` to its 2-ring without i and without other candidates (`deviation`: the screen's;
 /// j is left out where |deviation_j| exceeds kSpikeScreen and half of |deviation_i|, so that a
 /// spike's neighbours, which its offset screens by about a third of its own, stay in), fitted
 /// again without the points more than half of kPositionSpikeOffset off the first fit (a spike
-/// beside a larger one). The distance is along the quadric's normal under p_i, and `on_surface`
-/// where that line meets the quadric: a spike moved along the surface's normal goes back where
-/// it was, also where `reference` is tilted (beside another spike). NaN where `reference` is not
-/// finite, fewer than 10 points remain or the fit is ill-posed.
+/// beside a larger one). `on_surface` is where the line from p_i along the quadric's normal under
+/// it meets the quadric (a spike moved along the surface's normal goes back where it was, also
+/// where `reference` is tilted), or, where that point is more than one ring radius from the
+/// 1-ring's centroid (a vertex moved sideways), the quadric's point over the centroid;
+/// `height` is the distance from p_i to it. NaN
+/// where `reference` is not finite, fewer than 10 points remain or the fit is ill-posed.
 struct OffSurface {
   double height = NAN;
   Eigen::Vector3d on_surface = Eigen::Vector3d::Constant(NAN);
@@ -85,11 +92,12 @@ OffSurface off_surface(PositionsRef V, const Neighbourhoods& one_ring,
 ///    candidate (a spike of t ring radii measures about t (1 + 1 / valence)).
 /// 2. Leave-one-out fit (candidates only, off_surface): a quadric height z(x, y) fitted by least
 ///    squares to the 2-ring without the vertex and without other candidates (another spike
-///    nearby), over the plane of n_i; the vertex is a spike where its distance from the quadric
-///    exceeds kPositionSpikeOffset ring radii and kSpikeOverMisfit times the quadric's RMS misfit
-///    (a corner or a crease is off a surface that no quadric fits). Only interior vertices
-///    (every edge at it has two faces) with at least 10 such points are judged: a boundary
-///    vertex's neighbours lie on one side.
+///    nearby), over the plane of n_i or of ring_polygon_normal, whichever quadric fits its points
+///    better (a vertex moved sideways tilts n_i, a spike beside it the polygon); the vertex is a
+///    spike where its distance from the quadric exceeds kPositionSpikeOffset ring radii and
+///    kSpikeOverMisfit times the quadric's RMS misfit (a corner or a crease is off a surface that
+///    no quadric fits). Only interior vertices (every edge at it has two faces) with at least 10
+///    such points are judged: a boundary vertex's neighbours lie on one side.
 /// The repaired position of a spike is off_surface's `on_surface`. Deterministic (the same
 /// vertices and bits for any thread count).
 /// \pre V #V x 3 finite, `one_ring` and `faces` of the same mesh (F its faces), `reference`
