@@ -38,19 +38,6 @@ double ring_offset(PositionsRef V, const Neighbourhoods& ring, const RowMatrixX3
   return -c.dot(n) / radius;
 }
 
-/// Whether every edge at vertex i has two faces (its 1-ring closes around it).
-bool interior(FacesRef F, const Neighbourhoods& ring, const VertexFaces& faces, int i) {
-  for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
-    int shared = 0;
-    for (int a = faces.begin(i); a < faces.end(i); ++a) {
-      const int f = faces.faces[static_cast<std::size_t>(a)];
-      shared += F(f, 0) == *j || F(f, 1) == *j || F(f, 2) == *j;
-    }
-    if (shared != 2) return false;
-  }
-  return true;
-}
-
 /// Points of a leave-one-out fit at least: a quadric's 6 coefficients with a margin.
 constexpr std::size_t kMinPoints = 10;
 
@@ -100,8 +87,20 @@ Eigen::Vector3d ring_polygon_normal(PositionsRef V, FacesRef F, const VertexFace
   return sum.normalized();
 }
 
+bool ring_is_closed(FacesRef F, const Neighbourhoods& ring, const VertexFaces& faces, int i) {
+  for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
+    int shared = 0;
+    for (int a = faces.begin(i); a < faces.end(i); ++a) {
+      const int f = faces.faces[static_cast<std::size_t>(a)];
+      shared += F(f, 0) == *j || F(f, 1) == *j || F(f, 2) == *j;
+    }
+    if (shared != 2) return false;
+  }
+  return true;
+}
+
 OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::VectorXd& deviation,
-                       int i, double radius, const Eigen::Vector3d& reference) {
+                       int i, double radius, const Eigen::Vector3d& reference, bool closed_ring) {
   std::vector<int> points;
   for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
     points.push_back(*j);
@@ -153,8 +152,9 @@ OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::
     t -= h / slope;
   }
   Eigen::Vector3d foot = x + t * m;
-  // A vertex that left its ring (moved along a wrong direction, folding its faces) goes back
-  // onto the quadric at its 1-ring's centroid.
+  // A vertex that left its closed ring (moved along a wrong direction, folding its faces) goes
+  // back onto the quadric at its 1-ring's centroid (a boundary vertex is off its ring's centroid
+  // by the ring's one-sidedness).
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
     const Eigen::Vector3d d = (V.row(*j).transpose() - centre) / radius;
@@ -162,7 +162,7 @@ OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::
   }
   c /= static_cast<double>(ring.end(i) - ring.begin(i));
   const Eigen::Vector2d drift = foot.head<2>() - c;
-  if (drift.norm() > 1.0) foot = Eigen::Vector3d(c.x(), c.y(), q->at(c.x(), c.y()));
+  if (closed_ring && drift.norm() > 1.0) foot = Eigen::Vector3d(c.x(), c.y(), q->at(c.x(), c.y()));
   if (!foot.allFinite()) return {};
   const double height = std::copysign((x - foot).norm(), x.z() - q->at(x.x(), x.y()));
   return {height, centre + radius * (foot.x() * t1 + foot.y() * t2 + foot.z() * n), q->misfit};
@@ -200,15 +200,15 @@ PositionSpikes position_spikes(PositionsRef V, FacesRef F, const Neighbourhoods&
     // The few candidates one by one, in order: the same bits for any thread count.
     if (!(std::abs(screen.deviation[i]) > kSpikeScreen)) continue;
     const int v = static_cast<int>(i);
-    if (!interior(F, one_ring, faces, v)) continue;
+    const bool closed = ring_is_closed(F, one_ring, faces, v);
     // The frame of the judgement: the reference normal or the 1-ring polygon's, whichever
     // quadric fits its points better. A vertex moved sideways folds its faces and tilts the
     // reference (Max's normal: measured 125 degrees off), not the polygon; a spike beside this
     // one tilts the polygon (up to 75 degrees on strips), not the reference.
     const OffSurface by_reference = off_surface(V, one_ring, screen.deviation, v, screen.radius[i],
-                                                reference.row(i).transpose());
+                                                reference.row(i).transpose(), closed);
     const OffSurface by_polygon = off_surface(V, one_ring, screen.deviation, v, screen.radius[i],
-                                              ring_polygon_normal(V, F, faces, v));
+                                              ring_polygon_normal(V, F, faces, v), closed);
     const OffSurface& off =
         by_polygon.misfit < by_reference.misfit || !std::isfinite(by_reference.misfit)
             ? by_polygon

@@ -66,8 +66,9 @@ Eigen::Vector3d ring_polygon_normal(PositionsRef V, FacesRef F, const VertexFace
 /// again without the points more than half of kPositionSpikeOffset off the first fit (a spike
 /// beside a larger one). `on_surface` is where the line from p_i along the quadric's normal under
 /// it meets the quadric (a spike moved along the surface's normal goes back where it was, also
-/// where `reference` is tilted), or, where that point is more than one ring radius from the
-/// 1-ring's centroid (a vertex moved sideways), the quadric's point over the centroid;
+/// where `reference` is tilted), or, with `closed_ring` (ring_is_closed) and where that point is
+/// more than one ring radius from the 1-ring's centroid (a vertex moved sideways), the quadric's
+/// point over the centroid;
 /// `height` is the distance from p_i to it. NaN
 /// where `reference` is not finite, fewer than 10 points remain or the fit is ill-posed.
 struct OffSurface {
@@ -78,7 +79,10 @@ struct OffSurface {
 
 OffSurface off_surface(PositionsRef V, const Neighbourhoods& one_ring,
                        const Eigen::VectorXd& deviation, int i, double radius,
-                       const Eigen::Vector3d& reference);
+                       const Eigen::Vector3d& reference, bool closed_ring);
+
+/// Whether every edge at vertex i has two faces (its 1-ring closes around it).
+bool ring_is_closed(FacesRef F, const Neighbourhoods& one_ring, const VertexFaces& faces, int i);
 
 /// Vertices that sit off the surface their neighbours describe, from positions alone, and the
 /// positions that put them back on it.
@@ -96,8 +100,8 @@ OffSurface off_surface(PositionsRef V, const Neighbourhoods& one_ring,
 ///    better (a vertex moved sideways tilts n_i, a spike beside it the polygon); the vertex is a
 ///    spike where its distance from the quadric exceeds kPositionSpikeOffset ring radii and
 ///    kSpikeOverMisfit times the quadric's RMS misfit (a corner or a crease is off a surface that
-///    no quadric fits). Only interior vertices (every edge at it has two faces) with at least 10
-///    such points are judged: a boundary vertex's neighbours lie on one side.
+///    no quadric fits). Vertices with fewer than 10 such points are not judged (a third of the
+///    boundary vertices of random samplings, measured).
 /// The repaired position of a spike is off_surface's `on_surface`. Deterministic (the same
 /// vertices and bits for any thread count).
 /// \pre V #V x 3 finite, `one_ring` and `faces` of the same mesh (F its faces), `reference`
