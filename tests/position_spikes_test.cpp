@@ -173,6 +173,25 @@ TEST(PositionSpikes, NoneOnCleanMeshesCreasesAndCorners) {
   }
 }
 
+TEST(PositionSpikes, AZigZagFanIsJudgedAtBoundedCost) {
+  // A polygon of 20000 corners, alternately 0.3 above and below its plane, fan-triangulated
+  // around a hub: every corner screens (its 1-ring is the hub and its two neighbours), and
+  // every corner's 2-ring holds the hub's 20000 neighbours. Those are not judged (more than
+  // kMaxNeighbourhoodSize entries): O(#V) work instead of O(#V^2).
+  constexpr int n = 20000;
+  Mesh m;
+  m.V.resize(n + 1, 3);
+  m.V.row(0) << 0.0, 0.0, 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2.0 * 3.141592653589793 * k / n;
+    m.V.row(k + 1) << std::cos(a), std::sin(a), k % 2 == 0 ? 0.3 : -0.3;
+  }
+  m.F.resize(n, 3);
+  for (int k = 0; k < n; ++k) m.F.row(k) << 0, 1 + k, 1 + (k + 1) % n;
+  const Found f = find(m);
+  EXPECT_TRUE(f.spikes.vertices.empty());
+}
+
 TEST(PositionSpikes, FindsInteriorSpikesAndPutsThemOnTheSurface) {
   // A sphere of radius 1: the distance of a repaired spike from it is exact truth. Measured at
   // 4000 vertices: every interior spike found, none else.
@@ -427,6 +446,7 @@ TEST(PositionSpikes, DISABLED_MeasureBoundaries) {
     }
   }
 }
+
 
 }  // namespace
 }  // namespace focal

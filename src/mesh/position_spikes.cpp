@@ -101,7 +101,15 @@ bool ring_is_closed(FacesRef F, const Neighbourhoods& ring, const VertexFaces& f
 
 OffSurface off_surface(PositionsRef V, const Neighbourhoods& ring, const Eigen::VectorXd& deviation,
                        int i, double radius, const Eigen::Vector3d& reference, bool closed_ring) {
+  // A 2-ring with more than kMaxNeighbourhoodSize entries (a vertex beside the hub of a large
+  // fan) is not judged: the cost stays bounded per vertex, as for the k-rings.
+  std::size_t entries = 0;
+  for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
+    entries += 1 + static_cast<std::size_t>(ring.end(*j) - ring.begin(*j));
+  }
+  if (entries > static_cast<std::size_t>(kMaxNeighbourhoodSize)) return {};
   std::vector<int> points;
+  points.reserve(entries);
   for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
     points.push_back(*j);
     for (const int* k = ring.begin(*j); k != ring.end(*j); ++k) points.push_back(*k);
@@ -200,6 +208,7 @@ PositionSpikes position_spikes(PositionsRef V, FacesRef F, const Neighbourhoods&
     // The few candidates one by one, in order: the same bits for any thread count.
     if (!(std::abs(screen.deviation[i]) > kSpikeScreen)) continue;
     const int v = static_cast<int>(i);
+    if (one_ring.end(v) - one_ring.begin(v) > kMaxNeighbourhoodSize) continue;  // see off_surface
     const bool closed = ring_is_closed(F, one_ring, faces, v);
     // The frame of the judgement: the reference normal or the 1-ring polygon's, whichever
     // quadric fits its points better. A vertex moved sideways folds its faces and tilts the

@@ -68,9 +68,10 @@ Eigen::Vector3d ring_polygon_normal(PositionsRef V, FacesRef F, const VertexFace
 /// it meets the quadric (a spike moved along the surface's normal goes back where it was, also
 /// where `reference` is tilted), or, with `closed_ring` (ring_is_closed) and where that point is
 /// more than one ring radius from the 1-ring's centroid (a vertex moved sideways), the quadric's
-/// point over the centroid;
-/// `height` is the distance from p_i to it. NaN
-/// where `reference` is not finite, fewer than 10 points remain or the fit is ill-posed.
+/// point over the centroid; `height` is the distance from p_i to it. NaN where `reference` is
+/// not finite, the 2-ring's lists hold more than kMaxNeighbourhoodSize entries (the cost per
+/// vertex stays bounded beside the hub of a large fan), fewer than 10 points remain or the fit is
+/// ill-posed.
 struct OffSurface {
   double height = NAN;
   Eigen::Vector3d on_surface = Eigen::Vector3d::Constant(NAN);
