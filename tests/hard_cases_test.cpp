@@ -15,11 +15,13 @@
 #include <string>
 
 #include "focal/core/error.h"
+#include "focal/curvature/curvature.h"
 #include "focal/curvature/estimate.h"
 #include "focal/curvature/recommended.h"
 #include "focal/io/fields_io.h"
 #include "focal/evaluation/evaluation.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 
 namespace focal {
@@ -227,7 +229,7 @@ TEST(HardCases, PositionNoiseLeavesTruncationOut) {
   EXPECT_GT(plan.noise, kNoiseForThreeRings);
   EXPECT_LT(plan.position_noise, kNoiseForTwoRings);
   EXPECT_EQ(plan.rings, 1);
-  EXPECT_EQ(recommended_reach(plan), 11);
+  EXPECT_EQ(recommended_reach(plan), kRecommendedMaxReach);
   // Under the paper's 10% noise both agree (uniform amplitude a: a / sqrt(3) = 0.058; measured
   // 0.055 to 0.058 over five surfaces, regular and irregular).
   AnalyticSurface noisy = surface(SurfaceKind::torus, Triangulation::irregular, 2000);
@@ -235,7 +237,7 @@ TEST(HardCases, PositionNoiseLeavesTruncationOut) {
   const RecommendedPlan noisy_plan = recommended_plan(noisy.mesh.V, noisy.mesh.F);
   EXPECT_NEAR(noisy_plan.position_noise, noisy_plan.noise, 0.05 * noisy_plan.noise);
   EXPECT_EQ(noisy_plan.rings, 3);
-  EXPECT_EQ(recommended_reach(noisy_plan), kRecommendedMaxReach);
+  EXPECT_EQ(recommended_reach(noisy_plan), 12);
 }
 
 // Strong vertex noise without normals (issue 16's target: relative H error at most 0.5, no
@@ -266,6 +268,35 @@ TEST(HardCases, RobustRefitTakesThePullOfOutlierNormals) {
       rel_h(s, estimate_curvature_recommended(s.mesh.V, s.mesh.F, s.mesh.N).curvature);
   EXPECT_LT(wild, 2.5 * clean);
 }
+
+/// Coarse meshes: the default against the paper's 1-ring fit, with the plan the default makes
+/// (docs/notes/estimator-log.md, "Spikes without normals", last paragraph):
+/// build/release/tests/hard_cases_test --gtest_also_run_disabled_tests
+///   --gtest_filter='*DISABLED_MeasureCoarse*'
+TEST(HardCases, DISABLED_MeasureCoarse) {
+  for (SurfaceKind k : {SurfaceKind::torus, SurfaceKind::helix_tube}) {
+    for (int n : {300, 425, 600, 850}) {
+      for (std::uint64_t seed : {1, 2}) {
+        const AnalyticSurface a = make_surface(
+            {.kind = k, .triangulation = Triangulation::irregular, .target_vertices = n, .seed = seed});
+        const auto rel = [&](const CurvatureResult& r) { return evaluate(a, r).interior.relative_H; };
+        const RecommendedResult none = estimate_curvature_recommended(a.mesh.V, a.mesh.F, std::nullopt);
+        const double def_none = rel(none.curvature);
+        std::printf("   plan: rings %d noise %.4f position noise %.4f, creases %d\n", none.plan.rings,
+                    none.plan.noise, none.plan.position_noise, none.crease.cast<int>().sum());
+        const double def_file =
+            rel(estimate_curvature_recommended(a.mesh.V, a.mesh.F, a.mesh.normals()).curvature);
+        const double paper_max = rel(estimate_curvature(
+            a.mesh.V, a.mesh.F, vertex_normals(a.mesh.V, a.mesh.F, NormalWeighting::max), {}));
+        const double paper_file = rel(estimate_curvature(a.mesh.V, a.mesh.F, a.mesh.N, {}));
+        std::printf("%-10s %4d (%5d v) seed %d | no normals: default %.4f paper/Max %.4f | file: default %.4f paper %.4f\n",
+                    std::string(surface_name(k)).c_str(), n, static_cast<int>(a.mesh.V.rows()),
+                    static_cast<int>(seed), def_none, paper_max, def_file, paper_file);
+      }
+    }
+  }
+}
+
 
 }  // namespace
 }  // namespace focal

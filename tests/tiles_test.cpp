@@ -385,10 +385,12 @@ TEST(Tiles, ReachFollowsTheOptions) {
   paper.paper.method = Method::triangle;
   EXPECT_EQ(estimate_reach(paper), 2);
   EstimateOptions recommended;
-  // No choices yet: the widest plan (3 rings).
+  // No choices yet: every plan's bound (the clean plan's, with the spike repairs' rings).
   EXPECT_EQ(estimate_reach(recommended), kRecommendedMaxReach);
   recommended.recommended.mesh_wide = RecommendedMeshWide{.noise = 1e-4, .position_noise = 1e-4};
-  EXPECT_EQ(estimate_reach(recommended), 11);
+  EXPECT_EQ(estimate_reach(recommended), 13);
+  recommended.recommended.mesh_wide = RecommendedMeshWide{.noise = 0.06, .position_noise = 0.06};
+  EXPECT_EQ(estimate_reach(recommended), 12);
 }
 
 TEST(Tiles, IdsInIsMembershipInAnAscendingSet) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -174,11 +173,10 @@ Estimate estimate(const PreparedMesh& mesh, const EstimateOptions& options) {
 
 int estimate_reach(const EstimateOptions& options) {
   if (options.estimator == Estimator::recommended) {
-    // Without the mesh's choices, the widest plan (3 rings) bounds every plan's reach.
-    const double noise = options.recommended.mesh_wide
-                             ? options.recommended.mesh_wide->position_noise
-                             : std::numeric_limits<double>::infinity();
-    return recommended_reach(recommended_plan_for_noise(noise, options.recommended));
+    // Without the mesh's choices, the bound of every plan's reach.
+    if (!options.recommended.mesh_wide) return kRecommendedMaxReach;
+    return recommended_reach(recommended_plan_for_noise(
+        options.recommended.mesh_wide->position_noise, options.recommended));
   }
   // The corners of a vertex's faces, whose normals read their own faces.
   if (options.paper.method == Method::triangle) return 2;

@@ -24,6 +24,7 @@
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/jets.h"
 #include "focal/normals/vertex_normals.h"
+#include "mesh/position_spikes.h"
 #include "mesh/prepared_access.h"
 #include "normals/jet_normals_from.h"
 #include "normals/vertex_normals_from.h"
@@ -175,6 +176,20 @@ std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
   return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
 }
 
+/// Spikes without trusted normals (mesh/position_spikes.h, judged from the positions with Max's
+/// normals as the screen's directions): the positions with each spike moved onto the quadric
+/// of its 2-ring without it, or nothing when there is none.
+std::optional<RowMatrixX3d> position_spike_repaired(const Context& c) {
+  const detail::PositionSpikes spikes = detail::position_spikes(
+      c.mesh.V(), c.mesh.F(), *c.one_ring, *detail::incidence(c.mesh), c.max, 0);
+  if (spikes.vertices.empty()) return std::nullopt;
+  RowMatrixX3d V = c.mesh.V();
+  for (std::size_t k = 0; k < spikes.vertices.size(); ++k) {
+    V.row(spikes.vertices[k]) = spikes.repaired[k].transpose();
+  }
+  return V;
+}
+
 }  // namespace
 
 namespace {
@@ -185,11 +200,13 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
   Context c = make_context(mesh, options);
   RecommendedResult out;
   const RecommendedMeshWide mesh_wide = choose_normals(c, out);
-  if (repair_spikes && out.file_normals_used && out.plan.rings == 1) {
+  if (repair_spikes && out.plan.rings == 1) {
     // Spikes (step 4): the whole estimate again on the repaired positions, with this mesh's
     // mesh-wide choices and scale (away from the spikes the positions, and so the estimate, are
-    // the same).
-    if (const std::optional<RowMatrixX3d> V = spike_repaired(c)) {
+    // the same). With trusted normals the normals tell where a spike belongs; without, the
+    // positions around it.
+    if (const std::optional<RowMatrixX3d> V =
+            out.file_normals_used ? spike_repaired(c) : position_spike_repaired(c)) {
       RecommendedOptions o = options;
       o.mesh_wide = mesh_wide;
       const PreparedMesh repaired = detail::PreparedAccess::make(

@@ -15,6 +15,7 @@
 #include "curvature/recommended_steps.h"
 #include "curvature/spike_repair.h"
 #include "focal/core/error.h"
+#include "mesh/position_spikes.h"
 #include "mesh/prepared_access.h"
 #include "normals/jet_normals_from.h"
 
@@ -261,13 +262,15 @@ int recommended_reach(const RecommendedPlan& plan) {
   //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
   //    fitted normals at the corners of the faces of its ball's vertices (at most
   //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings);
-  //  - on clean positions with trusted normals, each position read is the spike repair's
-  //    (spike_repair.h): a spike's offset reads its 1-ring, whether it is isolated the offsets
-  //    of that 1-ring, 2 rings in all.
+  //  - on clean positions each position read may be a repaired spike's: with trusted normals
+  //    (spike_repair.h) a spike's offset reads its 1-ring, whether it is isolated the offsets
+  //    of that 1-ring, 2 rings in all; without them (mesh/position_spikes.h)
+  //    kPositionSpikeRings.
   const int normal_reach = std::max(kBoundaryJetRings + 2, plan.rings > 1 ? plan.jet_rings + 2 : 0);
   const int fit_reach = std::max(std::max(plan.rings, 1) + kMaxExtraRings + 1,
                                  plan.rings > 1 ? 0 : detail::kCorrectedBallRings + 1);
-  const int position_reach = plan.rings > 1 ? 0 : detail::kSpikeRepairRings;
+  const int position_reach =
+      plan.rings > 1 ? 0 : std::max(detail::kSpikeRepairRings, detail::kPositionSpikeRings);
   return fit_reach + normal_reach + position_reach;
 }
 

@@ -178,12 +178,13 @@ struct RecommendedMedians {
 /// jet_rings-ring jets from Max's normals, turned with the 1-ring); the fit reads the normals of
 /// rings + kMaxExtraRings rings, and the normals that the refit of undefined vertices replaced by
 /// their neighbours' mean one ring further; on clean positions every position read may be a spike's
-/// repaired one, which reads 2 rings further. 11 on clean positions, 12 at most
-/// (kRecommendedMaxReach). Derived in recommended_plan.cpp.
+/// repaired one, which reads 4 rings further (2 with trusted normals). 13 on clean positions,
+/// 12 on the widest noisy plan (3 rings, 4-ring jets), so 13 at most (kRecommendedMaxReach).
+/// Derived in recommended_plan.cpp.
 [[nodiscard]] int recommended_reach(const RecommendedPlan& plan);
 
-/// recommended_reach of the widest plan (3 rings, 4-ring jets).
-inline constexpr int kRecommendedMaxReach = 12;
+/// The largest recommended_reach of any plan (the clean plan's).
+inline constexpr int kRecommendedMaxReach = 13;
 
 /// The recommended estimate with what it decided and the normals it fitted.
 struct RecommendedResult {
