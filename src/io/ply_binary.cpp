@@ -38,8 +38,9 @@ class BinaryBody {
                      "file ends inside " + e.name + " " + std::to_string(complete) + " of " +
                          std::to_string(e.count));
     }
-    io_detail::check_count_fits(path_, "byte offset " + std::to_string(offset()), e.count,
-                                min_bytes, remaining, e.name + " elements");
+    // Binary: every element has its bytes (no separator that the last one may lack).
+    io_detail::check_records_fit(path_, "byte offset " + std::to_string(offset()), e.count,
+                                 min_bytes, remaining, e.name + " elements");
   }
 
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
