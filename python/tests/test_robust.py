@@ -179,3 +179,12 @@ def test_the_extra_is_declared():
         text = f.read()
     assert 'name = "focal-surfaces"' in text
     assert 'distributed = ["dask[distributed]"]' in text
+
+
+def test_streamed_tiles_of_a_file_that_is_not_ply_say_so(sphere, tmp_path):
+    import focal.stream
+
+    off = tmp_path / "s.off"
+    focal.write_mesh(off, sphere.V, sphere.F)
+    with pytest.raises(focal.InvalidInputError, match=r"s.off: streamed tiles .* read binary PLY"):
+        focal.stream._open(off)

@@ -561,8 +561,9 @@ Image render_panels(const std::vector<PanelContent>& panels, const Layout& layou
   if (drawn == 0) drawn = resolved;
   if (samples != std::min(o.samples, static_cast<int>(max_samples)) && o.samples > 1) {
     if (const auto& warn = current_execution().warning) {
-      warn(picture + ": not enough memory for " + std::to_string(o.samples) +
-           " samples per pixel; drawn with " + std::to_string(std::max(samples, 1)));
+      warn(picture + ": the driver (or the machine's memory) cannot hold " +
+           std::to_string(o.samples) + " samples per pixel at this size; drawn with " +
+           std::to_string(std::max(samples, 1)));
     }
   }
   glBindFramebuffer(GL_FRAMEBUFFER, drawn);

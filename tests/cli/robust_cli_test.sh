@@ -151,6 +151,16 @@ check "generate --vertices 100000000 on a 3 GB process: exit 2, how much it need
   _ "$rc" "$ERR"
 check "  ... and no temporary file" no_temporaries
 
+# A picture near the size limit: drawn (with fewer samples where the driver cannot hold 4), or
+# refused with what it needs, never 'framebuffer incomplete'. Skipped where focal has no render.
+if "$FOCAL" render -h >/dev/null 2>&1; then
+  run render s.ply -o large.png --size 12000x12000
+  check "render --size 12000x12000: a picture, or an error that says what is missing" \
+    bash -c '{ [[ $1 -eq 0 && -s large.png ]] || { [[ $1 -eq 2 ]] && grep -qE "needs about|cannot allocate|OpenGL context" "$2"; }; } && ! grep -q "framebuffer incomplete" "$2"' \
+    _ "$rc" "$ERR"
+  rm -f large.png
+fi
+
 # ---- 8. Messages of malformed files --------------------------------------------------------------
 printf 'solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n' >tri.stl
 { printf 'made by hand\n'; cat tri.stl; } >leading.stl
