@@ -146,7 +146,7 @@ bool shares_no_vertex(const PreparedMesh& mesh) {
       u = 1;
     }
   }
-  return F.rows() > 0;
+  return F.rows() > 1;  // one triangle alone is no soup
 }
 
 /// Counts the vertices without an estimate and, where that can explain them, those over the

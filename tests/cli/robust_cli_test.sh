@@ -190,6 +190,10 @@ expect_error "PLY 'format ascii 2.0': an unknown version is an error" 2 "PLY ver
 expect_error "binary PLY list element: the bytes that follow hold at most as many elements as bytes" 2 \
   "header declares 20000 face elements but the 13000 bytes that follow can hold at most 13000" \
   short.csv curvature short.ply -o short.csv
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n' >junk.off
+expect_error "OFF with an element line after the declared ones: an error naming it" 2 \
+  "line 7: data after the last of the 3 vertices and 1 faces the header declares: '3'" \
+  junk.csv curvature junk.off -o junk.csv
 { for t in 0 1 2 3; do printf 'v %d 0 0\nv %d 1 0\nv %d 0 1\n' "$t" "$t" "$t"; done
   printf 'f 1 2 3\nf 4 5 6\nf 7 8 9\nf 10 11 12\n'; } >soup.obj
 run curvature soup.obj -o soup.csv
