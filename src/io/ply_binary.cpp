@@ -9,6 +9,7 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "io/file_bytes.h"
 #include "io/ply.h"
 #include "io/ply_read.h"
@@ -26,6 +27,9 @@ class BinaryBody {
         end_(begin_ + data.size()),
         swap_(swap),
         threads_(threads) {}
+
+  /// Bytes not read yet (after read_body: those after the last element).
+  [[nodiscard]] std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
 
   /// Rejects a count that cannot fit in the rest of the file, before anything is allocated.
   void check_fits(const PlyElement& e) const {
@@ -325,7 +329,16 @@ Mesh read_binary_body(const std::filesystem::path& path, std::string_view data,
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
   const bool host_big = std::endian::native == std::endian::big;
   BinaryBody body(path, data, header.body_offset, file_big != host_big, threads);
-  return read_body(path, header, plan, body);
+  Mesh mesh = read_body(path, header, plan, body);
+  // Bytes after the last element: not part of the mesh (a line end some writers add, or a wrong
+  // count); read as before, but said, since they may be elements the header does not count.
+  if (const std::size_t extra = body.remaining(); extra > 1) {
+    if (const auto& warn = current_execution().warning) {
+      warn(path.string() + ": " + std::to_string(extra) +
+           " bytes follow the last element the header declares; ignored");
+    }
+  }
+  return mesh;
 }
 
 }  // namespace focal::io_detail::ply

@@ -194,6 +194,12 @@ printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n' >junk.off
 expect_error "OFF with an element line after the declared ones: an error naming it" 2 \
   "line 7: data after the last of the 3 vertices and 1 faces the header declares: '3'" \
   junk.csv curvature junk.off -o junk.csv
+{ printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n'
+  printf 'property float z\nend_header\n'; head -c 36 /dev/zero; printf 'junk after the data'; } >tail.ply
+run info tail.ply
+check "binary PLY with bytes after its last element: read, with a warning that says how many" \
+  bash -c '[[ $1 -eq 0 ]] && grep -q "^Warning: tail.ply: 19 bytes follow the last element the header declares; ignored" "$2"' \
+  _ "$rc" "$ERR"
 { for t in 0 1 2 3; do printf 'v %d 0 0\nv %d 1 0\nv %d 0 1\n' "$t" "$t" "$t"; done
   printf 'f 1 2 3\nf 4 5 6\nf 7 8 9\nf 10 11 12\n'; } >soup.obj
 run curvature soup.obj -o soup.csv
