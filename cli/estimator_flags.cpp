@@ -39,6 +39,15 @@ void print_summary(const CurvatureResult& r, const Log& log) {
   log.info("  H range: " + range_of(r.H) + "   K range: " + range_of(r.K));
 }
 
+/// Whether some row of N is a normal: finite and not zero.
+bool any_usable_normal(const RowMatrixX3d& N) {
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    const double length = N.row(i).squaredNorm();
+    if (std::isfinite(length) && length > 0.0) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void add_read_flags(CLI::App& command, ReadOptions& read) {
@@ -93,8 +102,12 @@ void EstimatorFlags::add_to(CLI::App& command) {
                    "the paper's method as written (1-ring closed-form two-slit fit of the "
                    "file's normals, else of Max normals) instead of the recommended estimator; "
                    "implied by any of --method --solver --rings --weights --normals");
-  command.add_option("--threads", threads, "worker threads (0 = FOCAL_NUM_THREADS or all)")
+  command.add_option("--threads", threads, "worker threads (0 = FOCAL_NUM_THREADS or every CPU; more than " +
+                         std::to_string(kMaxThreads) + " is clamped to it)")
       ->check(CLI::NonNegativeNumber);
+  command.add_flag("--ignore-normals", ignore_normals,
+                   "read the input as if it had no normals (meshes and clouds): they are "
+                   "estimated, as for a file without normal columns");
   add_read_flags(command, read);
   add_cloud_flags(command);
   command.add_flag("--strict", strict,
@@ -108,8 +121,11 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
                                                             {"jet", CloudNormalMethod::jet}};
   command
       .add_option("--k", cloud.k,
-                  "point clouds: neighbours per point, the k nearest (0 = " +
-                      std::to_string(default_cloud_neighbours) + ", docs/POINTS.md)")
+                  "point clouds: neighbours per point, the k nearest (0 = chosen from the "
+                  "cloud: " +
+                      std::to_string(default_cloud_neighbours) + ", or " +
+                      std::to_string(4 * default_cloud_neighbours) +
+                      " on noisy positions; docs/POINTS.md)")
       ->check(CLI::Range(0, 1024));
   command
       .add_option("--radius", cloud.radius,
@@ -129,7 +145,7 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
   command
       .add_option("--off-surface-ratio", cloud.off_surface_ratio,
                   "point clouds: leave out points farther from the plane of their 16 nearest "
-                  "than this many times those neighbours' median distance to it (0 = off; "
+                  "than this many times those neighbours' RMS distance to it (0 = off; "
                   "docs/POINTS.md)")
       ->default_str(std::to_string(default_off_surface_ratio).substr(0, 4));
   command
@@ -188,6 +204,15 @@ Input::Input(const std::string& path, const EstimatorFlags& flags, const Log& lo
     if (mesh.V.rows() == 0) throw IoError(path + ": no vertices, nothing to compute");
     log.info("  " + std::to_string(mesh.V.rows()) + " vertices, " + std::to_string(mesh.F.rows()) +
              " triangles");
+  }
+  if (flags.ignore_normals) {
+    mesh.N.resize(0, 3);
+  } else if (mesh.has_normals() && !any_usable_normal(mesh.N)) {
+    // Columns of zeros (CGAL's blobby.xyz: x y z 0 0 0) say nothing about the surface: as if
+    // absent, rather than every vertex undefined.
+    log.warning(path + ": every normal in the file is zero or not finite: read as a file without "
+                "normals (they are estimated; --ignore-normals says so without this warning)");
+    mesh.N.resize(0, 3);
   }
   cloud = mesh.is_cloud();
   if (cloud) {

@@ -26,6 +26,7 @@ struct EstimatorFlags {
   int threads = 0;      ///< --threads: every stage of the run (0 = FOCAL_NUM_THREADS or all)
   bool strict = false;  ///< --strict: problems found in the input are errors (input_check.h)
   bool paper = false;   ///< --paper: the paper's method as configured by the options above
+  bool ignore_normals = false;  ///< --ignore-normals: read the input as if it had no normals
   ReadOptions read;     ///< --no-weld, --weld-tolerance (STL)
   /// --method, --solver, --rings, --weights, --normals: giving any selects the paper's method.
   std::vector<CLI::Option*> method_options;

@@ -25,6 +25,7 @@ std::string one_line(const std::string& text) {
 }
 
 void Log::warning(const std::string& message) const {
+  if (progress()) std::fputs("\r\033[K", stderr);  // not after a progress line's text
   std::fprintf(stderr, "Warning: %s\n", one_line(message).c_str());
 }
 
@@ -35,6 +36,7 @@ void Log::info(const std::string& message) const {
 Stage::Stage(const Log& log, std::string name)
     : log_(log), name_(std::move(name)), start_(std::chrono::steady_clock::now()) {
   if (log_.verbose()) watcher_ = std::thread([this] { report_progress(); });
+  if (log_.progress()) progress_.emplace(name_);
 }
 
 void Stage::report_progress() {

@@ -5,10 +5,12 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "focal/core/execution.h"
+#include "progress.h"
 
 namespace focal::cli {
 
@@ -20,16 +22,24 @@ class Log {
  public:
   void set_verbose(bool v) { verbose_ = v; }
   [[nodiscard]] bool verbose() const { return verbose_; }
+  void set_quiet(bool q) { quiet_ = q; }
+  /// Whether long stages draw a progress line (progress.h): stderr is a terminal, no --quiet,
+  /// no -v.
+  [[nodiscard]] bool progress() const {
+    return !quiet_ && !verbose_ && ProgressLine::terminal();
+  }
   void warning(const std::string& message) const;
   void info(const std::string& message) const;  // only with -v
 
  private:
   bool verbose_ = false;
+  bool quiet_ = false;
 };
 
 /// Times one stage; with -v prints "  <name>: <ms> ms" when it ends, and on long runs a line
 /// "  <name>: running for <s> s" every second until then (a watcher thread, started only with
-/// -v, so that a 10 M-vertex run shows it is alive without the library knowing about the log).
+/// -v, so that a 10 M-vertex run shows it is alive without the library knowing about the log);
+/// without -v, on a terminal, the progress line of progress.h.
 class Stage {
  public:
   Stage(const Log& log, std::string name);
@@ -50,6 +60,7 @@ class Stage {
   std::condition_variable done_signal_;
   bool done_ = false;
   std::thread watcher_;
+  std::optional<ProgressLine> progress_;
 };
 
 /// The library's execution callbacks that print through `log` (the thread count is the

@@ -4,9 +4,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "commands.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
+#include "focal/io/interrupted_writes.h"
 #include "log.h"
 
 namespace {
@@ -17,12 +20,21 @@ constexpr int kInternalError = 3;
 
 int run(int argc, char** argv) {
   focal::cli::Log log;
+  // The outermost execution settings of every command: FOCAL_NUM_THREADS read (an error when it
+  // is not a number) and a thread count clamped by a command's scope reported as a warning.
+  focal::Execution settings;
+  settings.warning = [&log](const std::string& message) { log.warning(message); };
+  const focal::ExecutionScope scope(settings);
   CLI::App app{
       "focal: principal curvatures, directions and focal meshes of triangle meshes\n"
       "(Yu et al., Focal Surfaces of Discrete Geometry, SGP 2007)"};
   app.set_version_flag("--version", "focal 0.1.0");
   app.add_flag_callback(
       "-v,--verbose", [&log] { log.set_verbose(true); }, "stage timings and a summary on stderr");
+  app.add_flag_callback(
+      "-q,--quiet", [&log] { log.set_quiet(true); },
+      "no progress line on a terminal (a stage running over a second shows one on stderr: "
+      "stage, seconds, fraction of the pass and the time it has left; never on pipes)");
   // At most one command; "at least one" is checked after parsing, so that a misspelt command is
   // reported by name ("not expected: curvatre") rather than as a missing command.
   app.require_subcommand(0, 1);
@@ -75,6 +87,8 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A run stopped by Ctrl-C or kill leaves no temporary file of the output it was writing.
+  focal::remove_temporary_files_on_signals();
   try {
     return run(argc, argv);
   } catch (const focal::Error& e) {

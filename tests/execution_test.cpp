@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/curvature.h"
@@ -49,6 +51,92 @@ TEST(ExecutionScope, NestedScopesRestoreTheEnclosingOne) {
   EXPECT_EQ(current_execution().threads, 0);
   EXPECT_FALSE(current_execution().warning);
   EXPECT_EQ(warnings, std::vector<std::string>{"from inner"});
+}
+
+/// Sets FOCAL_NUM_THREADS for the lifetime of the object (unset again after).
+struct ThreadsVariable {
+  explicit ThreadsVariable(const char* value) { setenv("FOCAL_NUM_THREADS", value, 1); }
+  ~ThreadsVariable() { unsetenv("FOCAL_NUM_THREADS"); }
+  ThreadsVariable(const ThreadsVariable&) = delete;
+  ThreadsVariable& operator=(const ThreadsVariable&) = delete;
+};
+
+TEST(ThreadRule, CountsAboveTheMaximumAreClampedWithAWarning) {
+  EXPECT_EQ(resolve_threads(7).threads, 7);
+  EXPECT_TRUE(resolve_threads(7).warning.empty());
+  EXPECT_EQ(resolve_threads(kMaxThreads).threads, kMaxThreads);
+  EXPECT_TRUE(resolve_threads(kMaxThreads).warning.empty());
+  const ThreadRequest big = resolve_threads(1000000);
+  EXPECT_EQ(big.threads, kMaxThreads);
+  EXPECT_NE(big.warning.find("1000000 threads asked for"), std::string::npos) << big.warning;
+  EXPECT_EQ(resolve_threads(std::int64_t{1} << 40).threads, kMaxThreads);
+  EXPECT_THROW((void)resolve_threads(-1), InvalidInput);
+  // A scope clamps too and says so through its warning callback; the loops never count more.
+  std::vector<std::string> warnings;
+  const ExecutionScope scope(
+      {.threads = 1000000, .warning = [&](const std::string& w) { warnings.push_back(w); }});
+  EXPECT_EQ(current_execution().threads, kMaxThreads);
+  EXPECT_EQ(detail::thread_count(0), kMaxThreads);
+  EXPECT_EQ(detail::thread_count(1000000), kMaxThreads);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], big.warning);
+}
+
+TEST(ThreadRule, TheVariableFollowsTheSameRuleAndANonNumberIsAnError) {
+  {
+    const ThreadsVariable v("3");
+    EXPECT_EQ(resolve_threads(0).threads, 3);
+    EXPECT_EQ(detail::thread_count(0), 3);
+    EXPECT_EQ(resolve_threads(2).threads, 2);  // a count asked for wins over the variable
+  }
+  {
+    const ThreadsVariable v("1000000");
+    const ThreadRequest r = resolve_threads(0);
+    EXPECT_EQ(r.threads, kMaxThreads);
+    EXPECT_NE(r.warning.find("FOCAL_NUM_THREADS"), std::string::npos) << r.warning;
+    std::vector<std::string> warnings;
+    const ExecutionScope outermost(
+        {.warning = [&](const std::string& w) { warnings.push_back(w); }});
+    EXPECT_EQ(current_execution().threads, kMaxThreads);
+    EXPECT_EQ(warnings.size(), 1u);
+  }
+  {
+    const ThreadsVariable v("99999999999999999999999");  // too many digits: clamped, not an error
+    EXPECT_EQ(resolve_threads(0).threads, kMaxThreads);
+  }
+  for (const char* bad : {"abc", "-2", "1.5", "4x", " 4"}) {
+    const ThreadsVariable v(bad);
+    EXPECT_THROW((void)resolve_threads(0), InvalidInput) << bad;
+    EXPECT_THROW(ExecutionScope({}), InvalidInput) << bad;
+    EXPECT_THROW((void)detail::thread_count(0), InvalidInput) << bad;
+    try {
+      (void)resolve_threads(0);
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    }
+  }
+  {
+    const ThreadsVariable v("");  // empty: as unset
+    EXPECT_EQ(resolve_threads(0).threads, 0);
+  }
+}
+
+TEST(MemoryCheck, ARequestOverWhatIsAvailableIsAClearError) {
+  const std::uint64_t available = detail::available_memory();
+  ASSERT_GT(available, 0u);  // Linux: /proc/meminfo
+  EXPECT_NO_THROW(detail::require_memory(1 << 20, "a small thing"));
+  try {
+    detail::require_memory(std::uint64_t{1} << 62, "a picture of 2^62 bytes");
+    FAIL() << "no error";
+  } catch (const InvalidInput& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("a picture of 2^62 bytes needs about 4.61e+09 GB of memory, more than the "),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find(detail::memory_text(available).substr(0, 2)), std::string::npos) << m;
+  }
+  EXPECT_EQ(detail::memory_text(25'000'000'000), "25 GB");
+  EXPECT_EQ(detail::memory_text(1'500'000), "1.5 MB");
 }
 
 TEST(ExecutionScope, NegativeThreadsThrowAndLeaveTheScopeAsItWas) {

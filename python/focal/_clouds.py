@@ -1,6 +1,6 @@
 """Point clouds: curvature and normals of points without connectivity.
 
-``focal.cloud_curvature(points, normals=None, k=16)`` takes what Open3D, trimesh or a scanner
+``focal.cloud_curvature(points, normals=None)`` takes what Open3D, trimesh or a scanner
 gives (``np.asarray(pcd.points)``, ``np.asarray(pcd.normals)``; ``trimesh.PointCloud.vertices``)
 and returns the same ``Curvature`` as ``focal.curvature`` on a mesh. ``focal.read_mesh`` reads a
 cloud file (PLY/OBJ without faces, PCL's .pcd, LAS, .xyz .xyzn .xyzrgb .pts .txt .csv text)
@@ -16,7 +16,7 @@ import numpy as np
 
 from . import _focal_ext as _ext
 from ._errors import InvalidInputError
-from ._inputs import _as_rows, _shape_error, _threads
+from ._inputs import _as_rows, _finite_positions, _shape_error, _threads, _usable_normals, _whole
 from ._results import Curvature
 
 
@@ -28,8 +28,10 @@ def _cloud_arguments(
     threads: Optional[int],
 ):
     P = _as_rows(points, "points", np.float64)
-    if int(k) < 0:
-        raise InvalidInputError(f"k must be >= 0 (0: the default), got {k}")
+    if P.shape[0] == 0:
+        raise InvalidInputError("no points (no vertices), nothing to compute")
+    # The range of the command line's --k.
+    k = _whole(k, "k", 0, 1024, " (0: chosen from the cloud)")
     r = 0.0 if radius is None else float(radius)
     if radius is not None and not r > 0.0:
         raise InvalidInputError(f"radius must be None or > 0, got {radius}")
@@ -49,7 +51,7 @@ def cloud_curvature(
     points: Any,
     normals: Any = None,
     *,
-    k: int = 16,
+    k: int = 0,
     radius: Optional[float] = None,
     adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
@@ -67,8 +69,10 @@ def cloud_curvature(
     points : (n, 3) positions. normals : (n, 3) outward normals (need not be unit), or None:
         estimated (PCA, oriented by a minimum spanning tree or towards ``viewpoint``, then a
         quadratic jet; ``normal_method="pca"`` stops after PCA).
-    k : neighbours per point (the k nearest; 0 = the library default, 16). radius : the
-        neighbours within this distance instead (at most 1024, the nearest).
+    k : neighbours per point, the k nearest; 0 (the default, as ``focal curvature``): chosen
+        from the cloud (16, or 64 where the positions are noisy; the cloud's normals where they
+        agree with jets; include/focal/curvature/cloud_curvature.h, docs/POINTS.md).
+        radius : the neighbours within this distance instead (at most 1024, the nearest).
     adaptive_radius : c: the neighbours within c times the local spacing instead (the median,
         over the point and its k nearest, of their distances to their k-th nearest; docs/POINTS.md).
     viewpoint : (x, y, z) the scanner position: estimated normals face it.
@@ -94,6 +98,8 @@ def cloud_curvature(
         N = _as_rows(normals, "normals", np.float64)
         if N.shape[0] != P.shape[0]:
             raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
+        N = _usable_normals(N, "normals")
+    _finite_positions(P, "points")
     d = _ext.cloud_curvature(
         P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio),
         float(off_surface_ratio), t
@@ -104,15 +110,17 @@ def cloud_curvature(
 def cloud_normals(
     points: Any,
     *,
-    k: int = 16,
+    k: int = 0,
     radius: Optional[float] = None,
     adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
     threads: Optional[int] = None,
 ) -> np.ndarray:
-    """(n, 3) unit normals of a point cloud, estimated and consistently oriented (as
-    cloud_curvature estimates them; include/focal/normals/cloud_normals.h). NaN rows where a
-    point has fewer than two neighbours."""
+    """(n, 3) unit normals of a point cloud, estimated and consistently oriented, as
+    ``focal normals`` and cloud_curvature estimate them (k=0: the default's plan, jets over 16
+    neighbours or 64 on noisy positions, NaN rows for the outliers it leaves out; k, radius or
+    adaptive_radius: PCA then jets over those; include/focal/curvature/cloud_curvature.h,
+    estimate_cloud_normals). NaN rows where a point has fewer than two neighbours."""
     P, k, r, a, t = _cloud_arguments(points, k, radius, adaptive_radius, threads)
     return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), t)

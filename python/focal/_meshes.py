@@ -12,23 +12,33 @@ import numpy as np
 from . import _focal_ext as _ext
 from ._clouds import _cloud_arguments, _viewpoint
 from ._errors import InvalidInputError
-from ._inputs import _as_rows, _mesh_arrays, _shape_error, _threads, _vector
+from ._inputs import (
+    _as_rows,
+    _finite_positions,
+    _int32,
+    _mesh_arrays,
+    _shape_error,
+    _threads,
+    _usable_normals,
+    _vector,
+    _whole,
+)
 from ._results import Curvature, FocalMesh, FocalMeshes, Mesh, MeshFindings, Surface
 
 
-def read_mesh(path: "str | os.PathLike", *, threads: Optional[int] = None) -> Mesh:
+def read_mesh(path: "str | bytes | os.PathLike", *, threads: Optional[int] = None) -> Mesh:
     """Reads an OBJ, PLY (ascii or binary), OFF or STL mesh; the format comes from the extension.
 
     Vertex order and count are those of the file; polygons are fan-triangulated; normals are
     read when the file has them (``Mesh.N``, else None). Raises FocalIOError naming the file
     and the line, byte offset or element of the problem.
     """
-    d = _ext.read_mesh(os.fspath(path), _threads(threads))
+    d = _ext.read_mesh(os.fsencode(path), _threads(threads))
     return Mesh(d["V"], d["F"], d["N"])
 
 
 def write_mesh(
-    path: "str | os.PathLike", V: Any, F: Any, N: Any = None, *, float32: bool = False
+    path: "str | bytes | os.PathLike", V: Any, F: Any, N: Any = None, *, float32: bool = False
 ) -> None:
     """Writes V (n, 3), F (m, 3) and optionally N (n, 3) as .ply (binary), .obj or .off, chosen
     by the extension. Numbers are written so that they read back exactly; with ``float32`` as
@@ -36,7 +46,7 @@ def write_mesh(
     written through a temporary and renamed, so a failed write leaves nothing behind. Raises
     InvalidInputError for invalid arrays, FocalIOError on failure or for .stl."""
     Va, Fa, Na = _mesh_arrays(V, F, N)
-    _ext.write_mesh(os.fspath(path), Va, Fa, Na, bool(float32))
+    _ext.write_mesh(os.fsencode(path), Va, Fa, Na, bool(float32))
 
 
 def write_fields(
@@ -62,8 +72,8 @@ def write_fields(
     ``curvature.N``) where it reports them, else F and N as given. Written to a temporary file
     and renamed. Raises InvalidInputError for arrays that do not match, FocalIOError on failure.
     """
-    path = os.fspath(path)
-    ext = os.path.splitext(path)[1].lower()
+    path = os.fsencode(path)
+    ext = os.fsdecode(os.path.splitext(path)[1]).lower()
     n = np.asarray(curvature.k1).shape[0]
     fields = {name: _vector(getattr(curvature, name), name, n, dtype) for name, dtype in (
         ("k1", np.float64), ("k2", np.float64), ("H", np.float64), ("K", np.float64),
@@ -79,7 +89,9 @@ def write_fields(
         _ext.write_fields(path, fields, None, None, None, True, _threads(threads), bool(float32))
         return
     if ext != ".ply":
-        raise InvalidInputError(f"{path}: fields are written as .csv or .ply, not {ext!r}")
+        raise InvalidInputError(
+            f"{os.fsdecode(path)}: fields are written as .csv or .ply, not {ext!r}"
+        )
     if V is None or F is None:
         raise InvalidInputError("write_fields to .ply needs the mesh: V and F")
     used_F = curvature.F if curvature.F is not None else F
@@ -143,6 +155,10 @@ def _estimate_options(estimator: str, threads: Optional[int], options: dict) -> 
     o = dict(options)
     o["estimator"] = estimator
     o["threads"] = _threads(threads)
+    # As the command line's --rings (1 to 16); the other whole numbers as the C++ int holds them.
+    o["rings"] = _whole(o["rings"], "rings", 1, 16)
+    for name in ("lm_initial_angles", "lm_max_iterations"):
+        o[name] = _int32(o[name], name)
     return o
 
 
@@ -274,7 +290,7 @@ def curvature(
     }
     o = _estimate_options(estimator, threads, options)
     o["device"] = str(device)
-    o["tile_vertices"] = int(tile_vertices)
+    o["tile_vertices"] = _whole(tile_vertices, "tile_vertices", 0, 2**31 - 1)
     if F is None:
         defaults = {**_PAPER_OPTIONS, **_COMMON_OPTIONS}
         given = [name for name in _MESH_ONLY if options[name] != defaults[name]]
@@ -289,6 +305,8 @@ def curvature(
         if given:
             raise InvalidInputError(f"{', '.join(given)}: option(s) of point clouds (F=None)")
     Va, Fa, Na = _mesh_arrays(V, F, N)
+    _finite_positions(Va, "V")
+    Na = _usable_normals(Na, "N")
     d = _ext.curvature(Va, Fa, Na, o)
     for message in d.pop("warnings"):
         warnings.warn(message, stacklevel=2)
@@ -364,6 +382,8 @@ def generate_surface(
     ``triangulation`` "regular" or "irregular" (random, from ``seed``); shape parameters a, b,
     c (0: each surface's default, e.g. sphere radius a = 1). See include/focal/surfaces/surfaces.h.
     """
-    d = _ext.generate_surface(str(kind), str(triangulation), int(n), int(seed), float(a),
-                              float(b), float(c))
+    # The range of `focal generate --vertices`.
+    vertices = _whole(n, "n", 16, 100_000_000, " vertices")
+    d = _ext.generate_surface(str(kind), str(triangulation), vertices,
+                              _whole(seed, "seed", 0, 2**64 - 1), float(a), float(b), float(c))
     return Surface(**d)

@@ -9,7 +9,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _focal_ext as _ext
-from ._inputs import _as_rows, _mesh_arrays, _shape_error, _threads, _vector
+from ._inputs import _as_rows, _int32, _mesh_arrays, _shape_error, _threads, _vector
 from ._results import FocalMeshes
 
 
@@ -125,19 +125,19 @@ def render(
     options = _camera_options(Va, azimuth, elevation, orthographic, field_of_view, margin, eye,
                               target, up, half_extent)
     options.update(
-        width=int(width),
-        height=int(height),
+        width=_int32(width, "width"),
+        height=_int32(height, "height"),
         colour_map=str(colour_map),
         range=None if range is None else (float(range[0]), float(range[1])),
         range_percentile=float(range_percentile),
         title=str(title),
-        glyph_count=int(glyph_count),
+        glyph_count=_int32(glyph_count, "glyph_count"),
         splat_radius=float(splat_radius),
-        samples=int(samples),
+        samples=_int32(samples, "samples"),
         threads=_threads(threads),
     )
     return _ext.render(Va, Fa, Na, values, options, dirs, gammas,
-                       None if path is None else os.fspath(path))
+                       None if path is None else os.fsencode(path))
 
 
 def rasterise_gbuffer(
@@ -165,5 +165,5 @@ def rasterise_gbuffer(
     Na = _normals_for_picture(Va, Fa, N)
     options = _camera_options(Va, azimuth, elevation, orthographic, field_of_view, margin, eye,
                               target, up, half_extent)
-    options.update(width=int(width), height=int(height))
+    options.update(width=_int32(width, "width"), height=_int32(height, "height"))
     return GBuffer(**_ext.rasterise_gbuffer(Va, Fa, Na, options))

@@ -38,6 +38,22 @@ FIELDS = stream.FIELDS
 
 __all__ = ["cloud_curvature", "curvature", "curvature_stream", "main"]
 
+#: What is missing when Dask is not installed, in one line.
+_NO_DASK = ("focal.distributed needs Dask (the distributed package): "
+            "pip install 'focal-surfaces[distributed]'")
+
+
+def _dask():
+    """The ``distributed`` module, or a one-line ModuleNotFoundError naming the extra that
+    installs it."""
+    try:
+        import distributed
+    except ModuleNotFoundError as e:
+        if e.name not in ("distributed", "dask"):
+            raise
+        raise ModuleNotFoundError(_NO_DASK, name="distributed") from None
+    return distributed
+
 #: Tasks in flight per worker thread: enough to keep workers busy while results come back,
 #: few enough that the scheduler holds only a few tiles' arrays.
 _TASKS_PER_THREAD = 2
@@ -75,7 +91,7 @@ def _mesh_of(path_or_arrays: Any):
 
 
 def _local_client(workers: Optional[int], memory_limit: Any):
-    from distributed import Client, LocalCluster
+    Client, LocalCluster = _dask().Client, _dask().LocalCluster
 
     cluster = LocalCluster(
         n_workers=workers or os.cpu_count() or 1,
@@ -165,7 +181,7 @@ def cloud_curvature(
     retries: int = 2,
     progress: bool = False,
     on_tile: Optional[Callable[[int, np.ndarray, dict], None]] = None,
-    k: int = 16,
+    k: int = 0,
     radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Any = None,
@@ -218,7 +234,7 @@ def _run_tiles(tiles: list, task: Callable[[dict], tuple], n: int, client: Any,
     """Runs task(tile) = (function, arguments) of every tile on `client` (None: a LocalCluster,
     closed at the end), a few per worker thread in flight, and writes each result's owned rows
     into the fields of n vertices, which it returns."""
-    from distributed import as_completed
+    as_completed = _dask().as_completed
 
     out = _empty_fields(n)
     cluster = None
@@ -242,7 +258,7 @@ def _run_tiles(tiles: list, task: Callable[[dict], tuple], n: int, client: Any,
 
         first = [submit(i) for i in range(min(in_flight, len(tiles)))]
         if progress:
-            from distributed import progress as dask_progress
+            dask_progress = _dask().progress
 
             dask_progress(first)
         pending = as_completed(first, with_results=True)
@@ -303,7 +319,7 @@ def curvature_stream(
     import json
     import time
 
-    from distributed import as_completed
+    as_completed = _dask().as_completed
 
     own_cluster = client is None
     if own_cluster and options.get("threads") is None:
@@ -338,7 +354,7 @@ def curvature_stream(
                                  key=f"focal-stream-{name}-{t}-{uuid.uuid4().hex}")
                    for t in range(plan["tile_count"])]
         if progress:
-            from distributed import progress as dask_progress
+            dask_progress = _dask().progress
 
             dask_progress(futures)
         return sorted((r for _, r in as_completed(futures, with_results=True)),
@@ -461,9 +477,7 @@ def main(argv: Optional[list] = None) -> int:
     client = None
     try:
         if args.scheduler:
-            from distributed import Client
-
-            client = Client(args.scheduler)
+            client = _dask().Client(args.scheduler)
         common = dict(tile_vertices=args.tile_vertices, workers=args.workers,
                       memory_limit=args.memory_limit, progress=args.progress,
                       threads=args.threads, estimator="paper" if args.paper else "recommended")
@@ -475,7 +489,7 @@ def main(argv: Optional[list] = None) -> int:
             if mesh.F.shape[0] == 0:
                 common["k"] = 0  # a cloud: the library's default plan, as `focal curvature`'s
             _write_fields(args.output, curvature(mesh, client, **common))
-    except (focal.FocalIOError, focal.InvalidInputError, OSError) as e:
+    except (focal.FocalIOError, focal.InvalidInputError, OSError, ModuleNotFoundError) as e:
         print(f"Error: {e}", file=sys.stderr)
         return 2
     finally:

@@ -48,6 +48,7 @@ import numpy as np
 
 import focal
 from focal import _focal_ext as _ext
+from focal._errors import InvalidInputError
 
 __all__ = ["plan", "estimate_tile", "concatenate"]
 
@@ -62,7 +63,13 @@ FIELDS = ("k1", "k2", "H", "K", "d1", "d2", "residual", "point_class", "rays_use
 def _open(path: "str | os.PathLike"):
     """The mesh file's reader (focal::PlyTriangleReader): its header read and checked, the
     records read by ranges or ids, never all at once."""
-    return _ext.PlyTriangleReader(os.fspath(path))
+    name = os.fspath(path)
+    if os.path.splitext(os.fsdecode(name))[1].lower() != ".ply":
+        raise InvalidInputError(
+            f"{os.fsdecode(name)}: streamed tiles (--parts, curvature_stream) read binary PLY "
+            "only; convert it to binary PLY first (focal.write_mesh) or run without --parts"
+        )
+    return _ext.PlyTriangleReader(name)
 
 
 def _ids(x: np.ndarray) -> np.ndarray:

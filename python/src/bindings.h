@@ -97,6 +97,10 @@ focal::EstimateOptions estimate_options(const nb::dict& o);
 /// (clouds.cpp; its "threads" is the caller's ExecutionScope's).
 focal::CloudOptions cloud_options_from(const nb::dict& d);
 
+/// A file name as the package passes it: os.fsencode's bytes (str, bytes and os.PathLike; a
+/// name that is not UTF-8 keeps its bytes), the bytes the operating system takes.
+inline std::string path_of(const nb::bytes& path) { return {path.c_str(), path.size()}; }
+
 inline std::optional<focal::NormalsRef> normals_ref(const std::optional<DoubleRows>& N) {
   if (!N) return std::nullopt;
   return focal::NormalsRef(view(*N));

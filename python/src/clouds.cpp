@@ -89,7 +89,8 @@ nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adapt
   {
     nb::gil_scoped_release release;
     const focal::ExecutionScope scope({.threads = threads});
-    N = focal::cloud_normals(view(V), focal::cloud_neighbourhoods(view(V), o), o.normals);
+    // What `focal normals` runs on a cloud: the default's plan for k = 0, else those neighbours.
+    N = focal::estimate_cloud_normals(view(V), std::nullopt, o);
   }
   return nb::cast(to_numpy(std::move(N)));
 }

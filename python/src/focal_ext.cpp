@@ -13,8 +13,13 @@
 // Nothing in src/ includes these files: the bindings are the top layer.
 
 #include <nanobind/nanobind.h>
+#include <nanobind/stl/string.h>
+
+#include <cstdint>
+#include <cstring>
 
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 
 namespace nb = nanobind;
 
@@ -36,17 +41,32 @@ PyObject* io_error = nullptr;
 PyObject* device_error = nullptr;
 PyObject* focal_error = nullptr;
 
+/// Raises `type` with `message`, whose bytes need not be UTF-8 (a file name that is not keeps
+/// its bytes as \x escapes rather than failing the raise).
+void raise(PyObject* type, const char* message) {
+  PyObject* text = PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)),
+                                        "backslashreplace");
+  if (text == nullptr) return;  // the decoding error is set instead
+  PyErr_SetObject(type, text);
+  Py_DECREF(text);
+}
+
 void translate_errors(const std::exception_ptr& p, void*) {
   try {
     std::rethrow_exception(p);
   } catch (const focal::InvalidInput& e) {
-    PyErr_SetString(invalid_input_error ? invalid_input_error : PyExc_ValueError, e.what());
+    raise(invalid_input_error ? invalid_input_error : PyExc_ValueError, e.what());
   } catch (const focal::IoError& e) {
-    PyErr_SetString(io_error ? io_error : PyExc_OSError, e.what());
+    raise(io_error ? io_error : PyExc_OSError, e.what());
   } catch (const focal::DeviceError& e) {
-    PyErr_SetString(device_error ? device_error : PyExc_RuntimeError, e.what());
+    raise(device_error ? device_error : PyExc_RuntimeError, e.what());
   } catch (const focal::Error& e) {
-    PyErr_SetString(focal_error ? focal_error : PyExc_RuntimeError, e.what());
+    raise(focal_error ? focal_error : PyExc_RuntimeError, e.what());
+  } catch (const nb::cast_error&) {
+    // An option of the wrong type or out of the C++ type's range that the package let through
+    // (it checks every one it knows): a bad input, not an internal error.
+    raise(invalid_input_error ? invalid_input_error : PyExc_ValueError,
+          "an option's value has the wrong type or does not fit the library's integer type");
   }
 }
 
@@ -64,6 +84,11 @@ NB_MODULE(_focal_ext, m) {
           focal_error = base.inc_ref().ptr();
         });
   nb::register_exception_translator(&translate_errors);
+  // The one thread rule (focal/core/execution.h) for every threads= of the package.
+  m.def("_resolve_threads", [](std::int64_t requested) {
+    const focal::ThreadRequest r = focal::resolve_threads(requested);
+    return nb::make_tuple(r.threads, r.warning);
+  });
 
   focal_python::bind_meshes(m);
   focal_python::bind_render(m);

@@ -295,7 +295,8 @@ nb::ndarray<nb::numpy, double> vertex_normals(const DoubleRows& V, const IntRows
   return to_numpy(std::move(N));
 }
 
-nb::dict read_mesh(const std::string& path, int threads) {
+nb::dict read_mesh(const nb::bytes& path_bytes, int threads) {
+  const std::string path = path_of(path_bytes);
   focal::Mesh mesh;
   {
     nb::gil_scoped_release release;
@@ -309,8 +310,9 @@ focal::Precision precision_of(bool float32) {
   return float32 ? focal::Precision::float32 : focal::Precision::float64;
 }
 
-void write_mesh(const std::string& path, const DoubleRows& V, const IntRows& F,
+void write_mesh(const nb::bytes& path_bytes, const DoubleRows& V, const IntRows& F,
                 const std::optional<DoubleRows>& N, bool float32) {
+  const std::string path = path_of(path_bytes);
   nb::gil_scoped_release release;
   // The writers take a Mesh, which owns its arrays: one copy, made here.
   focal::Mesh mesh;
@@ -345,9 +347,10 @@ focal::CurvatureResult curvature_result(const nb::dict& c) {
 
 /// focal.write_fields: the files of `focal curvature -o` (.csv, or .ply with the mesh). The
 /// writers take owning structs: the arrays are copied once, here.
-void write_fields(const std::string& path, const nb::dict& fields,
+void write_fields(const nb::bytes& path_bytes, const nb::dict& fields,
                   const std::optional<DoubleRows>& V, const std::optional<IntRows>& F,
                   const std::optional<DoubleRows>& N, bool binary, int threads, bool float32) {
+  const std::string path = path_of(path_bytes);
   const focal::CurvatureResult r = curvature_result(fields);
   const focal::VectorXu8 crease = fields.contains("crease")
                                       ? vector_of<focal::VectorXu8, std::uint8_t>(fields["crease"])

@@ -61,7 +61,9 @@ nb::ndarray<nb::numpy, std::uint8_t> render(const DoubleRows& V, const IntRows& 
                                             const nb::dict& o,
                                             const std::optional<DoubleRows>& directions,
                                             const std::optional<nb::tuple>& gammas,
-                                            const std::optional<std::string>& path) {
+                                            const std::optional<nb::bytes>& path_bytes) {
+  const std::optional<std::string> path =
+      path_bytes ? std::optional<std::string>(path_of(*path_bytes)) : std::nullopt;
   static const std::pair<const char*, focal::ColourMap> maps[] = {
       {"diverging", focal::ColourMap::diverging}, {"classes", focal::ColourMap::classes}};
   focal::FieldPictureOptions p;

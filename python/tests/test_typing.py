@@ -47,4 +47,4 @@ def test_mypy_checks_a_use_of_the_api(tmp_path):
     errors = [line for line in r.stdout.splitlines() if ": error:" in line]
     assert len(errors) == 2, r.stdout + r.stderr
     assert "use_focal.py:11:" in errors[0] and "Curvature" in errors[0], errors[0]
-    assert "use_focal.py:12:" in errors[1] and '"str"' in errors[1], errors[1]
+    assert "use_focal.py:12:" in errors[1] and '"bytes"' in errors[1], errors[1]

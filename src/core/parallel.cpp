@@ -8,11 +8,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <condition_variable>
 #include <cstdlib>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <utility>
 
@@ -25,11 +28,61 @@ namespace {
 /// The innermost ExecutionScope's Execution on this thread (null: none); on a pool worker, that
 /// of the loop it is working on.
 thread_local const Execution* t_execution = nullptr;
+
+/// `requested` > 0 clamped to kMaxThreads; `what` names it in the warning.
+ThreadRequest clamped(std::int64_t requested, const std::string& what) {
+  ThreadRequest r;
+  r.threads = static_cast<int>(std::min<std::int64_t>(requested, kMaxThreads));
+  if (requested > kMaxThreads) {
+    r.warning = what + ": " + std::to_string(requested) + " threads asked for, more than the " +
+                std::to_string(kMaxThreads) + " focal uses (the pool has one per CPU, here " +
+                std::to_string(detail::available_cpus()) + "): using " +
+                std::to_string(kMaxThreads);
+  }
+  return r;
+}
+
+/// FOCAL_NUM_THREADS resolved (0 when unset, empty or 0). \throw InvalidInput when it is not a
+/// whole number >= 0.
+ThreadRequest environment_threads() {
+  const char* env = std::getenv("FOCAL_NUM_THREADS");
+  if (env == nullptr || *env == '\0') return {};
+  const std::string_view text(env);
+  std::int64_t n = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (error == std::errc::result_out_of_range && text.front() != '-') {
+    n = std::numeric_limits<std::int64_t>::max();  // all digits, too many: clamped below
+  } else if (error != std::errc{} || end != text.data() + text.size() || n < 0) {
+    throw InvalidInput("FOCAL_NUM_THREADS='" + std::string(text) +
+                       "' is not a thread count (a whole number >= 0; 0 or unset: every CPU)");
+  }
+  return clamped(n, "FOCAL_NUM_THREADS");
+}
+
 }  // namespace
+
+ThreadRequest resolve_threads(std::int64_t requested) {
+  if (requested < 0) {
+    throw InvalidInput("threads must be >= 0 (0: every CPU), got " + std::to_string(requested));
+  }
+  if (requested == 0) return environment_threads();
+  return clamped(requested, "threads");
+}
 
 ExecutionScope::ExecutionScope(const Execution& execution)
     : execution_(execution), enclosing_(t_execution) {
-  if (execution.threads < 0) throw InvalidInput("ExecutionScope: threads must be >= 0");
+  // The outermost scope also reads FOCAL_NUM_THREADS, so that a bad value is an error at the
+  // call rather than a thread count silently ignored.
+  if (execution.threads != 0 || enclosing_ == nullptr) {
+    const ThreadRequest r = resolve_threads(execution.threads);
+    execution_.threads = r.threads;
+    if (!r.warning.empty()) {
+      const auto& warn = execution.warning ? execution.warning
+                         : enclosing_ != nullptr ? enclosing_->warning
+                                                 : execution.warning;
+      if (warn) warn(r.warning);
+    }
+  }
   if (enclosing_ != nullptr) {
     // Fields left at their defaults are the enclosing scope's.
     if (execution_.threads == 0) execution_.threads = enclosing_->threads;
@@ -63,6 +116,7 @@ struct Job {
   /// The caller's current Execution: current on each worker while it takes chunks, so that a
   /// loop's body sees the settings of the thread that started the loop.
   const Execution* execution = nullptr;
+  bool outermost = false;  ///< counted in pass_progress
   std::atomic<std::int64_t> next{0};
   int joined = 0;            ///< workers that joined; guarded by Pool::mutex
   int inside = 0;            ///< workers still working on it; guarded by Pool::mutex
@@ -71,6 +125,11 @@ struct Job {
 };
 
 thread_local int t_slot = 0;   // worker_slot()
+
+// pass_progress(): the outermost pass's chunk counts (relaxed: a display reads them).
+std::atomic<std::int64_t> g_pass_done{0};
+std::atomic<std::int64_t> g_pass_total{0};
+std::atomic<std::uint64_t> g_pass_count{0};
 thread_local int t_depth = 0;  // > 0 while running chunks: a nested loop runs serially
 
 /// Takes chunks of `job` until none is left, as worker `slot` of it.
@@ -81,6 +140,7 @@ void take_chunks(Job& job, int slot) {
   for (std::int64_t c; (c = job.next.fetch_add(1, std::memory_order_relaxed)) < job.chunks;) {
     try {
       (*job.chunk)(c);
+      if (job.outermost) g_pass_done.fetch_add(1, std::memory_order_relaxed);
     } catch (...) {
       const std::scoped_lock lock(job.error_mutex);
       if (!job.error) job.error = std::current_exception();
@@ -163,17 +223,20 @@ int available_cpus() {
 }
 
 int thread_count(int requested) {
-  if (requested > 0) return requested;
+  if (requested > 0) return std::min(requested, kMaxThreads);
   if (const int scoped = current_execution().threads; scoped > 0) return scoped;
-  if (const char* env = std::getenv("FOCAL_NUM_THREADS")) {
-    const int n = std::atoi(env);
-    if (n > 0) return n;
-  }
+  if (const int env = environment_threads().threads; env > 0) return env;
   static const int cpus = available_cpus();
   return cpus;
 }
 
 int worker_slot() { return t_slot; }
+
+PassProgress pass_progress() {
+  return {g_pass_done.load(std::memory_order_relaxed),
+          g_pass_total.load(std::memory_order_relaxed),
+          g_pass_count.load(std::memory_order_relaxed)};
+}
 
 void parallel_chunks(std::int64_t chunks, int threads,
                      const std::function<void(std::int64_t)>& chunk) {
@@ -196,6 +259,10 @@ void parallel_chunks(std::int64_t chunks, int threads,
   job.chunk = &chunk;
   job.max_helpers = t - 1;
   job.execution = t_execution;
+  job.outermost = true;  // t_depth == 0 here: a nested loop ran serially above
+  g_pass_done.store(0, std::memory_order_relaxed);
+  g_pass_total.store(chunks, std::memory_order_relaxed);
+  g_pass_count.fetch_add(1, std::memory_order_relaxed);
   Pool::instance().run(job);
 }
 

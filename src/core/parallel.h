@@ -31,10 +31,21 @@ namespace focal::detail {
 /// CPUs this process may run on (its affinity mask), at least 1.
 int available_cpus();
 
-/// Threads to use: `requested` if > 0, else the current ExecutionScope's threads if > 0
+/// Threads to use: `requested` if > 0 (at most kMaxThreads), else the current ExecutionScope's threads if > 0
 /// (focal/core/execution.h), else FOCAL_NUM_THREADS if set, else available_cpus().
 /// At most this many threads work on one loop; fewer when the process-wide pool is busy.
 int thread_count(int requested);
+
+/// How far the outermost parallel pass (parallel_chunks, or parallel_for / _blocks over more
+/// than 1024 elements on more than one thread) started most recently in this process has come:
+/// chunks done of its total (0 of 0 before any). For a progress display only (a watcher thread
+/// may read it at any time); never for results.
+struct PassProgress {
+  std::int64_t done = 0;
+  std::int64_t total = 0;
+  std::uint64_t pass = 0;  ///< counts the passes started, so that a reader sees a new one
+};
+[[nodiscard]] PassProgress pass_progress();
 
 /// Index of the calling thread within the loop it is working on, in [0, thread_count(threads))
 /// of that loop (0 on the caller, and on any thread outside a loop). For per-thread scratch

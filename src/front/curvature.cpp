@@ -1,6 +1,7 @@
 #include "focal/curvature.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -92,8 +93,15 @@ void report_recommended(bool has_normals, const Estimate& e, const Execution& ex
                         "the file normals' side");
   }
   std::ostringstream plan;
-  plan << "  recommended estimator: " << normals_used(e) << ", jet residual " << e.plan.noise
-       << ", position noise " << e.plan.position_noise << " x edge length, " << e.plan.rings
+  plan << "  recommended estimator: " << normals_used(e);
+  if (std::isnan(e.plan.noise) && std::isnan(e.plan.position_noise)) {
+    // No vertex had a jet (every one over the neighbourhood cap, or too few neighbours).
+    plan << ", no jet fitted (noise unknown: the 1-ring plan)";
+  } else {
+    plan << ", jet residual " << e.plan.noise << ", position noise " << e.plan.position_noise
+         << " x edge length";
+  }
+  plan << ", " << e.plan.rings
        << "-ring " << (e.plan.gaussian ? "Gaussian-weighted " : "") << "fit";
   inform(execution, plan.str());
 }
@@ -126,6 +134,21 @@ bool may_be_crowded(const PreparedMesh& mesh, int rings) {
   return total > kMaxNeighbourhoodSize;
 }
 
+/// Whether every vertex is a corner of at most one triangle (a soup of unwelded triangles, as
+/// an OBJ or PLY exporter writes without shared vertices): no vertex has a neighbour's ray.
+bool shares_no_vertex(const PreparedMesh& mesh) {
+  std::vector<char> used(static_cast<std::size_t>(mesh.vertex_count()), 0);
+  const auto F = mesh.F();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      char& u = used[static_cast<std::size_t>(F(f, c))];
+      if (u != 0 && F(f, c) != F(f, (c + 2) % 3) && F(f, c) != F(f, (c + 1) % 3)) return false;
+      u = 1;
+    }
+  }
+  return F.rows() > 1;  // one triangle alone is no soup
+}
+
 /// Counts the vertices without an estimate and, where that can explain them, those over the
 /// neighbourhood cap, and warns about both.
 void count_undefined(const PreparedMesh& mesh, const EstimateOptions& o, Estimate& e) {
@@ -154,8 +177,11 @@ void count_undefined(const PreparedMesh& mesh, const EstimateOptions& o, Estimat
   const auto n = static_cast<std::int64_t>(e.curvature.point_class.size());
   if (e.undefined_count > 0 && e.undefined_count == n) {
     warn(execution, "every vertex is undefined (" + std::to_string(e.undefined_count) + ")" +
-                        (e.crowded_count > 0
-                             ? ""
+                        (e.crowded_count > 0 ? ""
+                         : shares_no_vertex(mesh)
+                             ? ": no two triangles share a vertex (a triangle soup: each "
+                               "triangle has corners of its own; weld equal positions into one "
+                               "vertex, e.g. write it as STL and read it back)"
                              : ": no vertex has two neighbour rays to fit (a mesh this coarse, "
                                "with neighbouring normals 90 degrees or more apart, has none)"));
   }

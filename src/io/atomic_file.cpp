@@ -54,9 +54,11 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
     if (ec) fail(target, "is a symbolic link to a missing file or folder; not written");
   }
   file_ = open_temporary(target_, temporary_);
+  slot_ = register_temporary(temporary_.c_str());
 }
 
 AtomicFile::~AtomicFile() {
+  release_temporary(slot_);
   if (committed_) return;
   if (file_ != nullptr) std::fclose(file_);
   std::error_code ignored;
@@ -68,7 +70,7 @@ void AtomicFile::commit() {
   std::error_code ec;
   std::filesystem::rename(temporary_, target_, ec);
   if (ec) fail(target_, "cannot replace the file: " + ec.message());
-  committed_ = true;
+  mark_committed();
 }
 
 void AtomicFile::finish() {

@@ -25,8 +25,20 @@
 
 namespace focal::io_detail {
 
+/// The longest temporary path (with its terminating zero) that a signal handler can remove.
+inline constexpr std::size_t kMaxRegisteredPath = 4096;
+
+/// Puts `path` in the table that the handlers of remove_temporary_files_on_signals
+/// (focal/io/interrupted_writes.h) unlink; returns its slot, or -1 when the table is full or the
+/// path too long (then a signal leaves that file, as without the handlers). Thread-safe.
+int register_temporary(const char* path);
+/// Takes slot `slot` (of register_temporary; -1: nothing) out of the table. Thread-safe.
+void release_temporary(int slot);
+
 /// A temporary file that becomes `target` on commit(). Destroyed without commit() (an exception
-/// on the way), it closes and removes the temporary file; `target` is not touched.
+/// on the way), it closes and removes the temporary file; `target` is not touched. While it
+/// exists, its path is in the table of register_temporary, so that a SIGINT or SIGTERM removes it
+/// too (when the program installed remove_temporary_files_on_signals).
 class AtomicFile {
  public:
   /// Creates the temporary file.
@@ -52,13 +64,19 @@ class AtomicFile {
   [[nodiscard]] const std::filesystem::path& target() const { return target_; }
   [[nodiscard]] const std::filesystem::path& temporary() const { return temporary_; }
   /// The temporary file has been renamed to the target (by its owner): do not remove it.
-  void mark_committed() { committed_ = true; }
+  void mark_committed() {
+    committed_ = true;
+    // Renamed: a signal now must not remove the path (nothing is there, or another writer's).
+    release_temporary(slot_);
+    slot_ = -1;
+  }
 
  private:
   std::filesystem::path target_;
   std::filesystem::path temporary_;
   std::FILE* file_ = nullptr;
   bool committed_ = false;
+  int slot_ = -1;  ///< of register_temporary
 };
 
 /// Buffered output to an AtomicFile, for writers that format into memory.

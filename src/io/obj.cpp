@@ -11,6 +11,7 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/io/mesh_io.h"
 #include "io/atomic_file.h"
 #include "io/file_bytes.h"
@@ -429,13 +430,29 @@ std::optional<Mesh> parse_obj_in_chunks(const std::filesystem::path& path, std::
   return obj_mesh(path, *runs, threads);
 }
 
+namespace {
+
+/// A file without faces whose last line has no end is most likely an OBJ cut inside its vertex
+/// block, not a point cloud: said through the execution's warning (the command prints it).
+Mesh warn_if_cut_cloud(const std::filesystem::path& path, std::string_view data, Mesh mesh) {
+  if (mesh.F.rows() == 0 && !data.empty() && data.back() != '\n') {
+    if (const auto& warn = current_execution().warning) {
+      warn(path.string() + ": no faces, and the last line has no end: the file may be cut "
+           "short; read as a point cloud of " + std::to_string(mesh.V.rows()) + " vertices");
+    }
+  }
+  return mesh;
+}
+
+}  // namespace
+
 Mesh parse_obj(const std::filesystem::path& path, std::string_view data, int threads,
                std::size_t chunk_bytes) {
   if (std::optional<Mesh> mesh = parse_obj_in_chunks(path, data, threads, chunk_bytes)) {
-    return std::move(*mesh);
+    return warn_if_cut_cloud(path, data, std::move(*mesh));
   }
   const ObjData whole = read_obj_serially(path, obj_text(path, data));
-  return obj_mesh(path, {&whole, 1}, threads);
+  return warn_if_cut_cloud(path, data, obj_mesh(path, {&whole, 1}, threads));
 }
 
 Mesh read_obj(const std::filesystem::path& path, int threads) {

@@ -70,6 +70,14 @@ class OffReader {
     Mesh mesh;
     read_vertices(h, mesh);
     read_faces(h, mesh);
+    // More element lines than the header declares: a wrong count, or two files in one; never
+    // silently dropped.
+    if (next_line()) {
+      fail_at_line(path_, cursor_.line_number(),
+                   "data after the last of the " + std::to_string(h.vertices) + " vertices and " +
+                       std::to_string(h.faces) + " faces the header declares: '" +
+                       std::string(tokens_[0]) + "'");
+    }
     return mesh;
   }
 
@@ -285,7 +293,8 @@ std::optional<Mesh> read_off_runs(const std::filesystem::path& path, std::string
   const std::vector<std::int64_t> first =  // element lines before each run
       io_detail::lines_before_runs(body, cuts, threads, io_detail::has_token_before_comment);
   const std::int64_t elements = header.vertices + header.faces;
-  if (first.back() < elements) return std::nullopt;
+  // Fewer element lines than declared, or more: the serial read reports where.
+  if (first.back() != elements) return std::nullopt;
 
   Mesh mesh;
   mesh.V.resize(header.vertices, 3);

@@ -9,6 +9,7 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "io/file_bytes.h"
 #include "io/ply.h"
 #include "io/ply_read.h"
@@ -27,6 +28,9 @@ class BinaryBody {
         swap_(swap),
         threads_(threads) {}
 
+  /// Bytes not read yet (after read_body: those after the last element).
+  [[nodiscard]] std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
+
   /// Rejects a count that cannot fit in the rest of the file, before anything is allocated.
   void check_fits(const PlyElement& e) const {
     const std::size_t min_bytes = e.min_binary_bytes();
@@ -38,8 +42,9 @@ class BinaryBody {
                      "file ends inside " + e.name + " " + std::to_string(complete) + " of " +
                          std::to_string(e.count));
     }
-    io_detail::check_count_fits(path_, "byte offset " + std::to_string(offset()), e.count,
-                                min_bytes, remaining, e.name + " elements");
+    // Binary: every element has its bytes (no separator that the last one may lack).
+    io_detail::check_records_fit(path_, "byte offset " + std::to_string(offset()), e.count,
+                                 min_bytes, remaining, e.name + " elements");
   }
 
   void read_vertices(const PlyElement& e, const std::vector<int>& roles, double* V, double* N) {
@@ -324,7 +329,16 @@ Mesh read_binary_body(const std::filesystem::path& path, std::string_view data,
   const bool file_big = header.encoding == PlyEncoding::binary_big_endian;
   const bool host_big = std::endian::native == std::endian::big;
   BinaryBody body(path, data, header.body_offset, file_big != host_big, threads);
-  return read_body(path, header, plan, body);
+  Mesh mesh = read_body(path, header, plan, body);
+  // Bytes after the last element: not part of the mesh (a line end some writers add, or a wrong
+  // count); read as before, but said, since they may be elements the header does not count.
+  if (const std::size_t extra = body.remaining(); extra > 1) {
+    if (const auto& warn = current_execution().warning) {
+      warn(path.string() + ": " + std::to_string(extra) +
+           " bytes follow the last element the header declares; ignored");
+    }
+  }
+  return mesh;
 }
 
 }  // namespace focal::io_detail::ply

@@ -82,6 +82,11 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view data)
       } else {
         fail_at_line(path, n, "unknown format '" + std::string(tokens[1]) + "'");
       }
+      // 1.0 is the only PLY version there is; another is not a file this reader understands.
+      if (tokens[2] != "1.0" && tokens[2] != "1") {
+        fail_at_line(path, n,
+                     "PLY version '" + std::string(tokens[2]) + "': only 1.0 is known");
+      }
       have_format = true;
     } else if (key == "element") {
       std::int64_t count = 0;

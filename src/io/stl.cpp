@@ -357,6 +357,16 @@ Mesh parse_stl(const std::filesystem::path& path, std::string_view data, int thr
     fail(path, "too short for a binary STL (" + std::to_string(data.size()) + " bytes) and " +
                    (starts_with_solid(data) ? "not ascii text" : "does not start with 'solid'"));
   }
+  if (const std::size_t solid = io_detail::to_lower(data.substr(0, 4096)).find("solid");
+      solid != std::string_view::npos && data.find('\0') == std::string_view::npos) {
+    // Text with `solid` after something other than blanks and # comments: an ascii STL with a
+    // line before it, not the binary file whose size error would otherwise be reported.
+    const std::string_view first = skip_leading_comments(data);
+    fail(path, "an ascii STL must start with 'solid' (blank and # comment lines may "
+               "come before it), but it starts with '" +
+                   std::string(first.substr(0, std::min(first.find('\n'), std::size_t{40}))) +
+                   "'; not a binary STL either (its size does not match its facet count)");
+  }
   return read_binary(path, data, threads);  // reports the size mismatch
 }
 

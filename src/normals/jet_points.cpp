@@ -50,15 +50,16 @@ void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::u
   ring.assign(1, v);
   test_and_set(v);
   // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
-  // Checked once per vertex whose neighbours were added (the ring may pass the cap by those), not
-  // once per neighbour: past it the ring is dropped either way.
+  // Past it the ring is dropped either way, so where the search stops does not change a result.
   const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
   std::size_t begin = 0;
   for (int depth = 0; depth < rings && begin < ring.size(); ++depth) {
     const std::size_t end = ring.size();
     for (std::size_t k = begin; k < end && ring.size() <= cap; ++k) {
       const int u = ring[k];
-      for (const int* w = one.begin(u); w != one.end(u); ++w) {
+      // Also within one vertex's neighbours: the centre of a fan of 100,000 corners would
+      // otherwise add them all to the ring of each of its 100,000 neighbours (quadratic).
+      for (const int* w = one.begin(u); w != one.end(u) && ring.size() <= cap; ++w) {
         if (!test_and_set(*w)) ring.push_back(*w);
       }
     }

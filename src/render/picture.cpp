@@ -4,11 +4,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "core/memory.h"
+#include "focal/core/execution.h"
 #include "focal/curvature/curvature.h"
 #include "focal/points/neighbours.h"
 #include "focal/render/render.h"
@@ -439,23 +442,39 @@ void main() { fragment = vec4(colour, 1.0); }
 )";
 
 /// Colour and depth renderbuffers with `samples` samples (0 = single-sampled) in a new
-/// framebuffer, left bound.
-GLuint make_colour_framebuffer(int width, int height, int samples) {
+/// framebuffer, left bound; 0 (nothing left allocated) when the driver cannot make it complete
+/// (out of its memory: a large picture with many samples).
+GLuint try_colour_framebuffer(int width, int height, int samples) {
   GLuint framebuffer = 0;
   glGenFramebuffers(1, &framebuffer);
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   const GLenum formats[] = {GL_RGBA8, GL_DEPTH_COMPONENT24};
   const GLenum attachments[] = {GL_COLOR_ATTACHMENT0, GL_DEPTH_ATTACHMENT};
+  GLuint renderbuffers[2] = {0, 0};
   for (int k = 0; k < 2; ++k) {
     GLuint renderbuffer = 0;
     glGenRenderbuffers(1, &renderbuffer);
     glBindRenderbuffer(GL_RENDERBUFFER, renderbuffer);
     glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, formats[k], width, height);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachments[k], GL_RENDERBUFFER, renderbuffer);
+    renderbuffers[k] = renderbuffer;
   }
-  require_no_gl_error("picture framebuffer");
-  render_detail::require_complete_framebuffer("picture framebuffer");
-  return framebuffer;
+  const bool complete = glGetError() == GL_NO_ERROR &&
+                        glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  if (complete) return framebuffer;
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteRenderbuffers(2, renderbuffers);
+  glDeleteFramebuffers(1, &framebuffer);
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  return 0;
+}
+
+/// Bytes of a width x height colour (RGBA8) and depth (24 bits, stored in 32) framebuffer with
+/// `samples` samples per pixel (0: one).
+std::uint64_t framebuffer_bytes(int width, int height, int samples) {
+  return static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * 8u *
+         static_cast<std::uint64_t>(std::max(1, samples));
 }
 
 void set_vector(GLuint program, const char* name, const Eigen::Vector3d& v) {
@@ -515,9 +534,38 @@ Image render_panels(const std::vector<PanelContent>& panels, const Layout& layou
   }
   GLint max_samples = 0;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  const int samples = o.samples > 1 ? std::min(o.samples, static_cast<int>(max_samples)) : 0;
-  const GLuint resolved = make_colour_framebuffer(o.width, o.height, 0);
-  const GLuint drawn = samples > 1 ? make_colour_framebuffer(o.width, o.height, samples) : resolved;
+  int samples = o.samples > 1 ? std::min(o.samples, static_cast<int>(max_samples)) : 0;
+  // The resolved picture, its copy read back and the RGB image: needed whatever the samples.
+  const std::string picture =
+      "render_field_picture: a " + std::to_string(o.width) + " x " + std::to_string(o.height) +
+      " picture";
+  const std::uint64_t pixels =
+      static_cast<std::uint64_t>(o.width) * static_cast<std::uint64_t>(o.height);
+  detail::require_memory(framebuffer_bytes(o.width, o.height, 0) + pixels * 7, picture);
+  const GLuint resolved = try_colour_framebuffer(o.width, o.height, 0);
+  if (resolved == 0) {
+    throw RenderError(picture + ": the OpenGL driver (" + gl.description() +
+                      ") cannot allocate its framebuffer (" +
+                      detail::memory_text(framebuffer_bytes(o.width, o.height, 0)) +
+                      "); a smaller size fits");
+  }
+  // Fewer samples where the driver (or the machine) has no memory for as many: the same picture,
+  // less smoothed edges, rather than no picture.
+  GLuint drawn = resolved;
+  const std::uint64_t available = detail::available_memory();
+  for (; samples > 1; samples /= 2) {
+    if (available != 0 && framebuffer_bytes(o.width, o.height, samples) > available / 2) continue;
+    drawn = try_colour_framebuffer(o.width, o.height, samples);
+    if (drawn != 0) break;
+  }
+  if (drawn == 0) drawn = resolved;
+  if (samples != std::min(o.samples, static_cast<int>(max_samples)) && o.samples > 1) {
+    if (const auto& warn = current_execution().warning) {
+      warn(picture + ": the driver (or the machine's memory) cannot hold " +
+           std::to_string(o.samples) + " samples per pixel at this size; drawn with " +
+           std::to_string(std::max(samples, 1)));
+    }
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, drawn);
   glClearColor(kBackground[0] / 255.0f, kBackground[1] / 255.0f, kBackground[2] / 255.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);

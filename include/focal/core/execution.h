@@ -7,6 +7,7 @@
 /// Nothing here changes a result: every field gives the same bits for any setting.
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -19,9 +20,28 @@ struct Progress {
   double fraction = 0.0;   ///< 0 at the start of the stage, 1 at its end
 };
 
+/// The most threads focal runs one loop on. A larger count (Execution::threads, --threads,
+/// FOCAL_NUM_THREADS, Python's threads=) is clamped to it with a warning: the worker pool has
+/// one thread per CPU anyway (docs/PERFORMANCE.md, "Threads"), and every thread counted costs
+/// per-thread scratch memory whether or not a CPU runs it.
+inline constexpr int kMaxThreads = 1024;
+
+/// A requested thread count resolved by the one rule of kMaxThreads.
+struct ThreadRequest {
+  int threads = 0;      ///< what is used: 0 (every CPU) or a count in [1, kMaxThreads]
+  std::string warning;  ///< not empty when the request was clamped: what was asked and used
+};
+
+/// The one rule for a thread count: `requested` > 0 clamped to kMaxThreads; 0 the value of
+/// FOCAL_NUM_THREADS when it is set to a count > 0 (clamped the same way), else 0.
+/// \throw InvalidInput when `requested` < 0, or FOCAL_NUM_THREADS is set (not empty) but is not
+/// a whole number >= 0 ("abc", "-2", "1.5").
+[[nodiscard]] ThreadRequest resolve_threads(std::int64_t requested);
+
 struct Execution {
   /// The most threads that work on one parallel loop. 0: the enclosing ExecutionScope's, else
-  /// FOCAL_NUM_THREADS if set, else every CPU this process may run on. Results are the same
+  /// FOCAL_NUM_THREADS if set, else every CPU this process may run on. At most kMaxThreads
+  /// (ExecutionScope clamps a larger count, warning through `warning`). Results are the same
   /// for any count.
   int threads = 0;
   /// Called on the calling thread as each stage begins and ends (none: nothing is reported).
@@ -48,7 +68,9 @@ struct Execution {
 /// thread in nested order (as locals).
 class ExecutionScope {
  public:
-  /// \throw InvalidInput when the count is negative.
+  /// The count goes through resolve_threads (a clamp is reported through the execution's warning
+  /// callback, else the enclosing scope's); FOCAL_NUM_THREADS is read by the outermost scope.
+  /// \throw InvalidInput when the count is negative or FOCAL_NUM_THREADS is not a number.
   explicit ExecutionScope(const Execution& execution);
   ~ExecutionScope();
   ExecutionScope(const ExecutionScope&) = delete;
