@@ -57,6 +57,7 @@ def cloud_curvature(
     solver: str = "closed-form",
     outlier_ratio: float = 3.0,
     off_surface_ratio: float = 10.0,
+    orient: str = "mst",
     threads: Optional[int] = None,
 ) -> Curvature:
     """Principal curvatures and directions, H and K of a point cloud, by the two-slit fit of the
@@ -72,6 +73,9 @@ def cloud_curvature(
     adaptive_radius : c: the neighbours within c times the local spacing instead (the median,
         over the point and its k nearest, of their distances to their k-th nearest; docs/POINTS.md).
     viewpoint : (x, y, z) the scanner position: estimated normals face it.
+    orient : how estimated normals get their side: ``"mst"`` (a minimum spanning tree, or the
+        viewpoint when given), ``"global"`` (the tree, then the winding number: closed surfaces
+        with thin or touching parts; docs/POINTS.md, "Orientation") or ``"viewpoint"``.
     solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
     outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
         median of the same are left out (NaN, ``undefined``); 0 keeps every point (the library
@@ -96,7 +100,7 @@ def cloud_curvature(
             raise _shape_error("normals", f"({P.shape[0]}, 3) like points", N.shape)
     d = _ext.cloud_curvature(
         P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio),
-        float(off_surface_ratio), t
+        float(off_surface_ratio), str(orient), t
     )
     return Curvature(**d)
 
@@ -109,10 +113,11 @@ def cloud_normals(
     adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
+    orient: str = "mst",
     threads: Optional[int] = None,
 ) -> np.ndarray:
     """(n, 3) unit normals of a point cloud, estimated and consistently oriented (as
     cloud_curvature estimates them; include/focal/normals/cloud_normals.h). NaN rows where a
-    point has fewer than two neighbours."""
+    point has fewer than two neighbours. ``orient`` as cloud_curvature's."""
     P, k, r, a, t = _cloud_arguments(points, k, radius, adaptive_radius, threads)
-    return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), t)
+    return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), str(orient), t)

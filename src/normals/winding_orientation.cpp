@@ -1,0 +1,226 @@
+#include "normals/winding_orientation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "core/parallel.h"
+#include "points/winding_number.h"
+
+namespace focal::detail {
+namespace {
+
+/// A neighbour is near a point's tangent plane when its chord's normal part is at most this
+/// share of the chord (60 deg from the normal): across a thin part the chord runs along it.
+constexpr double kTangentChord = 0.5;
+constexpr int kFewestTangent = 3;
+
+/// Tries per sweep (all segments that gain, then those that gain at least 1/2, 1/4, ... of the
+/// most).
+constexpr int kAttempts = 6;
+
+/// Signed normals of a segment's neighbours agree at least this much.
+constexpr double kSegmentAgreement = 0.5;
+
+/// With `across`, segments are joined across thin parts too: by edges whose chord runs along
+/// both normals (|n . e| >= this share of |e|) where the signed normals are opposite, as they
+/// are on the two sides of a plate: a side turned alone only raises the residual where both
+/// sides are wrong (two sheets that touch, turned together by the tree).
+constexpr double kAcrossChord = 0.7;
+
+/// The segment of each point (the smallest row in it), see orient_by_winding.
+std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph, const RowMatrixX3d& N,
+                          const Eigen::VectorXd& s, bool across) {
+  const auto n = static_cast<int>(V.rows());
+  std::vector<int> parent(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) parent[static_cast<std::size_t>(i)] = i;
+  const auto find = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) {
+      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      i = parent[static_cast<std::size_t>(i)];
+    }
+    return i;
+  };
+  for (int i = 0; i < n; ++i) {
+    if (!N.row(i).allFinite()) continue;
+    for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
+      if (*j <= i || !N.row(*j).allFinite()) continue;
+      const Eigen::RowVector3d e = V.row(*j) - V.row(i);
+      const double e2 = e.squaredNorm(), a = N.row(i).dot(e), c = N.row(*j).dot(e);
+      const double limit = kTangentChord * kTangentChord * e2;
+      const double agreement = s[i] * s[*j] * N.row(i).dot(N.row(*j));
+      const bool along = a * a <= limit && c * c <= limit && agreement > kSegmentAgreement;
+      const double normal = kAcrossChord * kAcrossChord * e2;
+      const bool through =
+          across && a * a >= normal && c * c >= normal && agreement < -kSegmentAgreement;
+      if (!along && !through) continue;
+      const int ri = find(i), rj = find(*j);
+      if (ri != rj) parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
+    }
+  }
+  for (int i = 0; i < n; ++i) parent[static_cast<std::size_t>(i)] = find(i);
+  return parent;
+}
+
+/// Serial, in index order: the same bits for any thread count.
+double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  double s = 0.0;
+  for (Eigen::Index i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+}  // namespace
+
+Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, NormalsRef N,
+                            int threads) {
+  Eigen::VectorXd area = Eigen::VectorXd::Zero(V.rows());
+  parallel_for(V.rows(), threads, [&](std::int64_t i) {
+    if (!V.row(i).allFinite() || !N.row(i).allFinite()) return;
+    const Eigen::RowVector3d n = N.row(i).normalized();
+    int m = 0, all = 0;
+    double tangent2 = 0.0, last2 = 0.0;
+    for (const int* j = neighbours.begin(static_cast<int>(i)); j != neighbours.end(static_cast<int>(i)); ++j) {
+      const Eigen::RowVector3d e = V.row(*j) - V.row(i);
+      const double e2 = e.squaredNorm();
+      if (!std::isfinite(e2)) continue;
+      ++all;
+      last2 = std::max(last2, e2);
+      const double normal = n.dot(e);
+      if (normal * normal <= kTangentChord * kTangentChord * e2) {
+        ++m;
+        tangent2 = std::max(tangent2, e2);
+      }
+    }
+    if (m >= kFewestTangent) {
+      area[i] = std::numbers::pi * tangent2 / m;
+    } else if (all > 0) {
+      area[i] = std::numbers::pi * last2 / all;
+    }
+  });
+  return area;
+}
+
+WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods& graph,
+                                           const Eigen::VectorXd& area, RowMatrixX3d& N,
+                                           int threads,
+                                           const WindingOrientationOptions& options) {
+  const Eigen::Index n = V.rows();
+  WindingOrientationReport report;
+  // a_j n_j per point (zero where there is no dipole), the smoothing lengths, the target 1/2 at
+  // every finite point.
+  RowMatrixX3d A = RowMatrixX3d::Zero(n, 3);
+  Eigen::VectorXd smoothing = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!V.row(i).allFinite()) continue;
+    b[i] = 0.5;
+    if (!(area[i] > 0.0) || !N.row(i).allFinite()) continue;
+    A.row(i) = area[i] * N.row(i).normalized();
+    smoothing[i] = options.smoothing * std::sqrt(area[i]);
+  }
+  const WindingTree tree(V, smoothing, options.beta);
+  const auto K = [&](const Eigen::VectorXd& s) {
+    return tree.winding((A.array().colwise() * s.array()).matrix(), threads);
+  };
+  const auto Kt = [&](const Eigen::VectorXd& r) {
+    const RowMatrixX3d g = tree.field(r, threads);
+    return Eigen::VectorXd((A.array() * g.array()).rowwise().sum());
+  };
+  const double lambda = options.damping;
+  const double norm_b = std::sqrt(dot(b, b));
+  // Rounds of damped CGLS for d = s - s0 on min |K d - c|^2 + lambda |d|^2, c = b - K s0, each
+  // seeded from the signs of the last (s0 = 1: the tree's).
+  Eigen::VectorXd s = Eigen::VectorXd::Ones(n);
+  for (int round = 0; round < options.rounds; ++round) {
+    Eigen::VectorXd r = b - K(s);
+    if (round == 0) report.residual_before = std::sqrt(dot(r, r)) / norm_b;
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd g = Kt(r);
+    Eigen::VectorXd p = g;
+    double gamma = dot(g, g);
+    for (int it = 0; it < options.iterations && gamma > 0.0; ++it) {
+      const Eigen::VectorXd q = K(p);
+      const double alpha = gamma / (dot(q, q) + lambda * dot(p, p));
+      d += alpha * p;
+      r -= alpha * q;
+      g = Kt(r) - lambda * d;
+      const double next = dot(g, g);
+      p = g + (next / gamma) * p;
+      gamma = next;
+    }
+    int turned = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (A.row(i).isZero() || (s[i] + d[i]) * s[i] >= 0.0) continue;
+      s[i] = -s[i];
+      ++turned;
+    }
+    if (turned == 0) break;
+  }
+  // Then sweeps over segments: the points joined by edges of `graph` whose chord lies near both
+  // tangent planes and whose signed normals agree (n_i . n_j > kSegmentAgreement), the pieces
+  // that the signs turn as a whole (a point alone turned in a consistent sheet only raises the
+  // residual). A segment S turns where that lowers |K s - b|^2 to first order with its points'
+  // own terms: sum_S s_k (K^T (K s - b))_k > sum_S |K e_k|^2. All such turn at once; a sweep
+  // that raises the residual is undone and ends them.
+  if (options.sweeps > 0) {
+    const Eigen::VectorXd column = tree.near_column_norms(A, threads);
+    Eigen::VectorXd r = K(s) - b;
+    double energy = dot(r, r);
+    bool failed = false;  // the last sweep turned nothing
+    for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+      const std::vector<int> label = segments(V, graph, N, s, sweep % 2 == 1);
+      const Eigen::VectorXd g = Kt(r);
+      std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (!A.row(i).isZero()) {
+          // Across a thin part the sides' own terms largely cancel (opposite dipoles side by
+          // side): only the residual's verdict counts there, checked below.
+          gain[static_cast<std::size_t>(label[i])] += s[i] * g[i] - (sweep % 2 == 1 ? 0.0 : column[i]);
+        }
+      }
+      // All segments of positive gain, or where that raises the residual, those of at least
+      // 1/2, 1/4, ... of the largest gain.
+      double largest = 0.0;
+      for (const double x : gain) largest = std::max(largest, x);
+      if (!(largest > 0.0)) {
+        if (failed) break;
+        failed = true;
+        continue;
+      }
+      bool lowered = false;
+      Eigen::VectorXd next, r_next;
+      double e_next = energy;
+      for (int attempt = 0; attempt < kAttempts && !lowered; ++attempt) {
+        const double least = attempt == 0 ? 0.0 : largest * std::ldexp(1.0, -attempt);
+        next = s;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double x = gain[static_cast<std::size_t>(label[i])];
+          if (!A.row(i).isZero() && x > least) next[i] = -s[i];
+        }
+        r_next = K(next) - b;
+        e_next = dot(r_next, r_next);
+        lowered = e_next < energy;
+      }
+      if (!lowered) {
+        // Both kinds of segment failed in a row: done.
+        if (failed) break;
+        failed = true;
+        continue;
+      }
+      failed = false;
+      s = next;
+      r = r_next;
+      energy = e_next;
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (s[i] > 0.0) continue;
+    N.row(i) *= -1.0;
+    ++report.flipped;
+  }
+  const Eigen::VectorXd after = b - K(s);
+  report.residual_after = std::sqrt(dot(after, after)) / norm_b;
+  return report;
+}
+
+}  // namespace focal::detail
