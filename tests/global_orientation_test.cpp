@@ -124,8 +124,8 @@ int flipped(const test::Solid& s, CloudOrientation orientation) {
 
 // The two small cases, clean and with noise of 0.1 spacing, seeds 1-3: the tree alone turns a
 // whole side (plate: 1729-1845 of 3520 points flipped; spheres: one sphere, 800 of 1600); the
-// global orientation leaves 46-158 (1.3-4.5%) and 47-54 (2.9-3.4%, where the spheres are within
-// two spacings of each other) flipped, NaN counted (docs/notes/points-log.md, "Global
+// global orientation leaves 47-143 (1.3-4.1%) and 41-61 (2.6-3.8%, where the spheres are within
+// about a spacing of each other) flipped, NaN counted (docs/notes/points-log.md, "Global
 // orientation"). Asserted: at most 5%, and the tree's failure itself (at least 45%), so that
 // the case stays a hard one. The issue's target, 1%, is not reached.
 TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
@@ -143,8 +143,9 @@ TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
   }
 }
 
-// A closed surface that the tree orients right stays right (the sphere, the thick plate):
-// measured 0 of 4160 turned on the clean 6-spacing plate, 0 on spheres (docs/notes).
+// A closed surface that the tree orients right stays right (the sphere, the clean plate six
+// spacings thick: measured 0 flipped either way; with noise 0.1 the thick plate has 0-2 with
+// the tree and 1-2 with the global orientation).
 TEST(GlobalOrientation, ThickSolidsStayRight) {
   for (std::uint64_t seed : {1, 2}) {
     const test::Solid plate = solid(Shape::thick_plate, seed, 0.0);
@@ -213,8 +214,10 @@ TEST(GlobalOrientation, DISABLED_Explore) {
   o.smoothing = env("FOCAL_WO_SMOOTHING", o.smoothing);
   o.beta = env("FOCAL_WO_BETA", o.beta);
   const int k = static_cast<int>(env("FOCAL_WO_K", 16));
+  const int only = static_cast<int>(env("FOCAL_WO_SHAPE", -1));
   for (const Shape shape :
        {Shape::plate, Shape::thick_plate, Shape::coin, Shape::ring, Shape::touching_spheres}) {
+    if (only >= 0 && static_cast<int>(shape) != only) continue;
     for (const double noise : {0.0, 0.1}) {
       for (std::uint64_t seed : {1, 2, 3}) {
         const test::Solid s = solid(shape, seed, noise);

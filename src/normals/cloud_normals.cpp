@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/normals/jets.h"
 #include "normals/cloud_jets.h"
 #include "normals/jet_normals_from.h"
@@ -278,6 +280,24 @@ int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d&
 
 }  // namespace
 
+namespace {
+
+/// Tells the verbose log (Execution::info) what the global orientation did.
+void tell(const detail::WindingOrientationReport& r) {
+  const Execution& execution = current_execution();
+  if (!execution.info) return;
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "global orientation: winding-number residual %.3f with the tree's signs, %.3f "
+                "with the field's: %s",
+                r.residual_before, r.residual_after,
+                r.decided ? (std::to_string(r.flipped) + " normals turned").c_str()
+                          : "not closed enough to decide, the tree's signs kept");
+  execution.info(line);
+}
+
+}  // namespace
+
 int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
                                int threads, const CloudCopy* copy_of, bool global) {
   check_sizes(V, neighbours, "orient_normals_mst");
@@ -288,7 +308,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   if (!copy_of) {
     const Neighbourhoods graph = symmetric(neighbours, threads);
     const int components = orient_over_graph(V, graph, N);
-    if (global) detail::orient_by_winding(V, graph, area, N, threads);
+    if (global) tell(detail::orient_by_winding(V, graph, area, N, threads));
     return components;
   }
   // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
@@ -300,8 +320,8 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   N = RowMatrixX3d();
   const int components = orient_over_graph(copy_of->cloud, graph, own);
   if (global) {
-    detail::orient_by_winding(copy_of->cloud, graph, detail::rows_from(area, p.position, threads),
-                              own, threads);
+    tell(detail::orient_by_winding(copy_of->cloud, graph,
+                                   detail::rows_from(area, p.position, threads), own, threads));
   }
   N = detail::rows_from(own, p.order, threads);
   return components;

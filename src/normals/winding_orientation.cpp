@@ -16,9 +16,10 @@ namespace {
 constexpr double kTangentChord = 0.5;
 constexpr int kFewestTangent = 3;
 
-/// Tries per sweep (all segments that gain, then those that gain at least 1/2, 1/4, ... of the
-/// most).
-constexpr int kAttempts = 6;
+/// A segment's edges lie in both tangent planes within this share of their length (15 deg):
+/// where two sheets nearly touch, a diagonal chord from one to the other is tangent to both
+/// within 30 deg and would join the one's turned patch to the other's right one.
+constexpr double kSegmentChord = 0.25;
 
 /// Signed normals of a segment's neighbours agree at least this much.
 constexpr double kSegmentAgreement = 0.5;
@@ -29,7 +30,10 @@ constexpr double kSegmentAgreement = 0.5;
 /// sides are wrong (two sheets that touch, turned together by the tree).
 constexpr double kAcrossChord = 0.7;
 
-/// The segment of each point (the smallest row in it), see orient_by_winding.
+/// The segment of each point (the smallest row in it): the points joined by edges of `graph`
+/// whose chord lies in both tangent planes within kSegmentChord of its length and whose signed
+/// normals agree (s_i s_j n_i . n_j > kSegmentAgreement); with `across`, also by the edges
+/// across thin parts (kAcrossChord).
 std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph, const RowMatrixX3d& N,
                           const Eigen::VectorXd& s, bool across) {
   const auto n = static_cast<int>(V.rows());
@@ -48,7 +52,7 @@ std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph, const Row
       if (*j <= i || !N.row(*j).allFinite()) continue;
       const Eigen::RowVector3d e = V.row(*j) - V.row(i);
       const double e2 = e.squaredNorm(), a = N.row(i).dot(e), c = N.row(*j).dot(e);
-      const double limit = kTangentChord * kTangentChord * e2;
+      const double limit = kSegmentChord * kSegmentChord * e2;
       const double agreement = s[i] * s[*j] * N.row(i).dot(N.row(*j));
       const bool along = a * a <= limit && c * c <= limit && agreement > kSegmentAgreement;
       const double normal = kAcrossChord * kAcrossChord * e2;
@@ -156,12 +160,12 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     }
     if (turned == 0) break;
   }
-  // Then sweeps over segments: the points joined by edges of `graph` whose chord lies near both
-  // tangent planes and whose signed normals agree (n_i . n_j > kSegmentAgreement), the pieces
-  // that the signs turn as a whole (a point alone turned in a consistent sheet only raises the
-  // residual). A segment S turns where that lowers |K s - b|^2 to first order with its points'
-  // own terms: sum_S s_k (K^T (K s - b))_k > sum_S |K e_k|^2. All such turn at once; a sweep
-  // that raises the residual is undone and ends them.
+  // Then sweeps over segments (see `segments`), the pieces that the signs turn as a whole (a
+  // point alone turned in a consistent sheet only raises the residual), by turns without and
+  // with the joins across thin parts. A segment S turns where that lowers |K s - b|^2 to first
+  // order: sum_S s_k (K^T (K s - b))_k > sum_S |K e_k|^2 (its points' own terms; left out for
+  // the segments joined across, whose sides' terms largely cancel). All such turn at once; a
+  // sweep that does not lower the residual is undone, and two such in a row end the sweeps.
   if (options.sweeps > 0) {
     const Eigen::VectorXd column = tree.near_column_norms(A, threads);
     Eigen::VectorXd r = K(s) - b;
@@ -172,37 +176,25 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
       const Eigen::VectorXd g = Kt(r);
       std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
       for (Eigen::Index i = 0; i < n; ++i) {
-        if (!A.row(i).isZero()) {
-          // Across a thin part the sides' own terms largely cancel (opposite dipoles side by
-          // side): only the residual's verdict counts there, checked below.
-          gain[static_cast<std::size_t>(label[i])] += s[i] * g[i] - (sweep % 2 == 1 ? 0.0 : column[i]);
-        }
-      }
-      // All segments of positive gain, or where that raises the residual, those of at least
-      // 1/2, 1/4, ... of the largest gain.
-      double largest = 0.0;
-      for (const double x : gain) largest = std::max(largest, x);
-      if (!(largest > 0.0)) {
-        if (failed) break;
-        failed = true;
-        continue;
+        if (A.row(i).isZero()) continue;
+        gain[static_cast<std::size_t>(label[i])] += s[i] * g[i] - (sweep % 2 == 1 ? 0.0 : column[i]);
       }
       bool lowered = false;
-      Eigen::VectorXd next, r_next;
+      Eigen::VectorXd next = s, r_next;
       double e_next = energy;
-      for (int attempt = 0; attempt < kAttempts && !lowered; ++attempt) {
-        const double least = attempt == 0 ? 0.0 : largest * std::ldexp(1.0, -attempt);
-        next = s;
-        for (Eigen::Index i = 0; i < n; ++i) {
-          const double x = gain[static_cast<std::size_t>(label[i])];
-          if (!A.row(i).isZero() && x > least) next[i] = -s[i];
+      int turned = 0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (!A.row(i).isZero() && gain[static_cast<std::size_t>(label[i])] > 0.0) {
+          next[i] = -s[i];
+          ++turned;
         }
+      }
+      if (turned > 0) {
         r_next = K(next) - b;
         e_next = dot(r_next, r_next);
         lowered = e_next < energy;
       }
       if (!lowered) {
-        // Both kinds of segment failed in a row: done.
         if (failed) break;
         failed = true;
         continue;
@@ -213,13 +205,19 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
       energy = e_next;
     }
   }
+  const Eigen::VectorXd after = b - K(s);
+  report.residual_after = std::sqrt(dot(after, after)) / norm_b;
+  // The field's own verdict on whether it decides: a closed surface sampled with consistent
+  // normals has w near 1/2 at every sample; an open one (a scan from one side) or one noisy
+  // beyond its spacing does not, whatever the signs, and then the tree's signs stay.
+  report.decided = report.residual_after <= options.closed_residual &&
+                   report.residual_after <= options.closed_gain * report.residual_before;
+  if (!report.decided) return report;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (s[i] > 0.0) continue;
     N.row(i) *= -1.0;
     ++report.flipped;
   }
-  const Eigen::VectorXd after = b - K(s);
-  report.residual_after = std::sqrt(dot(after, after)) / norm_b;
   return report;
 }
 

@@ -47,7 +47,7 @@ class WindingTree {
 
  private:
   struct Node {
-    Eigen::Vector3d centre;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double radius = 0.0;     ///< of the ball about centre that holds the node's points
     int begin = 0, end = 0;  ///< its points: order_[begin, end)
     int first_child = -1;    ///< children first_child ... first_child + children - 1; -1: leaf

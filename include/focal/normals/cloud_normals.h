@@ -20,7 +20,8 @@
 ///   oriented points says so (Barill et al. 2018; a Barnes-Hut octree): on a closed surface with
 ///   consistent outward normals it is 1/2 at every sample, also across parts a few spacings
 ///   thin, where the tree's rule (n_i . n_j > 0) joins the two sides; the signs are the
-///   least-squares fit of that, damped towards the tree's (which an open surface keeps).
+///   least-squares fit of that, damped towards the tree's, then whole patches turned where that
+///   fits better; taken only where the field says the cloud is closed (else the tree's stay).
 /// - orient_towards_viewpoint: each normal turned to face a viewpoint (scanner position).
 /// - cloud_normals: all of it, then jet normals (normals/jets.h) over the same neighbourhoods,
 ///   which keep each PCA normal's side and are second-order accurate (PCA is first-order on
@@ -46,7 +47,9 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
 
 /// Flips rows of N (in place, oriented by orient_normals_mst) to the signs whose winding number
 /// is nearest 1/2 at every point (see above; normals/winding_orientation.h), the neighbourhoods
-/// giving each point's area. Returns the number of rows flipped. NaN rows are left as they are.
+/// giving each point's area, where the field decides: where the signs found leave w far from
+/// 1/2 (an open or very noisy cloud) or hardly nearer than the tree's, N is left as it is.
+/// Returns the number of rows flipped. NaN rows are left as they are.
 /// \throw InvalidInput when shapes differ.
 int orient_normals_global(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N);
 
