@@ -41,11 +41,11 @@ RowMatrixX3d sphere_dipoles(const test::Solid& s, double r) {
 TEST(WindingTree, HalfOnTheSamplesOfASphere) {
   const test::Solid s = sphere_cloud(10.0, 1);
   const detail::WindingTree tree(s.V, Eigen::VectorXd::Constant(s.V.rows(), 0.5), 2.0);
-  const Eigen::VectorXd w = tree.winding(sphere_dipoles(s, 10.0), 0);
+  const Eigen::VectorXd w = tree.winding(sphere_dipoles(s, 10.0), {}, 0);
   EXPECT_NEAR(w.mean(), 0.455, 0.01);
   EXPECT_LT((w.array() - 0.5).abs().maxCoeff(), 0.08);
   const RowMatrixX3d inward = -sphere_dipoles(s, 10.0);
-  EXPECT_NEAR(tree.winding(inward, 0).mean(), -0.455, 0.01);
+  EXPECT_NEAR(tree.winding(inward, {}, 0).mean(), -0.455, 0.01);
 }
 
 // The far field to second order against every pair summed (beta so large that no cell is far):
@@ -56,7 +56,7 @@ TEST(WindingTree, FarFieldAgreesWithTheDirectSum) {
   const Eigen::VectorXd smoothing = Eigen::VectorXd::Constant(s.V.rows(), 0.5);
   const detail::WindingTree fast(s.V, smoothing, 2.0), exact(s.V, smoothing, 1e9);
   const RowMatrixX3d M = sphere_dipoles(s, 10.0);
-  EXPECT_LT((fast.winding(M, 0) - exact.winding(M, 0)).cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT((fast.winding(M, {}, 0) - exact.winding(M, {}, 0)).cwiseAbs().maxCoeff(), 0.05);
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::VectorXd q(s.V.rows());
@@ -64,7 +64,7 @@ TEST(WindingTree, FarFieldAgreesWithTheDirectSum) {
   const RowMatrixX3d gf = fast.field(q, 0), ge = exact.field(q, 0);
   EXPECT_LT((gf - ge).cwiseAbs().maxCoeff(), 0.12 * ge.cwiseAbs().maxCoeff());
   // The field is the transpose: q . K s = (K^T q) . s, exactly for the direct sums.
-  const Eigen::VectorXd Ks = exact.winding(M, 0);
+  const Eigen::VectorXd Ks = exact.winding(M, {}, 0);
   const double left = q.dot(Ks), right = (M.array() * ge.array()).sum();
   EXPECT_NEAR(left, right, 1e-10 * std::abs(left));
 }
@@ -74,8 +74,8 @@ TEST(WindingTree, SameBitsForAnyThreadCount) {
   const detail::WindingTree tree(s.V, Eigen::VectorXd::Constant(s.V.rows(), 0.5), 2.0);
   const RowMatrixX3d M = sphere_dipoles(s, 20.0);
   const Eigen::VectorXd q = M.col(0);
-  const Eigen::VectorXd w1 = test::on_threads(1, [&] { return tree.winding(M, 0); });
-  const Eigen::VectorXd w2 = test::on_threads(2, [&] { return tree.winding(M, 0); });
+  const Eigen::VectorXd w1 = test::on_threads(1, [&] { return tree.winding(M, {}, 0); });
+  const Eigen::VectorXd w2 = test::on_threads(2, [&] { return tree.winding(M, {}, 0); });
   EXPECT_EQ(w1, w2);
   const RowMatrixX3d g1 = test::on_threads(1, [&] { return tree.field(q, 0); });
   const RowMatrixX3d g2 = test::on_threads(2, [&] { return tree.field(q, 0); });
@@ -233,8 +233,8 @@ TEST(GlobalOrientation, DISABLED_Explore) {
         detail::WindingOrientationOptions zero = o;
         zero.iterations = 0;
         zero.damping = 1e300;
-        const double truth = detail::orient_by_winding(s.V, nb, area, T, 0, zero).residual_before;
-        const auto r = detail::orient_by_winding(s.V, nb, area, N, 0, o);
+        const double truth = detail::orient_by_winding(s.V, nb, nullptr, area, T, 0, zero).residual_before;
+        const auto r = detail::orient_by_winding(s.V, nb, nullptr, area, N, 0, o);
         int bad_lines = 0, good_flipped = 0;
         for (Eigen::Index i = 0; i < N.rows(); ++i) {
           const double c = N.row(i).dot(s.N.row(i));
@@ -271,7 +271,7 @@ TEST(GlobalOrientation, DISABLED_Speed) {
   detail::WindingOrientationOptions o;
   o.beta = env("FOCAL_WO_BETA", o.beta);
   o.iterations = static_cast<int>(env("FOCAL_WO_ITERATIONS", o.iterations));
-  const int turned = detail::orient_by_winding(s.V, nb, detail::patch_areas(s.V, nb, N, 0), N, 0, o).flipped;
+  const int turned = detail::orient_by_winding(s.V, nb, nullptr, detail::patch_areas(s.V, nb, N, 0), N, 0, o).flipped;
   auto t2 = std::chrono::steady_clock::now();
   std::printf("speed %d points: mst %.2f s, global %.2f s, turned %d, flipped %d\n",
               static_cast<int>(s.V.rows()), std::chrono::duration<double>(t1 - t0).count(),

@@ -306,21 +306,24 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   const Eigen::VectorXd area =
       global ? detail::patch_areas(V, neighbours, N, threads) : Eigen::VectorXd();
   if (!copy_of) {
-    const Neighbourhoods graph = symmetric(neighbours, threads);
-    const int components = orient_over_graph(V, graph, N);
-    if (global) tell(detail::orient_by_winding(V, graph, area, N, threads));
+    const int components = orient_over_graph(V, symmetric(neighbours, threads), N);
+    if (global) tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads));
     return components;
   }
   // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
   // from the copy's lists, N taken back (and the copy's N let go meanwhile), the cloud's own
-  // positions.
+  // positions. The winding number's segments read the copy's lists renamed (the graph let go).
   const RowPermutation& p = copy_of->permutation;
-  const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
-  RowMatrixX3d own = detail::rows_from(N, p.position, threads);
-  N = RowMatrixX3d();
-  const int components = orient_over_graph(copy_of->cloud, graph, own);
+  RowMatrixX3d own;
+  int components = 0;
+  {
+    const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
+    own = detail::rows_from(N, p.position, threads);
+    N = RowMatrixX3d();
+    components = orient_over_graph(copy_of->cloud, graph, own);
+  }
   if (global) {
-    tell(detail::orient_by_winding(copy_of->cloud, graph,
+    tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
                                    detail::rows_from(area, p.position, threads), own, threads));
   }
   N = detail::rows_from(own, p.order, threads);
@@ -330,7 +333,8 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
 int orient_normals_global(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
   check_sizes(V, neighbours, "orient_normals_global");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_global: N does not have #V rows");
-  return detail::orient_by_winding(V, neighbours, detail::patch_areas(V, neighbours, N, 0), N, 0)
+  return detail::orient_by_winding(V, neighbours, nullptr, detail::patch_areas(V, neighbours, N, 0),
+                                   N, 0)
       .flipped;
 }
 

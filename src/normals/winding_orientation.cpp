@@ -34,8 +34,10 @@ constexpr double kAcrossChord = 0.7;
 /// whose chord lies in both tangent planes within kSegmentChord of its length and whose signed
 /// normals agree (s_i s_j n_i . n_j > kSegmentAgreement); with `across`, also by the edges
 /// across thin parts (kAcrossChord).
-std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph, const RowMatrixX3d& N,
+std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph,
+                          const std::vector<int>* rename, const RowMatrixX3d& N,
                           const Eigen::VectorXd& s, bool across) {
+  const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
   const auto n = static_cast<int>(V.rows());
   std::vector<int> parent(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) parent[static_cast<std::size_t>(i)] = i;
@@ -46,20 +48,22 @@ std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph, const Row
     }
     return i;
   };
-  for (int i = 0; i < n; ++i) {
+  for (int row = 0; row < n; ++row) {
+    const int i = name(row);
     if (!N.row(i).allFinite()) continue;
-    for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
-      if (*j <= i || !N.row(*j).allFinite()) continue;
-      const Eigen::RowVector3d e = V.row(*j) - V.row(i);
-      const double e2 = e.squaredNorm(), a = N.row(i).dot(e), c = N.row(*j).dot(e);
+    for (const int* jr = graph.begin(row); jr != graph.end(row); ++jr) {
+      const int j = name(*jr);
+      if (j == i || !N.row(j).allFinite()) continue;
+      const Eigen::RowVector3d e = V.row(j) - V.row(i);
+      const double e2 = e.squaredNorm(), a = N.row(i).dot(e), c = N.row(j).dot(e);
       const double limit = kSegmentChord * kSegmentChord * e2;
-      const double agreement = s[i] * s[*j] * N.row(i).dot(N.row(*j));
+      const double agreement = s[i] * s[j] * N.row(i).dot(N.row(j));
       const bool along = a * a <= limit && c * c <= limit && agreement > kSegmentAgreement;
       const double normal = kAcrossChord * kAcrossChord * e2;
       const bool through =
           across && a * a >= normal && c * c >= normal && agreement < -kSegmentAgreement;
       if (!along && !through) continue;
-      const int ri = find(i), rj = find(*j);
+      const int ri = find(i), rj = find(j);
       if (ri != rj) parent[static_cast<std::size_t>(std::max(ri, rj))] = std::min(ri, rj);
     }
   }
@@ -106,6 +110,7 @@ Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, No
 }
 
 WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods& graph,
+                                           const std::vector<int>* rename,
                                            const Eigen::VectorXd& area, RowMatrixX3d& N,
                                            int threads,
                                            const WindingOrientationOptions& options) {
@@ -114,22 +119,20 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   // a_j n_j per point (zero where there is no dipole), the smoothing lengths, the target 1/2 at
   // every finite point.
   RowMatrixX3d A = RowMatrixX3d::Zero(n, 3);
-  Eigen::VectorXd smoothing = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (!V.row(i).allFinite()) continue;
-    b[i] = 0.5;
-    if (!(area[i] > 0.0) || !N.row(i).allFinite()) continue;
-    A.row(i) = area[i] * N.row(i).normalized();
-    smoothing[i] = options.smoothing * std::sqrt(area[i]);
-  }
-  const WindingTree tree(V, smoothing, options.beta);
-  const auto K = [&](const Eigen::VectorXd& s) {
-    return tree.winding((A.array().colwise() * s.array()).matrix(), threads);
-  };
-  const auto Kt = [&](const Eigen::VectorXd& r) {
-    const RowMatrixX3d g = tree.field(r, threads);
-    return Eigen::VectorXd((A.array() * g.array()).rowwise().sum());
-  };
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  const WindingTree tree = [&] {
+    Eigen::VectorXd smoothing = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (!V.row(i).allFinite()) continue;
+      b[i] = 0.5;
+      if (!(area[i] > 0.0) || !N.row(i).allFinite()) continue;
+      A.row(i) = area[i] * N.row(i).normalized();
+      smoothing[i] = options.smoothing * std::sqrt(area[i]);
+    }
+    return WindingTree(V, smoothing, options.beta);
+  }();
+  const auto K = [&](const Eigen::VectorXd& s) { return tree.winding(A, s, threads); };
+  const auto Kt = [&](const Eigen::VectorXd& r) { return tree.transpose(A, r, threads); };
   const double lambda = options.damping;
   const double norm_b = std::sqrt(dot(b, b));
   // Rounds of damped CGLS for d = s - s0 on min |K d - c|^2 + lambda |d|^2, c = b - K s0, each
@@ -172,7 +175,7 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     double energy = dot(r, r);
     bool failed = false;  // the last sweep turned nothing
     for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-      const std::vector<int> label = segments(V, graph, N, s, sweep % 2 == 1);
+      const std::vector<int> label = segments(V, graph, rename, N, s, sweep % 2 == 1);
       const Eigen::VectorXd g = Kt(r);
       std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
       for (Eigen::Index i = 0; i < n; ++i) {

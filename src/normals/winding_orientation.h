@@ -18,6 +18,7 @@
 // across thin parts too) turn those whose turning lowers |K s - 1/2|, checked on the residual
 // itself. Deterministic: the tree's sums are, and the dot products and sweeps are serial.
 #include <Eigen/Core>
+#include <vector>
 
 #include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
@@ -58,10 +59,12 @@ Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, No
                             int threads);
 
 /// Turns rows of N (oriented, e.g. by the tree) to the signs described above, then whole
-/// segments of `graph` (lists over V's rows, e.g. the symmetric neighbour graph) where that
-/// lowers the residual further. `area` as patch_areas (#V). Rows with a zero area or non-finite
-/// normal are left as they are.
+/// segments of `graph` (neighbour lists, e.g. points/neighbours.h's) where that lowers the
+/// residual further. `rename`: null, or graph's rows and entries are renamed to rows of V by it
+/// (the lists of a permuted copy: cloud_jets.h). `area` as patch_areas (#V, V's rows). Rows with
+/// a zero area or non-finite normal are left as they are.
 WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods& graph,
+                                           const std::vector<int>* rename,
                                            const Eigen::VectorXd& area, RowMatrixX3d& N,
                                            int threads,
                                            const WindingOrientationOptions& options = {});

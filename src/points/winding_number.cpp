@@ -104,15 +104,21 @@ void WindingTree::build(PositionsRef V, int node, const Eigen::Vector3d& low, do
   }
 }
 
-Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, int threads) const {
+Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                     int threads) const {
   if (M.rows() != rows_) throw InvalidInput("WindingTree::winding: M does not have #V rows");
+  if (sign.size() != 0 && sign.size() != rows_) {
+    throw InvalidInput("WindingTree::winding: sign is neither empty nor #V long");
+  }
   const auto n = static_cast<Eigen::Index>(order_.size());
   Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
   if (n == 0) return out;
   RowMatrixX3d Mt(n, 3);
   for (Eigen::Index t = 0; t < n; ++t) {
-    const auto m = M.row(order_[static_cast<std::size_t>(t)]);
-    Mt.row(t) = m.allFinite() ? Eigen::RowVector3d(m) : Eigen::RowVector3d::Zero();
+    const int row = order_[static_cast<std::size_t>(t)];
+    const Eigen::RowVector3d m = sign.size() != 0 ? Eigen::RowVector3d(sign[row] * M.row(row))
+                                                  : Eigen::RowVector3d(M.row(row));
+    Mt.row(t) = m.allFinite() ? m : Eigen::RowVector3d::Zero();
   }
   // Moments about each node's centre, children before parents (they come after them).
   const auto count = static_cast<std::size_t>(nodes_.size());
@@ -173,10 +179,24 @@ Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, int threads) const {
 }
 
 RowMatrixX3d WindingTree::field(const Eigen::VectorXd& q, int threads) const {
+  RowMatrixX3d out = RowMatrixX3d::Zero(rows_, 3);
+  each_field(q, threads, [&](int row, const Eigen::Vector3d& g) { out.row(row) = g.transpose(); });
+  return out;
+}
+
+Eigen::VectorXd WindingTree::transpose(const RowMatrixX3d& A, const Eigen::VectorXd& q,
+                                       int threads) const {
+  if (A.rows() != rows_) throw InvalidInput("WindingTree::transpose: A does not have #V rows");
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
+  each_field(q, threads, [&](int row, const Eigen::Vector3d& g) { out[row] = A.row(row).dot(g); });
+  return out;
+}
+
+template <class Out>
+void WindingTree::each_field(const Eigen::VectorXd& q, int threads, Out&& result) const {
   if (q.size() != rows_) throw InvalidInput("WindingTree::field: q does not have #V entries");
   const auto n = static_cast<Eigen::Index>(order_.size());
-  RowMatrixX3d out = RowMatrixX3d::Zero(rows_, 3);
-  if (n == 0) return out;
+  if (n == 0) return;
   Eigen::VectorXd qt(n);
   for (Eigen::Index t = 0; t < n; ++t) {
     const double v = q[order_[static_cast<std::size_t>(t)]];
@@ -235,9 +255,8 @@ RowMatrixX3d WindingTree::field(const Eigen::VectorXd& q, int threads) const {
           stack[top++] = c;
       }
     }
-    out.row(order_[static_cast<std::size_t>(t)]) = kInvFourPi * g.transpose();
+    result(order_[static_cast<std::size_t>(t)], (kInvFourPi * g).eval());
   });
-  return out;
 }
 
 Eigen::VectorXd WindingTree::near_column_norms(const RowMatrixX3d& M, int threads) const {

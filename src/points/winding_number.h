@@ -31,11 +31,17 @@ class WindingTree {
   /// `smoothing`: #V smoothing lengths s_j (>= 0). `beta` > 1: the far-field criterion.
   WindingTree(PositionsRef V, const Eigen::VectorXd& smoothing, double beta);
 
-  /// w_i at every point of V for dipoles M (#V x 3).
-  [[nodiscard]] Eigen::VectorXd winding(const RowMatrixX3d& M, int threads) const;
+  /// w_i at every point of V for dipoles M (#V x 3), each row times its entry of `sign` (#V)
+  /// when that is not empty.
+  [[nodiscard]] Eigen::VectorXd winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                        int threads) const;
 
   /// g_j (#V x 3) at every point of V for charges q (#V).
   [[nodiscard]] RowMatrixX3d field(const Eigen::VectorXd& q, int threads) const;
+
+  /// A_j . g_j (#V) at every point of V for charges q: (K^T q)_j for dipoles A (#V x 3).
+  [[nodiscard]] Eigen::VectorXd transpose(const RowMatrixX3d& A, const Eigen::VectorXd& q,
+                                          int threads) const;
 
   /// sum_i (m_j . (p_j - p_i) / (4 pi rho_ij^3))^2 at every point j over the points i of the
   /// cells near it (those not taken as a whole): the squared norm of column j of K where its
@@ -56,6 +62,9 @@ class WindingTree {
   };
   /// Splits `node` (its rows in order_, its cube's corner `low` and side `size`) into octants.
   void build(PositionsRef V, int node, const Eigen::Vector3d& low, double size, int depth);
+  /// Calls out(row, g) with the field g of charges q at every finite row of V.
+  template <class Out>
+  void each_field(const Eigen::VectorXd& q, int threads, Out&& out) const;
 
   RowMatrixX3d P_;              ///< the finite points in tree order
   Eigen::VectorXd s2_;          ///< half their squared smoothing lengths, in tree order
