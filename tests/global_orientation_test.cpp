@@ -92,11 +92,16 @@ enum class Shape { plate, thick_plate, coin, ring, touching_spheres };
 
 const char* shape_name(Shape s) {
   switch (s) {
-    case Shape::plate: return "plate 40x40x2";
-    case Shape::thick_plate: return "plate 40x40x6";
-    case Shape::coin: return "coin R15 t2";
-    case Shape::ring: return "ring R12 r1";
-    case Shape::touching_spheres: return "touching spheres r8";
+    case Shape::plate:
+      return "plate 40x40x2";
+    case Shape::thick_plate:
+      return "plate 40x40x6";
+    case Shape::coin:
+      return "coin R15 t2";
+    case Shape::ring:
+      return "ring R12 r1";
+    case Shape::touching_spheres:
+      return "touching spheres r8";
   }
   return "";
 }
@@ -104,10 +109,18 @@ const char* shape_name(Shape s) {
 test::Solid solid(Shape shape, std::uint64_t seed, double noise) {
   test::SolidBuilder b(seed);
   switch (shape) {
-    case Shape::plate: b.box({40, 40, 2}); break;
-    case Shape::thick_plate: b.box({40, 40, 6}); break;
-    case Shape::coin: b.coin(15, 2); break;
-    case Shape::ring: b.ring(12, 1); break;
+    case Shape::plate:
+      b.box({40, 40, 2});
+      break;
+    case Shape::thick_plate:
+      b.box({40, 40, 6});
+      break;
+    case Shape::coin:
+      b.coin(15, 2);
+      break;
+    case Shape::ring:
+      b.ring(12, 1);
+      break;
     case Shape::touching_spheres:
       b.sphere({-8, 0, 0}, 8);
       b.sphere({8, 0, 0}, 8);
@@ -158,7 +171,9 @@ TEST(GlobalOrientation, ThickSolidsStayRight) {
 TEST(GlobalOrientation, SameBitsForAnyThreadCount) {
   const test::Solid s = solid(Shape::plate, 4, 0.1);
   const Neighbourhoods nb = nearest_neighbours(s.V, 16);
-  const auto run = [&] { return cloud_normals(s.V, nb, {.orientation = CloudOrientation::global}); };
+  const auto run = [&] {
+    return cloud_normals(s.V, nb, {.orientation = CloudOrientation::global});
+  };
   EXPECT_EQ(test::on_threads(1, run), test::on_threads(2, run));
 }
 
@@ -189,9 +204,8 @@ TEST(GlobalOrientation, DISABLED_Table) {
         const int global = flipped(s, CloudOrientation::global);
         const auto t2 = std::chrono::steady_clock::now();
         std::printf("%-22s noise %.1f seed %d  points %6d  mst %5d  global %5d  (%.2f s, %.2f s)\n",
-                    shape_name(shape), noise, static_cast<int>(seed),
-                    static_cast<int>(s.V.rows()), mst, global,
-                    std::chrono::duration<double>(t1 - t0).count(),
+                    shape_name(shape), noise, static_cast<int>(seed), static_cast<int>(s.V.rows()),
+                    mst, global, std::chrono::duration<double>(t1 - t0).count(),
                     std::chrono::duration<double>(t2 - t1).count());
       }
     }
@@ -233,21 +247,25 @@ TEST(GlobalOrientation, DISABLED_Explore) {
         detail::WindingOrientationOptions zero = o;
         zero.iterations = 0;
         zero.damping = 1e300;
-        const double truth = detail::orient_by_winding(s.V, nb, nullptr, area, T, 0, zero).residual_before;
+        const double truth =
+            detail::orient_by_winding(s.V, nb, nullptr, area, T, 0, zero).residual_before;
         const auto r = detail::orient_by_winding(s.V, nb, nullptr, area, N, 0, o);
         int bad_lines = 0, good_flipped = 0;
         for (Eigen::Index i = 0; i < N.rows(); ++i) {
           const double c = N.row(i).dot(s.N.row(i));
-          if (std::abs(c) < 0.5) ++bad_lines;
-          else if (c < 0.0) ++good_flipped;
+          if (std::abs(c) < 0.5)
+            ++bad_lines;
+          else if (c < 0.0)
+            ++good_flipped;
         }
         std::printf("lines %s %d %d: %d of %d off by > 60 deg; flipped among the rest %d\n",
                     shape_name(shape), static_cast<int>(noise * 10), static_cast<int>(seed),
                     bad_lines, static_cast<int>(N.rows()), good_flipped);
-        std::printf("%-22s noise %.1f seed %d mst %5d global %5d residual truth %.3f mst %.3f "
-                    "global %.3f\n",
-                    shape_name(shape), noise, static_cast<int>(seed), mst,
-                    test::flipped_against(N, s.N), truth, r.residual_before, r.residual_after);
+        std::printf(
+            "%-22s noise %.1f seed %d mst %5d global %5d residual truth %.3f mst %.3f "
+            "global %.3f\n",
+            shape_name(shape), noise, static_cast<int>(seed), mst, test::flipped_against(N, s.N),
+            truth, r.residual_before, r.residual_after);
       }
     }
   }
@@ -271,7 +289,9 @@ TEST(GlobalOrientation, DISABLED_Speed) {
   detail::WindingOrientationOptions o;
   o.beta = env("FOCAL_WO_BETA", o.beta);
   o.iterations = static_cast<int>(env("FOCAL_WO_ITERATIONS", o.iterations));
-  const int turned = detail::orient_by_winding(s.V, nb, nullptr, detail::patch_areas(s.V, nb, N, 0), N, 0, o).flipped;
+  const int turned =
+      detail::orient_by_winding(s.V, nb, nullptr, detail::patch_areas(s.V, nb, N, 0), N, 0, o)
+          .flipped;
   auto t2 = std::chrono::steady_clock::now();
   std::printf("speed %d points: mst %.2f s, global %.2f s, turned %d, flipped %d\n",
               static_cast<int>(s.V.rows()), std::chrono::duration<double>(t1 - t0).count(),

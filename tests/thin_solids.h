@@ -31,7 +31,8 @@ class SolidBuilder {
   }
 
   /// The rectangle corner + u a + v b (u, v in [0, 1]), normal a x b outward.
-  void rectangle(const Eigen::Vector3d& corner, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  void rectangle(const Eigen::Vector3d& corner, const Eigen::Vector3d& a,
+                 const Eigen::Vector3d& b) {
     const int nu = std::max(1, static_cast<int>(std::lround(a.norm())));
     const int nv = std::max(1, static_cast<int>(std::lround(b.norm())));
     const Eigen::Vector3d n = a.cross(b);

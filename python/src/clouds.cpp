@@ -114,11 +114,10 @@ focal::CloudOptions cloud_options_from(const nb::dict& d) {
                                                   : nb::cast<std::vector<double>>(d["viewpoint"]);
   const double adaptive_radius =
       d.contains("adaptive_radius") ? nb::cast<double>(d["adaptive_radius"]) : 0.0;
-  focal::CloudOptions o = cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]),
-                                        adaptive_radius, nb::cast<std::string>(d["normal_method"]),
-                                        viewpoint, nb::cast<std::string>(d["solver"]),
-                                        d.contains("orient") ? nb::cast<std::string>(d["orient"])
-                                                             : std::string("mst"));
+  focal::CloudOptions o = cloud_options(
+      nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]), adaptive_radius,
+      nb::cast<std::string>(d["normal_method"]), viewpoint, nb::cast<std::string>(d["solver"]),
+      d.contains("orient") ? nb::cast<std::string>(d["orient"]) : std::string("mst"));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
   o.off_surface_ratio = nb::cast<double>(d["off_surface_ratio"]);
   return o;

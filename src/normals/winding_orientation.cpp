@@ -43,7 +43,8 @@ std::vector<int> segments(PositionsRef V, const Neighbourhoods& graph,
   for (int i = 0; i < n; ++i) parent[static_cast<std::size_t>(i)] = i;
   const auto find = [&](int i) {
     while (parent[static_cast<std::size_t>(i)] != i) {
-      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      parent[static_cast<std::size_t>(i)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
       i = parent[static_cast<std::size_t>(i)];
     }
     return i;
@@ -88,7 +89,8 @@ Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, No
     const Eigen::RowVector3d n = N.row(i).normalized();
     int m = 0, all = 0;
     double tangent2 = 0.0, last2 = 0.0;
-    for (const int* j = neighbours.begin(static_cast<int>(i)); j != neighbours.end(static_cast<int>(i)); ++j) {
+    for (const int* j = neighbours.begin(static_cast<int>(i));
+         j != neighbours.end(static_cast<int>(i)); ++j) {
       const Eigen::RowVector3d e = V.row(*j) - V.row(i);
       const double e2 = e.squaredNorm();
       if (!std::isfinite(e2)) continue;
@@ -112,8 +114,7 @@ Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, No
 WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods& graph,
                                            const std::vector<int>* rename,
                                            const Eigen::VectorXd& area, RowMatrixX3d& N,
-                                           int threads,
-                                           const WindingOrientationOptions& options) {
+                                           int threads, const WindingOrientationOptions& options) {
   const Eigen::Index n = V.rows();
   WindingOrientationReport report;
   // a_j n_j per point (zero where there is no dipole), the smoothing lengths, the target 1/2 at
@@ -180,7 +181,8 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
       std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
       for (Eigen::Index i = 0; i < n; ++i) {
         if (A.row(i).isZero()) continue;
-        gain[static_cast<std::size_t>(label[i])] += s[i] * g[i] - (sweep % 2 == 1 ? 0.0 : column[i]);
+        gain[static_cast<std::size_t>(label[i])] +=
+            s[i] * g[i] - (sweep % 2 == 1 ? 0.0 : column[i]);
       }
       bool lowered = false;
       Eigen::VectorXd next = s, r_next;

@@ -28,11 +28,11 @@ namespace focal::detail {
 /// Settings of orient_by_winding (defaults measured in docs/notes/points-log.md, "Global
 /// orientation").
 struct WindingOrientationOptions {
-  double beta = 1.5;         ///< far-field criterion of the tree
-  double damping = 0.05;     ///< lambda above
-  int iterations = 5;        ///< CGLS iterations per round
-  int rounds = 1;            ///< rounds, each seeded from the signs of the last
-  int sweeps = 6;            ///< sweeps over segments after the rounds, at most
+  double beta = 1.5;      ///< far-field criterion of the tree
+  double damping = 0.05;  ///< lambda above
+  int iterations = 5;     ///< CGLS iterations per round
+  int rounds = 1;         ///< rounds, each seeded from the signs of the last
+  int sweeps = 6;         ///< sweeps over segments after the rounds, at most
   /// The signs are taken only where the field decides: the residual of the signs found at most
   /// closed_residual and at most closed_gain times the tree's. Measured (docs/notes/points-log.md,
   /// "Global orientation"): closed thin solids 0.13-0.34 and 0.10-0.33 of the tree's, CGAL's
@@ -40,15 +40,15 @@ struct WindingOrientationOptions {
   /// before_upsample, sphere_20k_normal) or 0.52-0.90 of the tree's (point_set_3, oni too).
   double closed_residual = 0.4;
   double closed_gain = 0.4;
-  double smoothing = 0.5;    ///< smoothing length of each point, times sqrt of its area
+  double smoothing = 0.5;  ///< smoothing length of each point, times sqrt of its area
 };
 
 /// What orient_by_winding did.
 struct WindingOrientationReport {
-  bool decided = false;           ///< the field decided (the options' closed_* tests passed)
-  int flipped = 0;                ///< rows of N turned (0 unless decided)
-  double residual_before = NAN;   ///< |K s0 - 1/2| / |1/2| over the finite points
-  double residual_after = NAN;    ///< the same for the signs found
+  bool decided = false;          ///< the field decided (the options' closed_* tests passed)
+  int flipped = 0;               ///< rows of N turned (0 unless decided)
+  double residual_before = NAN;  ///< |K s0 - 1/2| / |1/2| over the finite points
+  double residual_after = NAN;   ///< the same for the signs found
 };
 
 /// The area of each point's patch (#V): pi d^2 / m over its list in `neighbours` (sorted by

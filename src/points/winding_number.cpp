@@ -62,7 +62,8 @@ void WindingTree::build(PositionsRef V, int node, const Eigen::Vector3d& low, do
   }
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   double r2 = 0.0;
-  for (int t = begin; t < end; ++t) r2 = std::max(r2, (V.row(order_[t]).transpose() - centre).squaredNorm());
+  for (int t = begin; t < end; ++t)
+    r2 = std::max(r2, (V.row(order_[t]).transpose() - centre).squaredNorm());
   nodes_[node].centre = centre;
   nodes_[node].radius = std::sqrt(r2);
   if (end - begin <= kLeafPoints || depth >= kMaxDepth || r2 == 0.0) return;
@@ -70,7 +71,8 @@ void WindingTree::build(PositionsRef V, int node, const Eigen::Vector3d& low, do
   // the cube's midpoint; a stable counting sort keeps rows in order within each octant.
   const Eigen::Vector3d mid = low + Eigen::Vector3d::Constant(0.5 * size);
   const auto octant = [&](int i) {
-    return (V(i, 0) >= mid.x() ? 1 : 0) | (V(i, 1) >= mid.y() ? 2 : 0) | (V(i, 2) >= mid.z() ? 4 : 0);
+    return (V(i, 0) >= mid.x() ? 1 : 0) | (V(i, 1) >= mid.y() ? 2 : 0) |
+           (V(i, 2) >= mid.z() ? 4 : 0);
   };
   std::array<int, 9> start{};
   for (int t = begin; t < end; ++t) ++start[static_cast<std::size_t>(octant(order_[t])) + 1];
@@ -101,6 +103,26 @@ void WindingTree::build(PositionsRef V, int node, const Eigen::Vector3d& low, do
     const Eigen::Vector3d child_low(o & 1 ? mid.x() : low.x(), o & 2 ? mid.y() : low.y(),
                                     o & 4 ? mid.z() : low.z());
     build(V, c++, child_low, 0.5 * size, depth + 1);
+  }
+}
+
+template <class Far, class Near>
+void WindingTree::visit(const Eigen::Vector3d& q, Far&& far, Near&& near) const {
+  int stack[8 * kMaxDepth + 8];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const auto k = static_cast<std::size_t>(stack[--top]);
+    const Node& node = nodes_[k];
+    const double d2 = (node.centre - q).squaredNorm();
+    if (d2 > beta2_ * node.radius * node.radius) {
+      far(node, k, d2);
+    } else if (node.first_child < 0) {
+      near(node);
+    } else {
+      for (int c = node.first_child + node.children - 1; c >= node.first_child; --c)
+        stack[top++] = c;
+    }
   }
 }
 
@@ -148,31 +170,23 @@ Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorX
     const Eigen::Vector3d q = P_.row(t).transpose();
     const double own = s2_[t];
     double w = 0.0;
-    int stack[8 * kMaxDepth + 8];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
-      const Eigen::Vector3d x = node.centre - q;
-      const double d2 = x.squaredNorm();
-      if (d2 > beta2_ * node.radius * node.radius) {
-        const auto k = static_cast<std::size_t>(&node - nodes_.data());
-        const double rho2 = d2 + own + node.s2;
-        const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
-        const Eigen::Matrix3d& T = second[k];
-        w += inv3 * (sum[k].dot(x) + T.trace() - 3.0 * inv2 * x.dot(T * x));
-      } else if (node.first_child < 0) {
-        for (int j = node.begin; j < node.end; ++j) {
-          const double rx = P_(j, 0) - q.x(), ry = P_(j, 1) - q.y(), rz = P_(j, 2) - q.z();
-          const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[j];
-          if (rho2 == 0.0) continue;  // a coincident point without smoothing: no term
-          w += (Mt(j, 0) * rx + Mt(j, 1) * ry + Mt(j, 2) * rz) / (rho2 * std::sqrt(rho2));
-        }
-      } else {
-        for (int c = node.first_child + node.children - 1; c >= node.first_child; --c)
-          stack[top++] = c;
-      }
-    }
+    visit(
+        q,
+        [&](const Node& node, std::size_t k, double d2) {
+          const Eigen::Vector3d x = node.centre - q;
+          const double rho2 = d2 + own + node.s2;
+          const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
+          const Eigen::Matrix3d& T = second[k];
+          w += inv3 * (sum[k].dot(x) + T.trace() - 3.0 * inv2 * x.dot(T * x));
+        },
+        [&](const Node& node) {
+          for (int j = node.begin; j < node.end; ++j) {
+            const double rx = P_(j, 0) - q.x(), ry = P_(j, 1) - q.y(), rz = P_(j, 2) - q.z();
+            const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[j];
+            if (rho2 == 0.0) continue;  // a coincident point without smoothing: no term
+            w += (Mt(j, 0) * rx + Mt(j, 1) * ry + Mt(j, 2) * rz) / (rho2 * std::sqrt(rho2));
+          }
+        });
     out[order_[static_cast<std::size_t>(t)]] = kInvFourPi * w;
   });
   return out;
@@ -228,39 +242,32 @@ void WindingTree::each_field(const Eigen::VectorXd& q, int threads, Out&& result
     const Eigen::Vector3d p = P_.row(t).transpose();
     const double own = s2_[t];
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    int stack[8 * kMaxDepth + 8];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
-      const Eigen::Vector3d x = p - node.centre;
-      const double d2 = x.squaredNorm();
-      if (d2 > beta2_ * node.radius * node.radius) {
-        const auto k = static_cast<std::size_t>(&node - nodes_.data());
-        const double rho2 = d2 + own + node.s2;
-        const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
-        g += inv3 * (charge[k] * x - dipole[k] + 3.0 * inv2 * x.dot(dipole[k]) * x);
-      } else if (node.first_child < 0) {
-        double gx = 0.0, gy = 0.0, gz = 0.0;
-        for (int i = node.begin; i < node.end; ++i) {
-          const double rx = p.x() - P_(i, 0), ry = p.y() - P_(i, 1), rz = p.z() - P_(i, 2);
-          const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[i];
-          if (rho2 == 0.0) continue;
-          const double f = qt[i] / (rho2 * std::sqrt(rho2));
-          gx += f * rx, gy += f * ry, gz += f * rz;
-        }
-        g += Eigen::Vector3d(gx, gy, gz);
-      } else {
-        for (int c = node.first_child + node.children - 1; c >= node.first_child; --c)
-          stack[top++] = c;
-      }
-    }
+    visit(
+        p,
+        [&](const Node& node, std::size_t k, double d2) {
+          const Eigen::Vector3d x = p - node.centre;
+          const double rho2 = d2 + own + node.s2;
+          const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
+          g += inv3 * (charge[k] * x - dipole[k] + 3.0 * inv2 * x.dot(dipole[k]) * x);
+        },
+        [&](const Node& node) {
+          double gx = 0.0, gy = 0.0, gz = 0.0;
+          for (int i = node.begin; i < node.end; ++i) {
+            const double rx = p.x() - P_(i, 0), ry = p.y() - P_(i, 1), rz = p.z() - P_(i, 2);
+            const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[i];
+            if (rho2 == 0.0) continue;
+            const double f = qt[i] / (rho2 * std::sqrt(rho2));
+            gx += f * rx, gy += f * ry, gz += f * rz;
+          }
+          g += Eigen::Vector3d(gx, gy, gz);
+        });
     result(order_[static_cast<std::size_t>(t)], (kInvFourPi * g).eval());
   });
 }
 
 Eigen::VectorXd WindingTree::near_column_norms(const RowMatrixX3d& M, int threads) const {
-  if (M.rows() != rows_) throw InvalidInput("WindingTree::near_column_norms: M does not have #V rows");
+  if (M.rows() != rows_)
+    throw InvalidInput("WindingTree::near_column_norms: M does not have #V rows");
   const auto n = static_cast<Eigen::Index>(order_.size());
   Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
   parallel_for(n, threads, [&](std::int64_t t) {
@@ -269,25 +276,17 @@ Eigen::VectorXd WindingTree::near_column_norms(const RowMatrixX3d& M, int thread
     const Eigen::Vector3d m = M.row(row).transpose(), p = P_.row(t).transpose();
     const double own = s2_[t];
     double sum = 0.0;
-    int stack[8 * kMaxDepth + 8];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
-      if ((node.centre - p).squaredNorm() > beta2_ * node.radius * node.radius) continue;
-      if (node.first_child < 0) {
-        for (int i = node.begin; i < node.end; ++i) {
-          const Eigen::Vector3d r = p - P_.row(i).transpose();
-          const double rho2 = r.squaredNorm() + own + s2_[i];
-          if (rho2 == 0.0) continue;
-          const double k = m.dot(r) / (rho2 * std::sqrt(rho2));
-          sum += k * k;
-        }
-      } else {
-        for (int c = node.first_child + node.children - 1; c >= node.first_child; --c)
-          stack[top++] = c;
-      }
-    }
+    visit(
+        p, [](const Node&, std::size_t, double) {},
+        [&](const Node& node) {
+          for (int i = node.begin; i < node.end; ++i) {
+            const Eigen::Vector3d r = p - P_.row(i).transpose();
+            const double rho2 = r.squaredNorm() + own + s2_[i];
+            if (rho2 == 0.0) continue;
+            const double k = m.dot(r) / (rho2 * std::sqrt(rho2));
+            sum += k * k;
+          }
+        });
     out[row] = kInvFourPi * kInvFourPi * sum;
   });
   return out;

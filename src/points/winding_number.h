@@ -5,7 +5,8 @@
 //
 // Each point j is a dipole m_j (its normal times its area, times a sign). The winding number at
 // point i of all the dipoles is
-//   w_i = sum_j m_j . (p_j - p_i) / (4 pi rho_ij^3),  rho_ij^2 = |p_j - p_i|^2 + (s_i^2 + s_j^2) / 2
+//   w_i = sum_j m_j . (p_j - p_i) / (4 pi rho_ij^3),  rho_ij^2 = |p_j - p_i|^2 + (s_i^2 + s_j^2) /
+//   2
 // with s_j a smoothing length per point (the term j = i is 0): 1 inside a closed surface sampled
 // with outward normals, 0 outside and 1/2 on it (the principal value). Its transpose, the field
 // of charges q_i at the points,
@@ -16,8 +17,9 @@
 // A cell of the octree (at most kLeafPoints points) whose points lie within R of its centre c
 // is taken as a whole for a point q with |q - c| > beta R: by its moments about c to second order
 // (the sum of m_j and of m_j (p_j - c)^T; the sum of q_i and of q_i (p_i - c)), smoothed by the
-// mean of its points' smoothing (a cell of one point is that point's exact term). Each point's sum runs over the cells in the tree's fixed order, one point per
-// parallel task: the same bits for any thread count.
+// mean of its points' smoothing (a cell of one point is that point's exact term). Each point's sum
+// runs over the cells in the tree's fixed order, one point per parallel task: the same bits for any
+// thread count.
 #include <Eigen/Core>
 #include <vector>
 
@@ -58,18 +60,22 @@ class WindingTree {
     int begin = 0, end = 0;  ///< its points: order_[begin, end)
     int first_child = -1;    ///< children first_child ... first_child + children - 1; -1: leaf
     int children = 0;
-    double s2 = 0.0;         ///< the mean of its points' half squared smoothing lengths
+    double s2 = 0.0;  ///< the mean of its points' half squared smoothing lengths
   };
   /// Splits `node` (its rows in order_, its cube's corner `low` and side `size`) into octants.
   void build(PositionsRef V, int node, const Eigen::Vector3d& low, double size, int depth);
+  /// The cells for a point q, in the tree's fixed order: far(node, index, |q - centre|^2) for
+  /// each cell taken as a whole, near(leaf) for each leaf that is not.
+  template <class Far, class Near>
+  void visit(const Eigen::Vector3d& q, Far&& far, Near&& near) const;
   /// Calls out(row, g) with the field g of charges q at every finite row of V.
   template <class Out>
   void each_field(const Eigen::VectorXd& q, int threads, Out&& out) const;
 
-  RowMatrixX3d P_;              ///< the finite points in tree order
-  Eigen::VectorXd s2_;          ///< half their squared smoothing lengths, in tree order
-  std::vector<int> order_;      ///< tree position -> row of V
-  std::vector<Node> nodes_;     ///< nodes_[0] the root; children after their parent
+  RowMatrixX3d P_;           ///< the finite points in tree order
+  Eigen::VectorXd s2_;       ///< half their squared smoothing lengths, in tree order
+  std::vector<int> order_;   ///< tree position -> row of V
+  std::vector<Node> nodes_;  ///< nodes_[0] the root; children after their parent
   Eigen::Index rows_ = 0;
   double beta2_ = 4.0;
 };
