@@ -300,3 +300,56 @@ TEST(GlobalOrientation, DISABLED_Speed) {
 }
 }  // namespace
 }  // namespace focal
+namespace focal {
+namespace {
+// A WNNC-like iteration for comparison (Lin et al. 2024: normals <- -normalised gradient of the
+// smoothed winding number, annealed width), by direct sums on the small cases: the PCA lines
+// take the sign of the iterate. FOCAL_WO_SEED=1 starts from the tree's normals, else from
+// the PCA lines' arbitrary signs.
+TEST(GlobalOrientation, DISABLED_Wnnc) {
+  const int iterations = static_cast<int>(env("FOCAL_WO_ITERATIONS", 40));
+  const bool seeded = env("FOCAL_WO_SEED", 1) > 0;
+  for (const Shape shape :
+       {Shape::plate, Shape::thick_plate, Shape::coin, Shape::ring, Shape::touching_spheres}) {
+    for (std::uint64_t seed : {1, 2}) {
+      const test::Solid s = solid(shape, seed, 0.0);
+      const Neighbourhoods nb = nearest_neighbours(s.V, 16);
+      const RowMatrixX3d pca = pca_normals(s.V, nb);
+      RowMatrixX3d N = pca;
+      if (seeded) orient_normals_mst(s.V, nb, N);
+      const Eigen::VectorXd a = detail::patch_areas(s.V, nb, N, 0);
+      const Eigen::Index n = s.V.rows();
+      for (int it = 0; it < iterations; ++it) {
+        // width from 4 spacings down to 0.5, geometrically
+        const double t = iterations > 1 ? static_cast<double>(it) / (iterations - 1) : 1.0;
+        const double sigma = 4.0 * std::pow(0.125, t);
+        RowMatrixX3d G(n, 3);
+        for (Eigen::Index i = 0; i < n; ++i) {
+          Eigen::Vector3d g = Eigen::Vector3d::Zero();
+          for (Eigen::Index j = 0; j < n; ++j) {
+            if (j == i) continue;
+            const Eigen::Vector3d r = (s.V.row(j) - s.V.row(i)).transpose();
+            const Eigen::Vector3d m = a[j] * N.row(j).transpose();
+            const double rho2 = r.squaredNorm() + sigma * sigma;
+            const double inv3 = 1.0 / (rho2 * std::sqrt(rho2));
+            g += -m * inv3 + 3.0 * m.dot(r) * r * inv3 / rho2;
+          }
+          G.row(i) = g.transpose();
+        }
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double norm = G.row(i).norm();
+          if (norm > 0.0) N.row(i) = -G.row(i) / norm;
+        }
+      }
+      RowMatrixX3d signed_lines = pca;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (signed_lines.row(i).dot(N.row(i)) < 0.0) signed_lines.row(i) *= -1.0;
+      }
+      std::printf("wnnc %-22s seed %d: flipped %d of %d\n", shape_name(shape),
+                  static_cast<int>(seed), test::flipped_against(signed_lines, s.N),
+                  static_cast<int>(n));
+    }
+  }
+}
+}  // namespace
+}  // namespace focal
