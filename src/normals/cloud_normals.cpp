@@ -286,14 +286,15 @@ namespace {
 void tell(const detail::WindingOrientationReport& r) {
   const Execution& execution = current_execution();
   if (!execution.info) return;
-  char line[200];
-  std::snprintf(line, sizeof line,
-                "global orientation: winding-number residual %.3f with the tree's signs, %.3f "
-                "with the field's: %s",
-                r.residual_before, r.residual_after,
-                r.decided ? (std::to_string(r.flipped) + " normals turned").c_str()
-                          : "not closed enough to decide, the tree's signs kept");
-  execution.info(line);
+  const std::string verdict =
+      r.decided ? std::to_string(r.flipped) + " normals turned"
+      : r.residual_after <= detail::WindingOrientationOptions{}.closed_residual
+          ? "the tree's signs kept (the field's fit them hardly better)"
+          : "the tree's signs kept (the field does not decide: an open or noisy cloud)";
+  char line[120];
+  std::snprintf(line, sizeof line, "global orientation: winding-number residual %.3f -> %.3f: ",
+                r.residual_before, r.residual_after);
+  execution.info(line + verdict);
 }
 
 }  // namespace
