@@ -292,8 +292,9 @@ void tell(const detail::WindingOrientationReport& r) {
           ? "the tree's signs kept (the field's fit them hardly better)"
           : "the tree's signs kept (the field does not decide: an open or noisy cloud)";
   char line[120];
-  std::snprintf(line, sizeof line, "global orientation: winding-number residual %.3f -> %.3f: ",
-                r.residual_before, r.residual_after);
+  std::snprintf(line, sizeof line,
+                "global orientation: winding-number residual %.3f -> %.3f: ", r.residual_before,
+                r.residual_after);
   execution.info(line + verdict);
 }
 
