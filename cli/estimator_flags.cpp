@@ -154,6 +154,18 @@ void EstimatorFlags::add_cloud_flags(CLI::App& command) {
                   "scanner) instead of by a minimum spanning tree")
       ->delimiter(',')
       ->expected(3);
+  const std::map<std::string, CloudOrientation> orientations = {
+      {"mst", CloudOrientation::mst},
+      {"global", CloudOrientation::global},
+      {"viewpoint", CloudOrientation::viewpoint}};
+  command
+      .add_option("--orient", cloud.normals.orientation,
+                  "point clouds without normals: how estimated normals get their side: mst (a "
+                  "minimum spanning tree), global (the tree, then the winding number: closed "
+                  "surfaces with thin or touching parts; docs/POINTS.md) or viewpoint (towards "
+                  "--viewpoint)")
+      ->transform(CLI::CheckedTransformer(orientations))
+      ->default_str("mst");
   command
       .add_option("--cloud-normals", cloud.normals.method,
                   "point clouds without normals: pca, or jet (PCA then a quadratic jet)")
@@ -172,6 +184,10 @@ CloudOptions EstimatorFlags::cloud_options() const {
   o.solver = options.solver;
   if (viewpoint.size() == 3)
     o.normals.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
+  if (o.normals.orientation == CloudOrientation::viewpoint && !o.normals.viewpoint)
+    throw InvalidInput("--orient viewpoint needs --viewpoint X,Y,Z");
+  if (o.normals.orientation == CloudOrientation::global && o.normals.viewpoint)
+    throw InvalidInput("--orient global and --viewpoint conflict: give one");
   return o;
 }
 

@@ -59,6 +59,7 @@ def cloud_curvature(
     solver: str = "closed-form",
     outlier_ratio: float = 3.0,
     off_surface_ratio: float = 10.0,
+    orient: str = "mst",
     threads: Optional[int] = None,
 ) -> Curvature:
     """Principal curvatures and directions, H and K of a point cloud, by the two-slit fit of the
@@ -76,6 +77,9 @@ def cloud_curvature(
     adaptive_radius : c: the neighbours within c times the local spacing instead (the median,
         over the point and its k nearest, of their distances to their k-th nearest; docs/POINTS.md).
     viewpoint : (x, y, z) the scanner position: estimated normals face it.
+    orient : how estimated normals get their side: ``"mst"`` (a minimum spanning tree, or the
+        viewpoint when given), ``"global"`` (the tree, then the winding number: closed surfaces
+        with thin or touching parts; docs/POINTS.md, "Orientation") or ``"viewpoint"``.
     solver : ``"closed-form"`` or ``"levenberg-marquardt"`` (the paper's).
     outlier_ratio : points farther from their 16 nearest than this many times their neighbours'
         median of the same are left out (NaN, ``undefined``); 0 keeps every point (the library
@@ -102,7 +106,7 @@ def cloud_curvature(
     _finite_positions(P, "points")
     d = _ext.cloud_curvature(
         P, N, k, r, a, normal_method, _viewpoint(viewpoint), solver, float(outlier_ratio),
-        float(off_surface_ratio), t
+        float(off_surface_ratio), str(orient), t
     )
     return Curvature(**d)
 
@@ -115,12 +119,14 @@ def cloud_normals(
     adaptive_radius: Optional[float] = None,
     normal_method: str = "jet",
     viewpoint: Optional[Sequence[float]] = None,
+    orient: str = "mst",
     threads: Optional[int] = None,
 ) -> np.ndarray:
     """(n, 3) unit normals of a point cloud, estimated and consistently oriented, as
     ``focal normals`` and cloud_curvature estimate them (k=0: the default's plan, jets over 16
     neighbours or 64 on noisy positions, NaN rows for the outliers it leaves out; k, radius or
     adaptive_radius: PCA then jets over those; include/focal/curvature/cloud_curvature.h,
-    estimate_cloud_normals). NaN rows where a point has fewer than two neighbours."""
+    estimate_cloud_normals). NaN rows where a point has fewer than two neighbours. ``orient``
+    as cloud_curvature's."""
     P, k, r, a, t = _cloud_arguments(points, k, radius, adaptive_radius, threads)
-    return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), t)
+    return _ext.cloud_normals(P, k, r, a, normal_method, _viewpoint(viewpoint), str(orient), t)

@@ -134,6 +134,7 @@ _CLOUD_OPTIONS = {
     "viewpoint": None,
     "outlier_ratio": 3.0,
     "off_surface_ratio": 10.0,
+    "orient": "mst",
 }
 #: Options that only meshes have (the solver applies to clouds too).
 _MESH_ONLY = ("normals", "method", "rings", "ray_weighting", "gaussian_width")
@@ -176,6 +177,7 @@ def _cloud_options(V: Any, cloud: dict, solver: str, threads: Optional[int]) -> 
         "solver": solver,
         "outlier_ratio": float(cloud["outlier_ratio"]),
         "off_surface_ratio": float(cloud["off_surface_ratio"]),
+        "orient": str(cloud["orient"]),
         "threads": t,
     }
 
@@ -214,6 +216,7 @@ def curvature(
     viewpoint: Optional[Sequence[float]] = None,
     outlier_ratio: float = 3.0,
     off_surface_ratio: float = 10.0,
+    orient: str = "mst",
 ) -> Curvature:
     """Per-vertex principal curvatures and directions, H and K of a mesh or, with ``F=None``, of
     a point cloud: what ``focal curvature`` computes (the same library call, focal::curvature in
@@ -246,10 +249,10 @@ def curvature(
         (width gaussian_width; 0: mean edge length x rings). lm_* : Levenberg-Marquardt.
     noise_for_two_rings, noise_for_three_rings, file_agreement, outlier_disagreement : the
         recommended estimator's thresholds (recommended.h).
-    k, radius, adaptive_radius, normal_method, viewpoint, outlier_ratio, off_surface_ratio :
-        point clouds only, as ``focal curvature``'s --k, --radius, --adaptive-radius,
-        --cloud-normals, --viewpoint, --outlier-ratio, --off-surface-ratio; ``k=0`` (with no
-        radius) is the adaptive default of the command line (docs/POINTS.md).
+    k, radius, adaptive_radius, normal_method, viewpoint, outlier_ratio, off_surface_ratio,
+    orient : point clouds only, as ``focal curvature``'s --k, --radius, --adaptive-radius,
+        --cloud-normals, --viewpoint, --outlier-ratio, --off-surface-ratio, --orient; ``k=0``
+        (with no radius) is the adaptive default of the command line (docs/POINTS.md).
 
     Returns
     -------
@@ -287,6 +290,7 @@ def curvature(
         "viewpoint": viewpoint,
         "outlier_ratio": outlier_ratio,
         "off_surface_ratio": off_surface_ratio,
+        "orient": orient,
     }
     o = _estimate_options(estimator, threads, options)
     o["device"] = str(device)

@@ -31,7 +31,7 @@ using namespace nb::literals;
 focal::CloudOptions cloud_options(int k, double radius, double adaptive_radius,
                                   const std::string& normal_method,
                                   const std::optional<std::vector<double>>& viewpoint,
-                                  const std::string& solver) {
+                                  const std::string& solver, const std::string& orient = "mst") {
   focal::CloudOptions o;
   o.k = k;
   o.radius = radius;
@@ -55,6 +55,16 @@ focal::CloudOptions cloud_options(int k, double radius, double adaptive_radius,
     if (viewpoint->size() != 3) throw focal::InvalidInput("viewpoint must be 3 numbers (x, y, z)");
     o.normals.viewpoint = Eigen::Vector3d((*viewpoint)[0], (*viewpoint)[1], (*viewpoint)[2]);
   }
+  if (orient == "mst") {
+    o.normals.orientation = focal::CloudOrientation::mst;
+  } else if (orient == "global") {
+    o.normals.orientation = focal::CloudOrientation::global;
+  } else if (orient == "viewpoint") {
+    o.normals.orientation = focal::CloudOrientation::viewpoint;
+  } else {
+    throw focal::InvalidInput("orient must be 'mst', 'global' or 'viewpoint', got '" + orient +
+                              "'");
+  }
   return o;
 }
 
@@ -62,9 +72,9 @@ nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N
                          double radius, double adaptive_radius, const std::string& normal_method,
                          const std::optional<std::vector<double>>& viewpoint,
                          const std::string& solver, double outlier_ratio, double off_surface_ratio,
-                         int threads) {
+                         const std::string& orient, int threads) {
   focal::CloudOptions o =
-      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver);
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, solver, orient);
   o.outlier_ratio = outlier_ratio;
   o.off_surface_ratio = off_surface_ratio;
   o.keep_neighbours = false;  // not returned
@@ -82,9 +92,10 @@ nb::dict cloud_curvature(const DoubleRows& V, const std::optional<DoubleRows>& N
 
 nb::object cloud_normals(const DoubleRows& V, int k, double radius, double adaptive_radius,
                          const std::string& normal_method,
-                         const std::optional<std::vector<double>>& viewpoint, int threads) {
+                         const std::optional<std::vector<double>>& viewpoint,
+                         const std::string& orient, int threads) {
   const focal::CloudOptions o =
-      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, "closed-form");
+      cloud_options(k, radius, adaptive_radius, normal_method, viewpoint, "closed-form", orient);
   focal::RowMatrixX3d N;
   {
     nb::gil_scoped_release release;
@@ -104,9 +115,10 @@ focal::CloudOptions cloud_options_from(const nb::dict& d) {
                                                   : nb::cast<std::vector<double>>(d["viewpoint"]);
   const double adaptive_radius =
       d.contains("adaptive_radius") ? nb::cast<double>(d["adaptive_radius"]) : 0.0;
-  focal::CloudOptions o = cloud_options(nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]),
-                                        adaptive_radius, nb::cast<std::string>(d["normal_method"]),
-                                        viewpoint, nb::cast<std::string>(d["solver"]));
+  focal::CloudOptions o = cloud_options(
+      nb::cast<int>(d["k"]), nb::cast<double>(d["radius"]), adaptive_radius,
+      nb::cast<std::string>(d["normal_method"]), viewpoint, nb::cast<std::string>(d["solver"]),
+      d.contains("orient") ? nb::cast<std::string>(d["orient"]) : std::string("mst"));
   o.outlier_ratio = nb::cast<double>(d["outlier_ratio"]);
   o.off_surface_ratio = nb::cast<double>(d["off_surface_ratio"]);
   return o;
@@ -207,9 +219,9 @@ nb::dict estimate_cloud_tile(const DoubleRows& V, const DoubleRows& N,
 void bind_clouds(nb::module_& m) {
   m.def("cloud_curvature", &cloud_curvature, "V"_a.noconvert(), "N"_a.none().noconvert(), "k"_a,
         "radius"_a, "adaptive_radius"_a, "normal_method"_a, "viewpoint"_a.none(), "solver"_a,
-        "outlier_ratio"_a, "off_surface_ratio"_a, "threads"_a);
+        "outlier_ratio"_a, "off_surface_ratio"_a, "orient"_a, "threads"_a);
   m.def("cloud_normals", &cloud_normals, "V"_a.noconvert(), "k"_a, "radius"_a, "adaptive_radius"_a,
-        "normal_method"_a, "viewpoint"_a.none(), "threads"_a);
+        "normal_method"_a, "viewpoint"_a.none(), "orient"_a, "threads"_a);
   m.def("cloud_tile_plan", &cloud_tile_plan, "V"_a.noconvert(), "N"_a.none().noconvert(),
         "options"_a, "tile_vertices"_a);
   m.def("extract_cloud_tile", &extract_cloud_tile, "V"_a.noconvert(), "N"_a.noconvert(),

@@ -16,8 +16,10 @@ namespace focal::detail {
 /// the cloud in its own order (its positions, its graph renamed from the copy's lists, N taken
 /// back for it), whose ties it breaks by row, so that the copy's normals are turned exactly as
 /// the cloud's would be.
+/// `global`: orient_normals_global after the tree (on the cloud in its own order too, each
+/// point's area from its list in `neighbours`).
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                       int threads, const CloudCopy* copy_of = nullptr);
+                       int threads, const CloudCopy* copy_of = nullptr, bool global = false);
 
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
 /// `copy_of` as orient_normals_mst; each jet's points are then summed in the cloud's order

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -12,9 +13,11 @@
 
 #include "core/parallel.h"
 #include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/normals/jets.h"
 #include "normals/cloud_jets.h"
 #include "normals/jet_normals_from.h"
+#include "normals/winding_orientation.h"
 
 namespace focal {
 namespace {
@@ -277,21 +280,64 @@ int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d&
 
 }  // namespace
 
+namespace {
+
+/// Tells the verbose log (Execution::info) what the global orientation did.
+void tell(const detail::WindingOrientationReport& r) {
+  const Execution& execution = current_execution();
+  if (!execution.info) return;
+  const std::string verdict =
+      r.decided ? std::to_string(r.flipped) + " normals turned"
+      : r.residual_after <= detail::WindingOrientationOptions{}.closed_residual
+          ? "the tree's signs kept (the field's fit them hardly better)"
+          : "the tree's signs kept (the field does not decide: an open or noisy cloud)";
+  char line[120];
+  std::snprintf(line, sizeof line,
+                "global orientation: winding-number residual %.3f -> %.3f: ", r.residual_before,
+                r.residual_after);
+  execution.info(line + verdict);
+}
+
+}  // namespace
+
 int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                               int threads, const CloudCopy* copy_of) {
+                               int threads, const CloudCopy* copy_of, bool global) {
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
-  if (!copy_of) return orient_over_graph(V, symmetric(neighbours, threads), N);
+  // The areas from the lists as given (sorted by distance), before N is taken anywhere.
+  const Eigen::VectorXd area =
+      global ? detail::patch_areas(V, neighbours, N, threads) : Eigen::VectorXd();
+  if (!copy_of) {
+    const int components = orient_over_graph(V, symmetric(neighbours, threads), N);
+    if (global) tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads));
+    return components;
+  }
   // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
   // from the copy's lists, N taken back (and the copy's N let go meanwhile), the cloud's own
-  // positions.
+  // positions. The winding number's segments read the copy's lists renamed (the graph let go).
   const RowPermutation& p = copy_of->permutation;
-  const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
-  RowMatrixX3d own = detail::rows_from(N, p.position, threads);
-  N = RowMatrixX3d();
-  const int components = orient_over_graph(copy_of->cloud, graph, own);
+  RowMatrixX3d own;
+  int components = 0;
+  {
+    const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
+    own = detail::rows_from(N, p.position, threads);
+    N = RowMatrixX3d();
+    components = orient_over_graph(copy_of->cloud, graph, own);
+  }
+  if (global) {
+    tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
+                                   detail::rows_from(area, p.position, threads), own, threads));
+  }
   N = detail::rows_from(own, p.order, threads);
   return components;
+}
+
+int orient_normals_global(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
+  check_sizes(V, neighbours, "orient_normals_global");
+  if (N.rows() != V.rows()) throw InvalidInput("orient_normals_global: N does not have #V rows");
+  return detail::orient_by_winding(V, neighbours, nullptr, detail::patch_areas(V, neighbours, N, 0),
+                                   N, 0)
+      .flipped;
 }
 
 void orient_towards_viewpoint(PositionsRef V, const Eigen::Vector3d& viewpoint, RowMatrixX3d& N) {
@@ -307,9 +353,26 @@ namespace {
 void check_jet_options(PositionsRef V, const Neighbourhoods& neighbours,
                        const CloudNormalOptions& options) {
   check_sizes(V, neighbours, "cloud_normals");
+  if (options.orientation == CloudOrientation::viewpoint && !options.viewpoint) {
+    throw InvalidInput("cloud_normals: orientation viewpoint needs a viewpoint");
+  }
+  if (options.orientation == CloudOrientation::global && options.viewpoint) {
+    throw InvalidInput("cloud_normals: orientation global and a viewpoint conflict");
+  }
   if (options.jet_degree < 1 || options.jet_degree > 4) {
     throw InvalidInput("cloud_normals: jet_degree must be in [1, 4], got " +
                        std::to_string(options.jet_degree));
+  }
+}
+
+/// Orients PCA normals N as `options` say (no viewpoint in orient_sided_jets' calls).
+void orient(PositionsRef V, const Neighbourhoods& neighbours, const CloudNormalOptions& options,
+            RowMatrixX3d& N, const detail::CloudCopy* copy_of) {
+  if (options.viewpoint) {
+    orient_towards_viewpoint(V, *options.viewpoint, N);
+  } else {
+    detail::orient_normals_mst(V, neighbours, N, 0, copy_of,
+                               options.orientation == CloudOrientation::global);
   }
 }
 
@@ -337,11 +400,7 @@ JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
                               const CloudNormalOptions& options, const CloudCopy* copy_of) {
   check_jet_options(V, neighbours, options);
   RowMatrixX3d N = pca_normals(V, neighbours);
-  if (options.viewpoint) {
-    orient_towards_viewpoint(V, *options.viewpoint, N);
-  } else {
-    detail::orient_normals_mst(V, neighbours, N, 0, copy_of);
-  }
+  orient(V, neighbours, options, N, copy_of);
   return jets_from_start(V, neighbours, options, std::move(N), copy_of);
 }
 
@@ -365,7 +424,7 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
   // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
   const RowMatrixX3d pca = pca_normals(V, neighbours);
   RowMatrixX3d mst = pca;
-  detail::orient_normals_mst(V, neighbours, mst, 0, copy_of);
+  orient(V, neighbours, options, mst, copy_of);
   detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
     const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();

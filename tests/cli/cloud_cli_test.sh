@@ -86,6 +86,11 @@ check "normals: estimated normals point outward on the sphere" \
 run normals bare.xyz -o inward.xyz --viewpoint 0,0,0
 check "normals --viewpoint 0,0,0 (the centre): every normal inward" \
   bash -c '[[ $1 -eq 0 ]] && awk "{ if (\$1*\$4 + \$2*\$5 + \$3*\$6 >= 0) bad++ } END { exit bad > 0 }" inward.xyz' _ "$rc"
+run normals bare.xyz -o global.xyz --orient global
+check "normals --orient global: a closed sphere keeps the tree's outward normals" \
+  bash -c '[[ $1 -eq 0 ]] && cmp -s normals.xyz global.xyz' _ "$rc"
+expect_error "--orient viewpoint needs --viewpoint" "--viewpoint" vp.xyz normals bare.xyz -o vp.xyz --orient viewpoint
+expect_error "--orient global and --viewpoint conflict" "conflict" vg.xyz normals bare.xyz -o vg.xyz --orient global --viewpoint 0,0,0
 
 # Noisy positions: `normals` takes the curvature default's plan (64 neighbours and quadratic jets
 # when the noise it measures is above 0.03), not a rule of its own. Mean angle (degrees) to the

@@ -1,0 +1,295 @@
+#include "points/winding_number.h"
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "core/parallel.h"
+#include "focal/core/error.h"
+
+namespace focal::detail {
+namespace {
+
+constexpr double kInvFourPi = 0.25 * std::numbers::inv_pi;
+/// Nodes deeper than this are leaves whatever their count (coincident points).
+constexpr int kMaxDepth = 48;
+
+}  // namespace
+
+WindingTree::WindingTree(PositionsRef V, const Eigen::VectorXd& smoothing, double beta)
+    : rows_(V.rows()), beta2_(beta * beta) {
+  if (smoothing.size() != V.rows()) {
+    throw InvalidInput("WindingTree: smoothing does not have #V entries");
+  }
+  if (!(beta > 1.0) || !std::isfinite(beta)) throw InvalidInput("WindingTree: beta must be > 1");
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (V.row(i).allFinite()) order_.push_back(static_cast<int>(i));
+  }
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  P_.resize(n, 3);
+  s2_.resize(n);
+  if (n == 0) return;
+  Eigen::Vector3d low = V.row(order_[0]).transpose(), high = low;
+  for (const int i : order_) {
+    low = low.cwiseMin(V.row(i).transpose());
+    high = high.cwiseMax(V.row(i).transpose());
+  }
+  nodes_.push_back({});
+  nodes_[0].begin = 0;
+  nodes_[0].end = static_cast<int>(n);
+  build(V, 0, low, (high - low).maxCoeff(), 0);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const int i = order_[static_cast<std::size_t>(t)];
+    P_.row(t) = V.row(i);
+    const double s = std::isfinite(smoothing[i]) ? smoothing[i] : 0.0;
+    s2_[t] = 0.5 * s * s;
+  }
+  for (Node& node : nodes_) {
+    double sum = 0.0;
+    for (int t = node.begin; t < node.end; ++t) sum += s2_[t];
+    node.s2 = sum / (node.end - node.begin);
+  }
+}
+
+void WindingTree::build(PositionsRef V, int node, const Eigen::Vector3d& low, double size,
+                        int depth) {
+  const int begin = nodes_[node].begin, end = nodes_[node].end;
+  Eigen::Vector3d lo = V.row(order_[begin]).transpose(), hi = lo;
+  for (int t = begin; t < end; ++t) {
+    lo = lo.cwiseMin(V.row(order_[t]).transpose());
+    hi = hi.cwiseMax(V.row(order_[t]).transpose());
+  }
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  double r2 = 0.0;
+  for (int t = begin; t < end; ++t)
+    r2 = std::max(r2, (V.row(order_[t]).transpose() - centre).squaredNorm());
+  nodes_[node].centre = centre;
+  nodes_[node].radius = std::sqrt(r2);
+  if (end - begin <= kLeafPoints || depth >= kMaxDepth || r2 == 0.0) return;
+  // The eight octants of the cube (low, size), each point in the octant of its position against
+  // the cube's midpoint; a stable counting sort keeps rows in order within each octant.
+  const Eigen::Vector3d mid = low + Eigen::Vector3d::Constant(0.5 * size);
+  const auto octant = [&](int i) {
+    return (V(i, 0) >= mid.x() ? 1 : 0) | (V(i, 1) >= mid.y() ? 2 : 0) |
+           (V(i, 2) >= mid.z() ? 4 : 0);
+  };
+  std::array<int, 9> start{};
+  for (int t = begin; t < end; ++t) ++start[static_cast<std::size_t>(octant(order_[t])) + 1];
+  for (std::size_t o = 0; o < 8; ++o) start[o + 1] += start[o];
+  std::vector<int> sorted(static_cast<std::size_t>(end - begin));
+  std::array<int, 8> fill{};
+  for (std::size_t o = 0; o < 8; ++o) fill[o] = start[o];
+  for (int t = begin; t < end; ++t) {
+    const int i = order_[t];
+    sorted[static_cast<std::size_t>(fill[static_cast<std::size_t>(octant(i))]++)] = i;
+  }
+  std::copy(sorted.begin(), sorted.end(), order_.begin() + begin);
+  const int first = static_cast<int>(nodes_.size());
+  int children = 0;
+  for (std::size_t o = 0; o < 8; ++o) {
+    if (start[o + 1] == start[o]) continue;
+    Node child;
+    child.begin = begin + start[o];
+    child.end = begin + start[o + 1];
+    nodes_.push_back(child);
+    ++children;
+  }
+  nodes_[node].first_child = first;
+  nodes_[node].children = children;
+  int c = first;
+  for (std::size_t o = 0; o < 8; ++o) {
+    if (start[o + 1] == start[o]) continue;
+    const Eigen::Vector3d child_low(o & 1 ? mid.x() : low.x(), o & 2 ? mid.y() : low.y(),
+                                    o & 4 ? mid.z() : low.z());
+    build(V, c++, child_low, 0.5 * size, depth + 1);
+  }
+}
+
+template <class Far, class Near>
+void WindingTree::visit(const Eigen::Vector3d& q, Far&& far, Near&& near) const {
+  int stack[8 * kMaxDepth + 8];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const auto k = static_cast<std::size_t>(stack[--top]);
+    const Node& node = nodes_[k];
+    const double d2 = (node.centre - q).squaredNorm();
+    if (d2 > beta2_ * node.radius * node.radius) {
+      far(node, k, d2);
+    } else if (node.first_child < 0) {
+      near(node);
+    } else {
+      for (int c = node.first_child + node.children - 1; c >= node.first_child; --c)
+        stack[top++] = c;
+    }
+  }
+}
+
+Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                     int threads) const {
+  if (M.rows() != rows_) throw InvalidInput("WindingTree::winding: M does not have #V rows");
+  if (sign.size() != 0 && sign.size() != rows_) {
+    throw InvalidInput("WindingTree::winding: sign is neither empty nor #V long");
+  }
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
+  if (n == 0) return out;
+  RowMatrixX3d Mt(n, 3);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const int row = order_[static_cast<std::size_t>(t)];
+    const Eigen::RowVector3d m = sign.size() != 0 ? Eigen::RowVector3d(sign[row] * M.row(row))
+                                                  : Eigen::RowVector3d(M.row(row));
+    Mt.row(t) = m.allFinite() ? m : Eigen::RowVector3d::Zero();
+  }
+  // Moments about each node's centre, children before parents (they come after them).
+  const auto count = static_cast<std::size_t>(nodes_.size());
+  std::vector<Eigen::Vector3d> sum(count);
+  std::vector<Eigen::Matrix3d> second(count);
+  for (std::size_t k = count; k-- > 0;) {
+    const Node& node = nodes_[k];
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
+    if (node.first_child < 0) {
+      for (int t = node.begin; t < node.end; ++t) {
+        const Eigen::Vector3d m = Mt.row(t).transpose();
+        s += m;
+        T += m * (P_.row(t).transpose() - node.centre).transpose();
+      }
+    } else {
+      for (int c = node.first_child; c < node.first_child + node.children; ++c) {
+        const auto cs = static_cast<std::size_t>(c);
+        s += sum[cs];
+        T += second[cs] + sum[cs] * (nodes_[cs].centre - node.centre).transpose();
+      }
+    }
+    sum[k] = s;
+    second[k] = T;
+  }
+  parallel_for(n, threads, [&](std::int64_t t) {
+    const Eigen::Vector3d q = P_.row(t).transpose();
+    const double own = s2_[t];
+    double w = 0.0;
+    visit(
+        q,
+        [&](const Node& node, std::size_t k, double d2) {
+          const Eigen::Vector3d x = node.centre - q;
+          const double rho2 = d2 + own + node.s2;
+          const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
+          const Eigen::Matrix3d& T = second[k];
+          w += inv3 * (sum[k].dot(x) + T.trace() - 3.0 * inv2 * x.dot(T * x));
+        },
+        [&](const Node& node) {
+          for (int j = node.begin; j < node.end; ++j) {
+            const double rx = P_(j, 0) - q.x(), ry = P_(j, 1) - q.y(), rz = P_(j, 2) - q.z();
+            const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[j];
+            if (rho2 == 0.0) continue;  // a coincident point without smoothing: no term
+            w += (Mt(j, 0) * rx + Mt(j, 1) * ry + Mt(j, 2) * rz) / (rho2 * std::sqrt(rho2));
+          }
+        });
+    out[order_[static_cast<std::size_t>(t)]] = kInvFourPi * w;
+  });
+  return out;
+}
+
+RowMatrixX3d WindingTree::field(const Eigen::VectorXd& q, int threads) const {
+  RowMatrixX3d out = RowMatrixX3d::Zero(rows_, 3);
+  each_field(q, threads, [&](int row, const Eigen::Vector3d& g) { out.row(row) = g.transpose(); });
+  return out;
+}
+
+Eigen::VectorXd WindingTree::transpose(const RowMatrixX3d& A, const Eigen::VectorXd& q,
+                                       int threads) const {
+  if (A.rows() != rows_) throw InvalidInput("WindingTree::transpose: A does not have #V rows");
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
+  each_field(q, threads, [&](int row, const Eigen::Vector3d& g) { out[row] = A.row(row).dot(g); });
+  return out;
+}
+
+template <class Out>
+void WindingTree::each_field(const Eigen::VectorXd& q, int threads, Out&& result) const {
+  if (q.size() != rows_) throw InvalidInput("WindingTree::field: q does not have #V entries");
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  if (n == 0) return;
+  Eigen::VectorXd qt(n);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const double v = q[order_[static_cast<std::size_t>(t)]];
+    qt[t] = std::isfinite(v) ? v : 0.0;
+  }
+  const auto count = static_cast<std::size_t>(nodes_.size());
+  std::vector<double> charge(count);
+  std::vector<Eigen::Vector3d> dipole(count);
+  for (std::size_t k = count; k-- > 0;) {
+    const Node& node = nodes_[k];
+    double Q = 0.0;
+    Eigen::Vector3d D = Eigen::Vector3d::Zero();
+    if (node.first_child < 0) {
+      for (int t = node.begin; t < node.end; ++t) {
+        Q += qt[t];
+        D += qt[t] * (P_.row(t).transpose() - node.centre);
+      }
+    } else {
+      for (int c = node.first_child; c < node.first_child + node.children; ++c) {
+        const auto cs = static_cast<std::size_t>(c);
+        Q += charge[cs];
+        D += dipole[cs] + charge[cs] * (nodes_[cs].centre - node.centre);
+      }
+    }
+    charge[k] = Q;
+    dipole[k] = D;
+  }
+  parallel_for(n, threads, [&](std::int64_t t) {
+    const Eigen::Vector3d p = P_.row(t).transpose();
+    const double own = s2_[t];
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    visit(
+        p,
+        [&](const Node& node, std::size_t k, double d2) {
+          const Eigen::Vector3d x = p - node.centre;
+          const double rho2 = d2 + own + node.s2;
+          const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
+          g += inv3 * (charge[k] * x - dipole[k] + 3.0 * inv2 * x.dot(dipole[k]) * x);
+        },
+        [&](const Node& node) {
+          double gx = 0.0, gy = 0.0, gz = 0.0;
+          for (int i = node.begin; i < node.end; ++i) {
+            const double rx = p.x() - P_(i, 0), ry = p.y() - P_(i, 1), rz = p.z() - P_(i, 2);
+            const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[i];
+            if (rho2 == 0.0) continue;
+            const double f = qt[i] / (rho2 * std::sqrt(rho2));
+            gx += f * rx, gy += f * ry, gz += f * rz;
+          }
+          g += Eigen::Vector3d(gx, gy, gz);
+        });
+    result(order_[static_cast<std::size_t>(t)], (kInvFourPi * g).eval());
+  });
+}
+
+Eigen::VectorXd WindingTree::near_column_norms(const RowMatrixX3d& M, int threads) const {
+  if (M.rows() != rows_)
+    throw InvalidInput("WindingTree::near_column_norms: M does not have #V rows");
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
+  parallel_for(n, threads, [&](std::int64_t t) {
+    const auto row = order_[static_cast<std::size_t>(t)];
+    if (!M.row(row).allFinite()) return;
+    const Eigen::Vector3d m = M.row(row).transpose(), p = P_.row(t).transpose();
+    const double own = s2_[t];
+    double sum = 0.0;
+    visit(
+        p, [](const Node&, std::size_t, double) {},
+        [&](const Node& node) {
+          for (int i = node.begin; i < node.end; ++i) {
+            const Eigen::Vector3d r = p - P_.row(i).transpose();
+            const double rho2 = r.squaredNorm() + own + s2_[i];
+            if (rho2 == 0.0) continue;
+            const double k = m.dot(r) / (rho2 * std::sqrt(rho2));
+            sum += k * k;
+          }
+        });
+    out[row] = kInvFourPi * kInvFourPi * sum;
+  });
+  return out;
+}
+
+}  // namespace focal::detail
