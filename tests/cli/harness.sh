@@ -1,8 +1,8 @@
-# The helpers of the focal command's shell tests (cloud_cli_test.sh, robust_cli_test.sh), sourced
-# with the test's arguments FOCAL_BINARY SCRATCH_DIR: the binary as an absolute path in $FOCAL,
-# the scratch folder emptied and made the working directory, check NAME COMMAND... (one line per
-# check, counted in $passed / $failed), run ARGS... (focal's stdout in $OUT, stderr in $ERR,
-# exit status in $rc).
+# The helpers of the focal command's shell tests (cloud_cli_test.sh, robust_cli_test.sh,
+# smooth_cli_test.sh), sourced with the test's arguments FOCAL_BINARY SCRATCH_DIR: the binary as
+# an absolute path in $FOCAL, the scratch folder emptied and made the working directory, check
+# NAME COMMAND... (one line per check, counted in $passed / $failed), run ARGS... (focal's stdout
+# in $OUT, stderr in $ERR, exit status in $rc).
 # shellcheck shell=bash disable=SC2034
 set -euo pipefail
 [[ $# -eq 2 ]] || { echo "usage: $0 FOCAL_BINARY SCRATCH_DIR" >&2; exit 2; }

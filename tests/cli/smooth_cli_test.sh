@@ -3,26 +3,10 @@
 # faces kept, --normals, a clean sphere left as it is, and the error contract.
 #
 # Usage: smooth_cli_test.sh FOCAL_BINARY SCRATCH_DIR. Prints one line per check, then
-# "N passed, M failed"; exits 1 when any check failed. The helpers follow cli_test.sh's.
+# "N passed, M failed"; exits 1 when any check failed. The helpers are harness.sh's.
 # shellcheck disable=SC2016
-set -euo pipefail
-[[ $# -eq 2 ]] || { echo "usage: $0 FOCAL_BINARY SCRATCH_DIR" >&2; exit 2; }
-FOCAL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
-SCRATCH=$2
-[[ -n $SCRATCH && $SCRATCH != / ]] || { echo "refusing to use '$SCRATCH'" >&2; exit 2; }
-rm -rf "$SCRATCH" && mkdir -p "$SCRATCH" && cd "$SCRATCH"
-OUT=$PWD/.stdout
-ERR=$PWD/.stderr
-passed=0
-failed=0
-check() {
-  local name=$1
-  shift
-  if "$@"; then printf 'ok    %s\n' "$name"; passed=$((passed + 1)); else
-    printf 'FAIL  %s -- %s\n' "$name" "$(head -c 300 "$ERR")"; failed=$((failed + 1)); fi
-}
-rc=0
-run() { rc=0; "$FOCAL" "$@" >"$OUT" 2>"$ERR" || rc=$?; }
+# shellcheck source=harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 below() { awk -v x="$1" -v b="$2" 'BEGIN { exit !(x ~ /^[-+0-9.eE]+$/ && x + 0 <= b + 0) }'; }
 # rms_radius FILE: RMS of |p| - 1 over the vertex lines of an ascii OFF file (after the counts).
 rms_radius() {
