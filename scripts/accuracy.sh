@@ -293,17 +293,15 @@ Where focal default loses on these cases (measured, docs/notes/estimator-log.md)
   is exact for the symmetric stencils of a strip grid in the long direction; the two-slit fit and
   the per-triangle pass see neighbours at very different distances, and their first-order terms
   do not cancel. Closing it needs anisotropy-aware weights; not built.
-- **Spikes** (0.5% of the vertices 2 edges off): a spike tilts the faces around it past the crease
-  angle, so its 2-ring keeps the crease handling (Max's normals, the per-triangle pass) instead
-  of the corrected step on the file's normals, which LRTC20 on the file's normals shows to be
-  better there; without file normals the jets of its 2-ring are pulled, and the 2-ring
-  closed-form fit of Max's normals averages the spike over more rays. Dropping creases that lie
-  inside one vertex's 1-ring was measured (docs/notes/estimator-log.md, "The corrected step") and not kept.
 - **Coarse pear and graded pear with file normals**: 2% to 6% behind the per-triangle pass or
   LRTC20 at one mean edge length on the same normals: the corrected step's ball (one local edge
   length) is not the best one for every vertex of these meshes.
-  **Coarse helix tube and torus strips without normals**: behind the per-triangle pass on Max's
-  normals; the default's per-vertex roughness test keeps the jets' normals there.
+  **Coarse helix tube and torus without normals**: behind LRTC20 on Max's normals (the torus
+  within half a percent); **torus strips without normals**: behind the per-triangle pass on
+  Max's normals; the default's per-vertex roughness test keeps the jets' normals there.
+- (**Spikes**, 0.5% of the vertices 2 edges off, are no longer lost: with the file's normals
+  the spike repair and without them the spike step from positions alone move them back;
+  docs/METHOD.md, "Spikes".)
 - **Creases under vertex noise**: crease detection runs on clean positions only (noise folds
   faces past any angle), so the noisy capped cylinder is fitted across its rims; its error is
   still the lowest of the table.
@@ -326,11 +324,10 @@ HARDPEERS
     cat "$work/hard-peers.md"
     cat <<'HARDPEERLOSSES'
 
-Where a peer beats focal default on these cases (all without normals; measured, not analysed
-further): near boundaries, pymeshlab's quadric fitting at rings 1-2 of the open saddle, monkey
-saddle and cylinder (its fit is not one of focal's neighbourhoods there); on the noisy capped
-cylinder, libigl's 5-ring quadric fit, whose wide neighbourhood averages the noise that the
-default, fitting across the rims it cannot detect under noise (above), does not.
+Where a peer beats focal default on these cases (without normals; measured, not analysed
+further): on the noisy capped cylinder, libigl's 5-ring quadric fit, whose wide neighbourhood
+averages the noise that the default, fitting across the rims it cannot detect under noise
+(above), does not.
 HARDPEERLOSSES
     cat <<'DIRECTIONS'
 
@@ -505,9 +502,9 @@ HEAD
   normals) take the noise in.
 - **Hard cases.** Lowest or tied in most categories. On strips across the curvature the
   cotangent formula and the mid-edge operator (GGRZ06) are ahead. Outlier normals and spikes
-  are found and undone with the file's normals; without normals spikes are not told from the
-  surface and wider fits do better on some. Creases (the capped cylinder) are flagged on clean
-  positions and not fitted across.
+  are found and undone with the file's normals; without normals spikes are found from the
+  positions (each vertex against a quadric fitted to its neighbours without it) and moved back.
+  Creases (the capped cylinder) are flagged on clean positions and not fitted across.
 - **Principal directions.** The angle of d1 to the exact direction: focal's default is ahead
   of every peer that gives directions on most cases; pymeshlab's normal cycles win where a
   regular grid runs along the principal directions.
