@@ -56,8 +56,10 @@ constexpr double kMaxCreaseMove = 4.0;
 
 /// Where each point's neighbourhood comes from: a mesh's rings, or a cloud's lists.
 struct Neighbours {
+  /// A mesh's 1-ring (its nearest neighbours); null for clouds.
   const Neighbourhoods* one_ring = nullptr;
-  int rings = 0;
+  /// Each point's neighbourhood: a mesh's vertices within its rings (the vertex itself
+  /// included, ascending: gathered_rings), or a cloud's nearest neighbours.
   const Neighbourhoods* lists = nullptr;
   bool oriented = true;  ///< frame normals on one side (meshes); clouds compare lines
   /// The input's normals (Max's, or the cloud's), which group a crease's sides in every pass:
@@ -66,18 +68,52 @@ struct Neighbours {
 };
 
 struct Scratch {
-  std::vector<std::uint64_t> in_ring;
   std::vector<int> ring, side[detail::smoothing::kMaxSides];
   std::vector<Eigen::Vector3d> normals;  ///< crease_sides' scratch
   FitScratch fit;
 };
 
 void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
-  if (nb.one_ring) {
-    detail::jets::gather_ring(*nb.one_ring, i, nb.rings, s.in_ring, nullptr, s.ring);
-  } else {
-    s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
+  s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
+}
+
+/// Every vertex's vertices within `rings` edges (jets::gather_ring: itself included, ascending),
+/// gathered once for all passes: the positions move, the neighbourhoods do not.
+Neighbourhoods gathered_rings(const Neighbourhoods& one, int rings) {
+  const int n = one.vertex_count();
+  struct Gather {
+    std::vector<std::uint64_t> in_ring;
+    std::vector<int> ring;
+  };
+  detail::PerThread<Gather> scratch(0);
+  Neighbourhoods out;
+  out.offsets.resize(n + 1);
+  out.offsets[0] = 0;
+  // Twice: the sizes, then (at their offsets) the lists; gathering is cheaper than the memory
+  // of lists kept per block.
+  detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
+    Gather& g = scratch.local();
+    for (std::int64_t v = begin; v < end; ++v) {
+      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
+      out.offsets[v + 1] = static_cast<int>(g.ring.size());
+    }
+  });
+  std::int64_t total = 0;
+  for (int v = 0; v < n; ++v) {
+    total += out.offsets[v + 1];
+    if (total > std::numeric_limits<int>::max())
+      throw InvalidInput("smooth: the rings of the mesh's vertices hold more than 2^31 entries");
+    out.offsets[v + 1] = static_cast<int>(total);
   }
+  out.indices.resize(static_cast<Eigen::Index>(total));
+  detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
+    Gather& g = scratch.local();
+    for (std::int64_t v = begin; v < end; ++v) {
+      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
+      std::copy(g.ring.begin(), g.ring.end(), out.indices.data() + out.offsets[v]);
+    }
+  });
+  return out;
 }
 
 /// One pass: every point's surface, in the frame of its row of `frames`.
@@ -337,9 +373,10 @@ SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RecommendedPlan plan = recommended_plan(mesh.with_normals(std::nullopt));
   const int rings = o.rings > 0 ? o.rings : plan.rings > 1 ? plan.jet_rings : kCleanRings;
+  const Neighbourhoods lists = gathered_rings(*one, rings);
   Neighbours nb;
   nb.one_ring = one.get();
-  nb.rings = rings;
+  nb.lists = &lists;
   RowMatrixX3d max = face_normals(mesh);
   nb.sides_of = &max;
   SmoothResult out = run(mesh.V(), max, nb, o, h, plan.jet_iterations > 1);

@@ -17,14 +17,16 @@ using jets::terms_stride;
 using kernels::eigen_of;
 
 /// The fitted height at scaled coordinates (x, y): sum c_k x^(t-b) y^b over the monomials
-/// by degree t, then by the power b of y (jet_fit.cpp's numbering).
-double height_at(const double* c, int degree, double x, double y) {
-  double xs[jets::kMaxDegree + 1], ys[jets::kMaxDegree + 1];
+/// by degree t, then by the power b of y (jet_fit.cpp's numbering). D fixed: unrolled, the same
+/// operations in the same order for every D.
+template <int D>
+double height_at(const double* c, double x, double y) {
+  double xs[D + 1], ys[D + 1];
   xs[0] = ys[0] = 1.0;
-  for (int t = 1; t <= degree; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
+  for (int t = 1; t <= D; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
   double height = 0.0;
   int k = 0;
-  for (int t = 0; t <= degree; ++t) {
+  for (int t = 0; t <= D; ++t) {
     for (int b = 0; b <= t; ++b, ++k) height += c[k] * xs[t - b] * ys[b];
   }
   return height;
@@ -43,12 +45,26 @@ bool fit_points(int degree, const jets::Points& points, FitScratch& s) {
   return b.solved[0];
 }
 
+template <int D>
+void misfits_of_degree(FitScratch& s) {
+  const double* c = s.batch.c;
+  const jets::Point* q = s.points.data();
+  double* out = s.misfit.data();
+  for (std::size_t p = 0; p < s.points.size(); ++p) out[p] = q[p].z - height_at<D>(c, q[p].x, q[p].y);
+}
+
 /// Each point's residual against the fit in s.batch.c into s.misfit (scaled units).
 void misfits(int degree, FitScratch& s) {
   s.misfit.resize(s.points.size());
-  for (std::size_t p = 0; p < s.points.size(); ++p) {
-    const jets::Point& q = s.points[p];
-    s.misfit[p] = q.z - height_at(s.batch.c, degree, q.x, q.y);
+  switch (degree) {
+    case 4:
+      return misfits_of_degree<4>(s);
+    case 3:
+      return misfits_of_degree<3>(s);
+    case 2:
+      return misfits_of_degree<2>(s);
+    default:
+      return misfits_of_degree<1>(s);
   }
 }
 
@@ -88,10 +104,17 @@ bool centre_off(int degree, double floor, FitScratch& s) {
   double c[jets::kMaxCoefficients];
   std::copy(s.batch.c, s.batch.c + m, c);
   s.saved_misfit = s.misfit;
-  s.keep.assign(s.points.size(), 1);
-  s.keep[0] = 0;
+  // The fit without the point itself from the least-squares fit's moments: the point is the
+  // origin, which adds 1 to the count and +0 to every other sum, so the sums without it are
+  // those with 1 taken off the count (the bits of a fit to the others alone).
+  jets::JetBatch& b = s.batch;
+  const double count = b.xy[0];
+  b.xy[0] = count - 1.0;
   bool off = false;
-  if (fit_kept(degree, s)) {
+  const bool solved = jets::solve_moments(degree, b, b.count[0] - 1);
+  b.xy[0] = count;
+  if (solved) {
+    misfits(degree, s);
     // The others' residuals alone set the scale.
     const double centre = std::abs(s.misfit[0]);
     std::vector<double>& magnitude = s.magnitude;
