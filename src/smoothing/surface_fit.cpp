@@ -80,19 +80,26 @@ bool fit_kept(int degree, FitScratch& s) {
   return true;
 }
 
+/// Whether `value` exceeds both `floor` and `scales` robust scales (1.4826 x the median of
+/// |r| over the n residuals r, the median the element at n / 2 in ascending order), without
+/// ordering them: c x e is monotone in e, so c x median < value exactly where more than n / 2
+/// of the |r| have c x |r| < value (the same decision as selecting the median, bit for bit).
+bool beyond_robust_scales(const double* r, std::size_t n, double scales, double floor,
+                          double value) {
+  if (!(value > floor)) return false;
+  const double c = scales * 1.4826;
+  std::size_t below = 0;
+  for (std::size_t p = 0; p < n; ++p) below += c * std::abs(r[p]) < value;
+  return below > n / 2;
+}
+
 /// Whether a least-squares fit's residuals hint at outliers: one beyond kSuspectScales robust
 /// scales (and the floor). Gaussian residuals pass it in most fits; a point far off, or two
 /// that bend the fit towards them (masking each other), do not.
 bool suspect(const std::vector<double>& misfit, double floor) {
-  std::vector<double> magnitude(misfit.size());
   double largest = 0.0;
-  for (std::size_t p = 0; p < misfit.size(); ++p) {
-    magnitude[p] = std::abs(misfit[p]);
-    largest = std::max(largest, magnitude[p]);
-  }
-  const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
-  std::nth_element(magnitude.begin(), middle, magnitude.end());
-  return largest > std::max(kSuspectScales * 1.4826 * *middle, floor);
+  for (const double r : misfit) largest = std::max(largest, std::abs(r));
+  return beyond_robust_scales(misfit.data(), misfit.size(), kSuspectScales, floor, largest);
 }
 
 /// Whether the point itself (the origin) lies beyond kSuspectScales robust scales (and the
@@ -116,15 +123,8 @@ bool centre_off(int degree, double floor, FitScratch& s) {
   if (solved) {
     misfits(degree, s);
     // The others' residuals alone set the scale.
-    const double centre = std::abs(s.misfit[0]);
-    std::vector<double>& magnitude = s.magnitude;
-    magnitude.clear();
-    for (std::size_t p = 1; p < s.misfit.size(); ++p) magnitude.push_back(std::abs(s.misfit[p]));
-    if (!magnitude.empty()) {
-      const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
-      std::nth_element(magnitude.begin(), middle, magnitude.end());
-      off = centre > std::max(kSuspectScales * 1.4826 * *middle, floor);
-    }
+    off = beyond_robust_scales(s.misfit.data() + 1, s.misfit.size() - 1, kSuspectScales, floor,
+                               std::abs(s.misfit[0]));
   }
   std::copy(c, c + m, s.batch.c);
   s.misfit.swap(s.saved_misfit);

@@ -30,7 +30,7 @@ struct LocalSurface {
 struct FitScratch {
   jets::Points points, kept_points;
   std::vector<double> terms;
-  std::vector<double> misfit, saved_misfit, magnitude;
+  std::vector<double> misfit, saved_misfit;
   std::vector<char> keep;
   jets::JetBatch batch;
 };
