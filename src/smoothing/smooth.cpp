@@ -71,6 +71,7 @@ struct Scratch {
   std::vector<int> ring, side[detail::smoothing::kMaxSides];
   std::vector<Eigen::Vector3d> normals;  ///< crease_sides' scratch
   FitScratch fit;
+  detail::smoothing::LaneFits lanes;  ///< the fits over a whole neighbourhood or one side
 };
 
 void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
@@ -128,9 +129,12 @@ struct Pass {
 /// The surface of point i: over its whole neighbourhood; or, where its neighbours' normals fall
 /// into sides of a crease (keep_creases), each side's surface, the point moved onto the one it
 /// lies on, or onto the planes of all it lies on (the crease line, a corner). A point lies on
-/// the sides its nearest neighbours are members of. Returns whether it is on several sides.
-bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
-                const SmoothOptions& o, double floor, int i, Scratch& s, LocalSurface& out) {
+/// the sides its nearest neighbours are members of. A fit of o.degree over the whole
+/// neighbourhood or one side is queued in s.lanes (`queued`), for the caller to run.
+enum class Fit { plain, crease, queued };
+
+Fit surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
+               const SmoothOptions& o, double floor, int i, Scratch& s, LocalSurface& out) {
   using namespace detail::smoothing;
   neighbourhood_of(nb, i, s);
   Eigen::Vector3d mean[kMaxSides];
@@ -140,10 +144,15 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
                         : 0;
   if (sides < 2) {
     const bool one = sides == 1;
-    out = fit_local_surface(
-        V, i, one ? mean[0] : Eigen::Vector3d(frames.row(i).transpose()), one ? s.side[0] : s.ring,
-        one ? side_degree(s.side[0].size(), o.degree) : o.degree, o.robust, floor, s.fit);
-    return false;
+    const Eigen::Vector3d n = one ? mean[0] : Eigen::Vector3d(frames.row(i).transpose());
+    const std::vector<int>& members = one ? s.side[0] : s.ring;
+    const int degree = one ? side_degree(s.side[0].size(), o.degree) : o.degree;
+    if (degree == o.degree) {
+      s.lanes.queue(V, i, n, members);
+      return Fit::queued;
+    }
+    out = fit_local_surface(V, i, n, members, degree, o.robust, floor, s.fit);
+    return Fit::plain;
   }
   const Eigen::Vector3d ni = nb.sides_of->row(i).transpose();
   // The sides the point lies on: those its nearest neighbours (1-ring) are members of.
@@ -187,7 +196,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
               ? fit[k]
               : fit_local_surface(V, i, mean[k], s.side[k], side_degree(s.side[k].size(), o.degree),
                                   o.robust, floor, s.fit);
-    return false;
+    return Fit::plain;
   }
   // A point on a crease moves onto the sides' planes, as far as its noise lets it: a move
   // beyond kMaxCreaseMove residuals (a side's surface extrapolated, or sides met by mistake)
@@ -199,7 +208,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
   if (!((moved - p).norm() <= std::max(kMaxCreaseMove * residual, floor))) {
     out = fit_local_surface(V, i, mean[nearest], s.side[nearest],
                             side_degree(s.side[nearest].size(), o.degree), o.robust, floor, s.fit);
-    return false;
+    return Fit::plain;
   }
   out = *on[0];
   out.point = moved;
@@ -212,7 +221,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
   }
   out.normal = normal.normalized();
   out.ok = out.point.allFinite() && out.normal.allFinite();
-  return true;
+  return Fit::crease;
 }
 
 Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
@@ -228,23 +237,40 @@ Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
   detail::PerThread<Scratch> scratch(0);
   detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
     Scratch& s = scratch.local();
-    for (std::int64_t k = begin; k < end; ++k) {
-      const int i = static_cast<int>(k);
-      LocalSurface f;
-      if (frames.row(i).allFinite() && V.row(i).allFinite()) {
-        p.crease[i] = surface_of(V, frames, nb, o, floor, i, s, f);
-      }
+    const auto store = [&](int i, const LocalSurface& f) {
       if (!f.ok) {
         p.V.row(i) = V.row(i);
         p.N.row(i).setConstant(kNaN);
         p.residual[i] = kNaN;
-        continue;
+        return;
       }
       p.V.row(i) = f.point.transpose();
       p.N.row(i) = f.normal.transpose();
       p.residual[i] = f.residual;
       p.outlier[static_cast<std::size_t>(i)] = f.centre_rejected;
+    };
+    int row[detail::jets::kMaxLanes];
+    LocalSurface fits[detail::jets::kMaxLanes];
+    const auto run_queued = [&] {
+      const int queued = s.lanes.queued;
+      s.lanes.run(V, o.degree, o.robust, floor, fits);
+      for (int l = 0; l < queued; ++l) store(row[l], fits[l]);
+    };
+    for (std::int64_t k = begin; k < end; ++k) {
+      const int i = static_cast<int>(k);
+      LocalSurface f;
+      if (frames.row(i).allFinite() && V.row(i).allFinite()) {
+        row[s.lanes.queued] = i;
+        const Fit fit = surface_of(V, frames, nb, o, floor, i, s, f);
+        if (fit == Fit::queued) {
+          if (s.lanes.queued == s.lanes.width) run_queued();
+          continue;
+        }
+        p.crease[i] = fit == Fit::crease;
+      }
+      store(i, f);
     }
+    if (s.lanes.queued > 0) run_queued();
   });
   for (Eigen::Index i = 0; i < n; ++i) {
     p.crease_points += p.crease[i];

@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "kernels/eigen.h"
 #include "kernels/local_shape.h"
 
@@ -226,12 +227,12 @@ bool robust_refit(int degree, double scaled_floor, FitScratch& s) {
 
 }  // namespace
 
-LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
-                               const std::vector<int>& ring, int degree, bool robust, double floor,
-                               FitScratch& s) {
-  const kernels::Frame<double> frame = kernels::frame_of(kernels::vec3_of(n));
-  const double scale = jets::gather_points(V, i, frame, ring, s.points);
-  if (!(scale > 0.0) || !fit_points(degree, s.points, s)) return {};
+namespace {
+
+/// The rest of fit_local_surface after its least-squares fit (in s.batch, solved, over s.points
+/// in `frame`, scaled by `scale`): the residuals, the test for outliers and the robust refit.
+LocalSurface finish_fit(PositionsRef V, int i, const kernels::Frame<double>& frame, double scale,
+                        int degree, bool robust, double floor, FitScratch& s) {
   misfits(degree, s);
   s.keep.assign(s.points.size(), 1);
   const double scaled_floor = floor / scale;
@@ -251,6 +252,66 @@ LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
   s.misfit.swap(s.saved_misfit);
   s.keep.assign(s.points.size(), 1);
   return surface_of_fit(V, i, frame, scale, degree, s);
+}
+
+}  // namespace
+
+LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
+                               const std::vector<int>& ring, int degree, bool robust, double floor,
+                               FitScratch& s) {
+  const kernels::Frame<double> frame = kernels::frame_of(kernels::vec3_of(n));
+  const double scale = jets::gather_points(V, i, frame, ring, s.points);
+  if (!(scale > 0.0) || !fit_points(degree, s.points, s)) return {};
+  return finish_fit(V, i, frame, scale, degree, robust, floor, s);
+}
+
+LaneFits::LaneFits() : width(jets::batch_width(SimdIsa::best)) {}
+
+void LaneFits::queue(PositionsRef V, int i, const Eigen::Vector3d& n,
+                     const std::vector<int>& ring) {
+  const int l = queued++;
+  point[l] = i;
+  frame[l] = kernels::frame_of(kernels::vec3_of(n));
+  scale[l] = jets::gather_points(V, i, frame[l], ring, lane[l].points);
+}
+
+void LaneFits::run(PositionsRef V, int degree, bool robust, double floor, LocalSurface* out) {
+  jets::JetBatch& b = batch;
+  b.points_max = 0;
+  for (int l = 0; l < width; ++l) {
+    b.count[l] = l < queued && scale[l] > 0.0 ? static_cast<int>(lane[l].points.size()) : 0;
+    b.points_max = std::max(b.points_max, b.count[l]);
+  }
+  // Every lane's points padded with (0, 0, 0) to points_max (JetBatch::points).
+  const auto n = static_cast<std::size_t>(b.points_max);
+  if (zeros.size() < n) zeros.resize(n, jets::Point{0.0, 0.0, 0.0});
+  for (int l = 0; l < width; ++l) {
+    if (b.count[l] == 0) {
+      b.points[l] = zeros.data();
+    } else {
+      lane[l].points.resize(n, jets::Point{0.0, 0.0, 0.0});
+      b.points[l] = lane[l].points.data();
+    }
+  }
+  terms.resize(n * static_cast<std::size_t>(terms_stride(degree) * width));
+  b.terms = terms.data();
+  jets::top_degree_kernel(SimdIsa::best, degree)(b);
+  const int m = coefficient_count(degree), moments = coefficient_count(2 * degree);
+  for (int l = 0; l < queued; ++l) {
+    out[l] = {};
+    if (b.count[l] == 0 || !b.solved[l]) continue;
+    // Lane l as the scalar fit of its points would leave it (the same bits).
+    FitScratch& s = lane[l];
+    s.points.resize(static_cast<std::size_t>(b.count[l]));
+    jets::JetBatch& one = s.batch;
+    one.points[0] = s.points.data();
+    one.count[0] = one.points_max = b.count[l];
+    one.solved[0] = true;
+    for (int k = 0; k < moments; ++k) one.xy[k] = b.xy[k * width + l];
+    for (int k = 0; k < m; ++k) one.z[k] = b.z[k * width + l], one.c[k] = b.c[k * width + l];
+    out[l] = finish_fit(V, point[l], frame[l], scale[l], degree, robust, floor, s);
+  }
+  queued = 0;
 }
 
 }  // namespace focal::detail::smoothing
