@@ -17,20 +17,39 @@ using jets::coefficient_count;
 using jets::terms_stride;
 using kernels::eigen_of;
 
+/// Two doubles as one SSE2 register: two points' heights at once, each with the products and
+/// sums of one alone (the same bits).
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+
 /// The fitted height at scaled coordinates (x, y): sum c_k x^(t-b) y^b over the monomials
 /// by degree t, then by the power b of y (jet_fit.cpp's numbering). D fixed: unrolled, the same
-/// operations in the same order for every D.
-template <int D>
-double height_at(const double* c, double x, double y) {
-  double xs[D + 1], ys[D + 1];
-  xs[0] = ys[0] = 1.0;
+/// operations in the same order for every D; T a double or a Pair.
+template <int D, class T>
+T height_at(const double* c, T x, T y) {
+  T xs[D + 1], ys[D + 1];
+  xs[0] = ys[0] = T{} + 1.0;
   for (int t = 1; t <= D; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
-  double height = 0.0;
+  T height = T{};
   int k = 0;
   for (int t = 0; t <= D; ++t) {
     for (int b = 0; b <= t; ++b, ++k) height += c[k] * xs[t - b] * ys[b];
   }
   return height;
+}
+
+template <int D>
+void misfits_of_degree(FitScratch& s) {
+  const double* c = s.batch.c;
+  const jets::Point* q = s.points.data();
+  double* out = s.misfit.data();
+  const std::size_t n = s.points.size();
+  std::size_t p = 0;
+  for (; p + 1 < n; p += 2) {
+    const Pair x = {q[p].x, q[p + 1].x}, y = {q[p].y, q[p + 1].y}, z = {q[p].z, q[p + 1].z};
+    const Pair r = z - height_at<D>(c, x, y);
+    out[p] = r[0], out[p + 1] = r[1];
+  }
+  if (p < n) out[p] = q[p].z - height_at<D>(c, q[p].x, q[p].y);
 }
 
 /// The least-squares fit of `degree` to `points` (one lane of the scalar kernel) into s.batch.c.
@@ -44,14 +63,6 @@ bool fit_points(int degree, const jets::Points& points, FitScratch& s) {
   b.terms = s.terms.data();
   jets::top_degree_kernel(std::nullopt, degree)(b);
   return b.solved[0];
-}
-
-template <int D>
-void misfits_of_degree(FitScratch& s) {
-  const double* c = s.batch.c;
-  const jets::Point* q = s.points.data();
-  double* out = s.misfit.data();
-  for (std::size_t p = 0; p < s.points.size(); ++p) out[p] = q[p].z - height_at<D>(c, q[p].x, q[p].y);
 }
 
 /// Each point's residual against the fit in s.batch.c into s.misfit (scaled units).
