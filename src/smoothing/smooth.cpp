@@ -54,12 +54,52 @@ constexpr double kOnSideResiduals = 1.5;
 /// (the noise: uniform noise of amplitude a has an RMS of a / sqrt(3), and moves up to a).
 constexpr double kMaxCreaseMove = 4.0;
 
+/// Each mesh vertex's vertices within its rings (jets::gather_ring: itself included, ascending),
+/// gathered once for all passes (the positions move, the neighbourhoods do not) and packed: the
+/// gaps between consecutive entries (the first: v minus it) as LEB128 varints, one byte each for
+/// gaps below 128 (a few bytes an entry where nearby vertices have nearby indices, at most five).
+struct PackedRings {
+  std::vector<std::uint64_t> offsets;  ///< #V + 1, into bytes
+  std::vector<std::uint8_t> bytes;
+
+  void unpack(int v, std::vector<int>& ring) const {
+    ring.clear();
+    const std::uint8_t* p = bytes.data() + offsets[static_cast<std::size_t>(v)];
+    const std::uint8_t* end = bytes.data() + offsets[static_cast<std::size_t>(v) + 1];
+    bool first = true;
+    int last = v;
+    while (p != end) {
+      std::uint32_t gap = 0;
+      for (unsigned shift = 0;; shift += 7) {
+        const std::uint8_t byte = *p++;
+        gap |= static_cast<std::uint32_t>(byte & 0x7f) << shift;
+        if (byte < 0x80) break;
+      }
+      last = first ? v - static_cast<int>(gap) : last + static_cast<int>(gap);
+      first = false;
+      ring.push_back(last);
+    }
+  }
+};
+
+void pack_ring(int v, const std::vector<int>& ring, std::vector<std::uint8_t>& out) {
+  int last = v;
+  bool first = true;
+  for (const int w : ring) {
+    auto gap = static_cast<std::uint32_t>(first ? v - w : w - last);
+    first = false;
+    last = w;
+    for (; gap >= 0x80; gap >>= 7) out.push_back(static_cast<std::uint8_t>(gap | 0x80));
+    out.push_back(static_cast<std::uint8_t>(gap));
+  }
+}
+
 /// Where each point's neighbourhood comes from: a mesh's rings, or a cloud's lists.
 struct Neighbours {
-  /// A mesh's 1-ring (its nearest neighbours); null for clouds.
+  /// A mesh's 1-ring (its nearest neighbours) and its vertices' rings; null for clouds.
   const Neighbourhoods* one_ring = nullptr;
-  /// Each point's neighbourhood: a mesh's vertices within its rings (the vertex itself
-  /// included, ascending: gathered_rings), or a cloud's nearest neighbours.
+  const PackedRings* rings = nullptr;
+  /// A cloud's nearest neighbours.
   const Neighbourhoods* lists = nullptr;
   bool oriented = true;  ///< frame normals on one side (meshes); clouds compare lines
   /// The input's normals (Max's, or the cloud's), which group a crease's sides in every pass:
@@ -75,45 +115,47 @@ struct Scratch {
 };
 
 void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
-  s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
+  if (nb.rings) {
+    nb.rings->unpack(i, s.ring);
+  } else {
+    s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
+  }
 }
 
-/// Every vertex's vertices within `rings` edges (jets::gather_ring: itself included, ascending),
-/// gathered once for all passes: the positions move, the neighbourhoods do not.
-Neighbourhoods gathered_rings(const Neighbourhoods& one, int rings) {
+/// The rings of every vertex, packed (PackedRings): per block of vertices, then joined in order.
+PackedRings gathered_rings(const Neighbourhoods& one, int rings) {
   const int n = one.vertex_count();
+  constexpr std::int64_t kBlock = 4096;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
   struct Gather {
     std::vector<std::uint64_t> in_ring;
     std::vector<int> ring;
   };
   detail::PerThread<Gather> scratch(0);
-  Neighbourhoods out;
-  out.offsets.resize(n + 1);
+  std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(blocks));
+  PackedRings out;
+  out.offsets.resize(static_cast<std::size_t>(n) + 1);
+  detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    Gather& g = scratch.local();
+    std::vector<std::uint8_t>& bytes = packed[static_cast<std::size_t>(begin / kBlock)];
+    for (std::int64_t v = begin; v < end; ++v) {
+      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
+      pack_ring(static_cast<int>(v), g.ring, bytes);
+      out.offsets[static_cast<std::size_t>(v) + 1] = bytes.size();  // within the block
+    }
+  });
+  std::size_t total = 0;
+  for (const auto& bytes : packed) total += bytes.size();
+  out.bytes.reserve(total);
   out.offsets[0] = 0;
-  // Twice: the sizes, then (at their offsets) the lists; gathering is cheaper than the memory
-  // of lists kept per block.
-  detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
-    Gather& g = scratch.local();
-    for (std::int64_t v = begin; v < end; ++v) {
-      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
-      out.offsets[v + 1] = static_cast<int>(g.ring.size());
-    }
-  });
-  std::int64_t total = 0;
-  for (int v = 0; v < n; ++v) {
-    total += out.offsets[v + 1];
-    if (total > std::numeric_limits<int>::max())
-      throw InvalidInput("smooth: the rings of the mesh's vertices hold more than 2^31 entries");
-    out.offsets[v + 1] = static_cast<int>(total);
+  for (std::int64_t k = 0; k < blocks; ++k) {
+    const std::uint64_t base = out.bytes.size();
+    for (std::int64_t v = k * kBlock; v < std::min<std::int64_t>(n, (k + 1) * kBlock); ++v)
+      out.offsets[static_cast<std::size_t>(v) + 1] += base;
+    auto& bytes = packed[static_cast<std::size_t>(k)];
+    out.bytes.insert(out.bytes.end(), bytes.begin(), bytes.end());
+    std::vector<std::uint8_t>().swap(bytes);
   }
-  out.indices.resize(static_cast<Eigen::Index>(total));
-  detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
-    Gather& g = scratch.local();
-    for (std::int64_t v = begin; v < end; ++v) {
-      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
-      std::copy(g.ring.begin(), g.ring.end(), out.indices.data() + out.offsets[v]);
-    }
-  });
   return out;
 }
 
@@ -399,10 +441,10 @@ SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RecommendedPlan plan = recommended_plan(mesh.with_normals(std::nullopt));
   const int rings = o.rings > 0 ? o.rings : plan.rings > 1 ? plan.jet_rings : kCleanRings;
-  const Neighbourhoods lists = gathered_rings(*one, rings);
+  const PackedRings packed = gathered_rings(*one, rings);
   Neighbours nb;
   nb.one_ring = one.get();
-  nb.lists = &lists;
+  nb.rings = &packed;
   RowMatrixX3d max = face_normals(mesh);
   nb.sides_of = &max;
   SmoothResult out = run(mesh.V(), max, nb, o, h, plan.jet_iterations > 1);
