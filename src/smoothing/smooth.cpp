@@ -162,7 +162,8 @@ PackedRings gathered_rings(const Neighbourhoods& one, int rings) {
 /// One pass: every point's surface, in the frame of its row of `frames`.
 struct Pass {
   RowMatrixX3d V, N;
-  Eigen::VectorXd residual;
+  Eigen::VectorXd residual;  ///< per point, while the pass runs (freed after: its median kept)
+  double median_residual = kNaN;  ///< of the fitted points
   std::vector<char> outlier;  ///< the point itself lay far off its surface
   VectorXu8 crease;           ///< on several sides of a crease
   int crease_points = 0, unfitted = 0;
@@ -314,23 +315,20 @@ Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
     }
     if (s.lanes.queued > 0) run_queued();
   });
+  // The median of the finite residuals, in place (the vector is not needed afterwards).
+  double* const r = p.residual.data();
+  std::ptrdiff_t finite = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     p.crease_points += p.crease[i];
-    p.unfitted += !std::isfinite(p.residual[i]);
+    if (std::isfinite(r[i])) r[finite++] = r[i];
   }
+  p.unfitted = static_cast<int>(n - finite);
+  if (finite > 0) {
+    std::nth_element(r, r + finite / 2, r + finite);
+    p.median_residual = r[finite / 2];
+  }
+  p.residual = Eigen::VectorXd();
   return p;
-}
-
-double median_of(const Eigen::VectorXd& x) {
-  std::vector<double> v;
-  v.reserve(static_cast<std::size_t>(x.size()));
-  for (const double e : x) {
-    if (std::isfinite(e)) v.push_back(e);
-  }
-  if (v.empty()) return kNaN;
-  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), middle, v.end());
-  return *middle;
 }
 
 void validate(const SmoothOptions& o) {
@@ -399,7 +397,7 @@ SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, cons
     check_cancel(e, t);
     if (e.progress) e.progress({"smooth", static_cast<double>(t) / passes});
     Pass p = run_pass(t == 0 ? V : PositionsRef(next.V), frames, nb, o, scale);
-    const double noise = median_of(p.residual) / scale;
+    const double noise = p.median_residual / scale;
     if (t == 0) {
       out.N = p.N;
       out.unfitted = p.unfitted;
@@ -446,8 +444,10 @@ SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
   nb.one_ring = one.get();
   nb.rings = &packed;
   RowMatrixX3d max = face_normals(mesh);
-  nb.sides_of = &max;
-  SmoothResult out = run(mesh.V(), max, nb, o, h, plan.jet_iterations > 1);
+  // Without keep_creases the input's normals are the first frames only (no copy kept).
+  nb.sides_of = o.keep_creases ? &max : nullptr;
+  SmoothResult out = run(mesh.V(), o.keep_creases ? RowMatrixX3d(max) : std::move(max), nb, o, h,
+                         plan.jet_iterations > 1);
   out.rings = rings;
   if (const auto N = mesh.normals()) to_side_of(*N, out.N);
   return out;
@@ -470,7 +470,7 @@ SmoothResult smooth_cloud(const PreparedMesh& cloud, const SmoothOptions& o) {
     SmoothOptions measure = o;
     measure.iterations = 1;
     const Pass p = run_pass(V, frames, nb, measure, spacing);
-    k = median_of(p.residual) / spacing > kCloudNoisy ? kCloudNoisyNeighbours : kCloudNeighbours;
+    k = p.median_residual / spacing > kCloudNoisy ? kCloudNoisyNeighbours : kCloudNeighbours;
     if (k != kCloudNeighbours) lists = nearest_neighbours(V, k);
   }
   SmoothResult out = run(V, std::move(frames), nb, o, spacing, false);
