@@ -63,22 +63,24 @@ struct PackedRings {
   std::vector<std::uint8_t> bytes;
 
   void unpack(int v, std::vector<int>& ring) const {
-    ring.clear();
     const std::uint8_t* p = bytes.data() + offsets[static_cast<std::size_t>(v)];
     const std::uint8_t* end = bytes.data() + offsets[static_cast<std::size_t>(v) + 1];
-    bool first = true;
-    int last = v;
-    while (p != end) {
-      std::uint32_t gap = 0;
-      for (unsigned shift = 0;; shift += 7) {
+    ring.resize(static_cast<std::size_t>(end - p));  // at most one entry a byte
+    int* out = ring.data();
+    const auto gap = [&p] {
+      std::uint32_t value = *p++;
+      if (value < 0x80) return value;
+      value &= 0x7f;
+      for (unsigned shift = 7;; shift += 7) {
         const std::uint8_t byte = *p++;
-        gap |= static_cast<std::uint32_t>(byte & 0x7f) << shift;
-        if (byte < 0x80) break;
+        value |= static_cast<std::uint32_t>(byte & 0x7f) << shift;
+        if (byte < 0x80) return value;
       }
-      last = first ? v - static_cast<int>(gap) : last + static_cast<int>(gap);
-      first = false;
-      ring.push_back(last);
-    }
+    };
+    int last = v;
+    if (p != end) *out++ = last = v - static_cast<int>(gap());
+    while (p != end) *out++ = last += static_cast<int>(gap());
+    ring.resize(static_cast<std::size_t>(out - ring.data()));
   }
 };
 
