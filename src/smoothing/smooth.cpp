@@ -164,10 +164,10 @@ PackedRings gathered_rings(const Neighbourhoods& one, int rings) {
 /// One pass: every point's surface, in the frame of its row of `frames`.
 struct Pass {
   RowMatrixX3d V, N;
-  Eigen::VectorXd residual;  ///< per point, while the pass runs (freed after: its median kept)
+  Eigen::VectorXd residual;       ///< per point, while the pass runs (freed after: its median kept)
   double median_residual = kNaN;  ///< of the fitted points
-  std::vector<char> outlier;  ///< the point itself lay far off its surface
-  VectorXu8 crease;           ///< on several sides of a crease
+  std::vector<char> outlier;      ///< the point itself lay far off its surface
+  VectorXu8 crease;               ///< on several sides of a crease
   int crease_points = 0, unfitted = 0;
 };
 

@@ -15,8 +15,10 @@ namespace focal::detail::smoothing {
 
 /// The surface fitted around one point.
 struct LocalSurface {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< the fitted graph's point over (0, 0): P + height * n
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< its unit normal there, on the frame normal's side
+  Eigen::Vector3d point =
+      Eigen::Vector3d::Zero();  ///< the fitted graph's point over (0, 0): P + height * n
+  Eigen::Vector3d normal =
+      Eigen::Vector3d::Zero();   ///< its unit normal there, on the frame normal's side
   double height = 0.0;           ///< signed offset from P to `point` along the frame normal
   double residual = 0.0;         ///< RMS height residual of the kept points (length units)
   int kept = 0;                  ///< points in the final fit
