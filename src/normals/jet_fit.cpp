@@ -386,6 +386,23 @@ TopDegreeKernel top_degree_kernel(std::optional<SimdIsa> isa, int degree) {
   }
 }
 
+bool solve_moments(int degree, JetBatch& b, int count) {
+  const auto solve = [&](auto m) {
+    return solve_normal_equations<double, decltype(m)::value>(b.xy, b.z, b.c) &&
+           count >= decltype(m)::value;
+  };
+  switch (degree) {
+    case 4:
+      return solve(std::integral_constant<int, coefficient_count(4)>{});
+    case 3:
+      return solve(std::integral_constant<int, coefficient_count(3)>{});
+    case 2:
+      return solve(std::integral_constant<int, coefficient_count(2)>{});
+    default:
+      return solve(std::integral_constant<int, coefficient_count(1)>{});
+  }
+}
+
 int batch_width(std::optional<SimdIsa> isa) {
   if (!isa) return 1;
   switch (detail::simd_isa(*isa)) {

@@ -73,6 +73,13 @@ using TopDegreeKernel = void (*)(JetBatch&);
 /// path, one vertex at a time.
 TopDegreeKernel top_degree_kernel(std::optional<SimdIsa> isa, int degree);
 
+/// The degree-`degree` fit of a scalar batch (the kernel without lanes) from its moments b.xy,
+/// b.z as they stand into b.c: a caller that downdated them (a point taken out of the sums) gets
+/// the fit without that point, with the bits of a fit to the remaining points. False when the
+/// system is not well posed or `count` (the points the moments sum) is below
+/// coefficient_count(degree).
+bool solve_moments(int degree, JetBatch& b, int count);
+
 /// The kernel's lane count: 1 without lanes.
 int batch_width(std::optional<SimdIsa> isa);
 

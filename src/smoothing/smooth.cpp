@@ -54,10 +54,54 @@ constexpr double kOnSideResiduals = 1.5;
 /// (the noise: uniform noise of amplitude a has an RMS of a / sqrt(3), and moves up to a).
 constexpr double kMaxCreaseMove = 4.0;
 
+/// Each mesh vertex's vertices within its rings (jets::gather_ring: itself included, ascending),
+/// gathered once for all passes (the positions move, the neighbourhoods do not) and packed: the
+/// gaps between consecutive entries (the first: v minus it) as LEB128 varints, one byte each for
+/// gaps below 128 (a few bytes an entry where nearby vertices have nearby indices, at most five).
+struct PackedRings {
+  std::vector<std::uint64_t> offsets;  ///< #V + 1, into bytes
+  std::vector<std::uint8_t> bytes;
+
+  void unpack(int v, std::vector<int>& ring) const {
+    const std::uint8_t* p = bytes.data() + offsets[static_cast<std::size_t>(v)];
+    const std::uint8_t* end = bytes.data() + offsets[static_cast<std::size_t>(v) + 1];
+    ring.resize(static_cast<std::size_t>(end - p));  // at most one entry a byte
+    int* out = ring.data();
+    const auto gap = [&p] {
+      std::uint32_t value = *p++;
+      if (value < 0x80) return value;
+      value &= 0x7f;
+      for (unsigned shift = 7;; shift += 7) {
+        const std::uint8_t byte = *p++;
+        value |= static_cast<std::uint32_t>(byte & 0x7f) << shift;
+        if (byte < 0x80) return value;
+      }
+    };
+    int last = v;
+    if (p != end) *out++ = last = v - static_cast<int>(gap());
+    while (p != end) *out++ = last += static_cast<int>(gap());
+    ring.resize(static_cast<std::size_t>(out - ring.data()));
+  }
+};
+
+void pack_ring(int v, const std::vector<int>& ring, std::vector<std::uint8_t>& out) {
+  int last = v;
+  bool first = true;
+  for (const int w : ring) {
+    auto gap = static_cast<std::uint32_t>(first ? v - w : w - last);
+    first = false;
+    last = w;
+    for (; gap >= 0x80; gap >>= 7) out.push_back(static_cast<std::uint8_t>(gap | 0x80));
+    out.push_back(static_cast<std::uint8_t>(gap));
+  }
+}
+
 /// Where each point's neighbourhood comes from: a mesh's rings, or a cloud's lists.
 struct Neighbours {
+  /// A mesh's 1-ring (its nearest neighbours) and its vertices' rings; null for clouds.
   const Neighbourhoods* one_ring = nullptr;
-  int rings = 0;
+  const PackedRings* rings = nullptr;
+  /// A cloud's nearest neighbours.
   const Neighbourhoods* lists = nullptr;
   bool oriented = true;  ///< frame normals on one side (meshes); clouds compare lines
   /// The input's normals (Max's, or the cloud's), which group a crease's sides in every pass:
@@ -66,35 +110,76 @@ struct Neighbours {
 };
 
 struct Scratch {
-  std::vector<std::uint64_t> in_ring;
   std::vector<int> ring, side[detail::smoothing::kMaxSides];
   std::vector<Eigen::Vector3d> normals;  ///< crease_sides' scratch
   FitScratch fit;
+  detail::smoothing::LaneFits lanes;  ///< the fits over a whole neighbourhood or one side
 };
 
 void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
-  if (nb.one_ring) {
-    detail::jets::gather_ring(*nb.one_ring, i, nb.rings, s.in_ring, nullptr, s.ring);
+  if (nb.rings) {
+    nb.rings->unpack(i, s.ring);
   } else {
     s.ring.assign(nb.lists->begin(i), nb.lists->end(i));
   }
 }
 
+/// The rings of every vertex, packed (PackedRings): per block of vertices, then joined in order.
+PackedRings gathered_rings(const Neighbourhoods& one, int rings) {
+  const int n = one.vertex_count();
+  constexpr std::int64_t kBlock = 4096;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+  struct Gather {
+    std::vector<std::uint64_t> in_ring;
+    std::vector<int> ring;
+  };
+  detail::PerThread<Gather> scratch(0);
+  std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(blocks));
+  PackedRings out;
+  out.offsets.resize(static_cast<std::size_t>(n) + 1);
+  detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
+    Gather& g = scratch.local();
+    std::vector<std::uint8_t>& bytes = packed[static_cast<std::size_t>(begin / kBlock)];
+    for (std::int64_t v = begin; v < end; ++v) {
+      detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
+      pack_ring(static_cast<int>(v), g.ring, bytes);
+      out.offsets[static_cast<std::size_t>(v) + 1] = bytes.size();  // within the block
+    }
+  });
+  std::size_t total = 0;
+  for (const auto& bytes : packed) total += bytes.size();
+  out.bytes.reserve(total);
+  out.offsets[0] = 0;
+  for (std::int64_t k = 0; k < blocks; ++k) {
+    const std::uint64_t base = out.bytes.size();
+    for (std::int64_t v = k * kBlock; v < std::min<std::int64_t>(n, (k + 1) * kBlock); ++v)
+      out.offsets[static_cast<std::size_t>(v) + 1] += base;
+    auto& bytes = packed[static_cast<std::size_t>(k)];
+    out.bytes.insert(out.bytes.end(), bytes.begin(), bytes.end());
+    std::vector<std::uint8_t>().swap(bytes);
+  }
+  return out;
+}
+
 /// One pass: every point's surface, in the frame of its row of `frames`.
 struct Pass {
   RowMatrixX3d V, N;
-  Eigen::VectorXd residual;
-  std::vector<char> outlier;  ///< the point itself lay far off its surface
-  VectorXu8 crease;           ///< on several sides of a crease
+  Eigen::VectorXd residual;       ///< per point, while the pass runs (freed after: its median kept)
+  double median_residual = kNaN;  ///< of the fitted points
+  std::vector<char> outlier;      ///< the point itself lay far off its surface
+  VectorXu8 crease;               ///< on several sides of a crease
   int crease_points = 0, unfitted = 0;
 };
 
 /// The surface of point i: over its whole neighbourhood; or, where its neighbours' normals fall
 /// into sides of a crease (keep_creases), each side's surface, the point moved onto the one it
 /// lies on, or onto the planes of all it lies on (the crease line, a corner). A point lies on
-/// the sides its nearest neighbours are members of. Returns whether it is on several sides.
-bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
-                const SmoothOptions& o, double floor, int i, Scratch& s, LocalSurface& out) {
+/// the sides its nearest neighbours are members of. A fit of o.degree over the whole
+/// neighbourhood or one side is queued in s.lanes (`queued`), for the caller to run.
+enum class Fit { plain, crease, queued };
+
+Fit surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
+               const SmoothOptions& o, double floor, int i, Scratch& s, LocalSurface& out) {
   using namespace detail::smoothing;
   neighbourhood_of(nb, i, s);
   Eigen::Vector3d mean[kMaxSides];
@@ -104,10 +189,15 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
                         : 0;
   if (sides < 2) {
     const bool one = sides == 1;
-    out = fit_local_surface(
-        V, i, one ? mean[0] : Eigen::Vector3d(frames.row(i).transpose()), one ? s.side[0] : s.ring,
-        one ? side_degree(s.side[0].size(), o.degree) : o.degree, o.robust, floor, s.fit);
-    return false;
+    const Eigen::Vector3d n = one ? mean[0] : Eigen::Vector3d(frames.row(i).transpose());
+    const std::vector<int>& members = one ? s.side[0] : s.ring;
+    const int degree = one ? side_degree(s.side[0].size(), o.degree) : o.degree;
+    if (degree == o.degree) {
+      s.lanes.queue(V, i, n, members);
+      return Fit::queued;
+    }
+    out = fit_local_surface(V, i, n, members, degree, o.robust, floor, s.fit);
+    return Fit::plain;
   }
   const Eigen::Vector3d ni = nb.sides_of->row(i).transpose();
   // The sides the point lies on: those its nearest neighbours (1-ring) are members of.
@@ -151,7 +241,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
               ? fit[k]
               : fit_local_surface(V, i, mean[k], s.side[k], side_degree(s.side[k].size(), o.degree),
                                   o.robust, floor, s.fit);
-    return false;
+    return Fit::plain;
   }
   // A point on a crease moves onto the sides' planes, as far as its noise lets it: a move
   // beyond kMaxCreaseMove residuals (a side's surface extrapolated, or sides met by mistake)
@@ -163,7 +253,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
   if (!((moved - p).norm() <= std::max(kMaxCreaseMove * residual, floor))) {
     out = fit_local_surface(V, i, mean[nearest], s.side[nearest],
                             side_degree(s.side[nearest].size(), o.degree), o.robust, floor, s.fit);
-    return false;
+    return Fit::plain;
   }
   out = *on[0];
   out.point = moved;
@@ -176,7 +266,7 @@ bool surface_of(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb
   }
   out.normal = normal.normalized();
   out.ok = out.point.allFinite() && out.normal.allFinite();
-  return true;
+  return Fit::crease;
 }
 
 Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
@@ -192,41 +282,55 @@ Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
   detail::PerThread<Scratch> scratch(0);
   detail::parallel_for_blocks(n, 256, 0, [&](std::int64_t begin, std::int64_t end) {
     Scratch& s = scratch.local();
-    for (std::int64_t k = begin; k < end; ++k) {
-      const int i = static_cast<int>(k);
-      LocalSurface f;
-      if (frames.row(i).allFinite() && V.row(i).allFinite()) {
-        p.crease[i] = surface_of(V, frames, nb, o, floor, i, s, f);
-      }
+    const auto store = [&](int i, const LocalSurface& f) {
       if (!f.ok) {
         p.V.row(i) = V.row(i);
         p.N.row(i).setConstant(kNaN);
         p.residual[i] = kNaN;
-        continue;
+        return;
       }
       p.V.row(i) = f.point.transpose();
       p.N.row(i) = f.normal.transpose();
       p.residual[i] = f.residual;
       p.outlier[static_cast<std::size_t>(i)] = f.centre_rejected;
+    };
+    int row[detail::jets::kMaxLanes];
+    LocalSurface fits[detail::jets::kMaxLanes];
+    const auto run_queued = [&] {
+      const int queued = s.lanes.queued;
+      s.lanes.run(V, o.degree, o.robust, floor, fits);
+      for (int l = 0; l < queued; ++l) store(row[l], fits[l]);
+    };
+    for (std::int64_t k = begin; k < end; ++k) {
+      const int i = static_cast<int>(k);
+      LocalSurface f;
+      if (frames.row(i).allFinite() && V.row(i).allFinite()) {
+        row[s.lanes.queued] = i;
+        const Fit fit = surface_of(V, frames, nb, o, floor, i, s, f);
+        if (fit == Fit::queued) {
+          if (s.lanes.queued == s.lanes.width) run_queued();
+          continue;
+        }
+        p.crease[i] = fit == Fit::crease;
+      }
+      store(i, f);
     }
+    if (s.lanes.queued > 0) run_queued();
   });
+  // The median of the finite residuals, in place (the vector is not needed afterwards).
+  double* const r = p.residual.data();
+  std::ptrdiff_t finite = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     p.crease_points += p.crease[i];
-    p.unfitted += !std::isfinite(p.residual[i]);
+    if (std::isfinite(r[i])) r[finite++] = r[i];
   }
+  p.unfitted = static_cast<int>(n - finite);
+  if (finite > 0) {
+    std::nth_element(r, r + finite / 2, r + finite);
+    p.median_residual = r[finite / 2];
+  }
+  p.residual = Eigen::VectorXd();
   return p;
-}
-
-double median_of(const Eigen::VectorXd& x) {
-  std::vector<double> v;
-  v.reserve(static_cast<std::size_t>(x.size()));
-  for (const double e : x) {
-    if (std::isfinite(e)) v.push_back(e);
-  }
-  if (v.empty()) return kNaN;
-  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), middle, v.end());
-  return *middle;
 }
 
 void validate(const SmoothOptions& o) {
@@ -295,7 +399,7 @@ SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, cons
     check_cancel(e, t);
     if (e.progress) e.progress({"smooth", static_cast<double>(t) / passes});
     Pass p = run_pass(t == 0 ? V : PositionsRef(next.V), frames, nb, o, scale);
-    const double noise = median_of(p.residual) / scale;
+    const double noise = p.median_residual / scale;
     if (t == 0) {
       out.N = p.N;
       out.unfitted = p.unfitted;
@@ -337,12 +441,15 @@ SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
   const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RecommendedPlan plan = recommended_plan(mesh.with_normals(std::nullopt));
   const int rings = o.rings > 0 ? o.rings : plan.rings > 1 ? plan.jet_rings : kCleanRings;
+  const PackedRings packed = gathered_rings(*one, rings);
   Neighbours nb;
   nb.one_ring = one.get();
-  nb.rings = rings;
+  nb.rings = &packed;
   RowMatrixX3d max = face_normals(mesh);
-  nb.sides_of = &max;
-  SmoothResult out = run(mesh.V(), max, nb, o, h, plan.jet_iterations > 1);
+  // Without keep_creases the input's normals are the first frames only (no copy kept).
+  nb.sides_of = o.keep_creases ? &max : nullptr;
+  SmoothResult out = run(mesh.V(), o.keep_creases ? RowMatrixX3d(max) : std::move(max), nb, o, h,
+                         plan.jet_iterations > 1);
   out.rings = rings;
   if (const auto N = mesh.normals()) to_side_of(*N, out.N);
   return out;
@@ -365,7 +472,7 @@ SmoothResult smooth_cloud(const PreparedMesh& cloud, const SmoothOptions& o) {
     SmoothOptions measure = o;
     measure.iterations = 1;
     const Pass p = run_pass(V, frames, nb, measure, spacing);
-    k = median_of(p.residual) / spacing > kCloudNoisy ? kCloudNoisyNeighbours : kCloudNeighbours;
+    k = p.median_residual / spacing > kCloudNoisy ? kCloudNoisyNeighbours : kCloudNeighbours;
     if (k != kCloudNeighbours) lists = nearest_neighbours(V, k);
   }
   SmoothResult out = run(V, std::move(frames), nb, o, spacing, false);

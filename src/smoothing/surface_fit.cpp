@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "kernels/eigen.h"
 #include "kernels/local_shape.h"
 
@@ -16,18 +17,39 @@ using jets::coefficient_count;
 using jets::terms_stride;
 using kernels::eigen_of;
 
+/// Two doubles as one SSE2 register: two points' heights at once, each with the products and
+/// sums of one alone (the same bits).
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+
 /// The fitted height at scaled coordinates (x, y): sum c_k x^(t-b) y^b over the monomials
-/// by degree t, then by the power b of y (jet_fit.cpp's numbering).
-double height_at(const double* c, int degree, double x, double y) {
-  double xs[jets::kMaxDegree + 1], ys[jets::kMaxDegree + 1];
-  xs[0] = ys[0] = 1.0;
-  for (int t = 1; t <= degree; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
-  double height = 0.0;
+/// by degree t, then by the power b of y (jet_fit.cpp's numbering). D fixed: unrolled, the same
+/// operations in the same order for every D; T a double or a Pair.
+template <int D, class T>
+T height_at(const double* c, T x, T y) {
+  T xs[D + 1], ys[D + 1];
+  xs[0] = ys[0] = T{} + 1.0;
+  for (int t = 1; t <= D; ++t) xs[t] = xs[t - 1] * x, ys[t] = ys[t - 1] * y;
+  T height = T{};
   int k = 0;
-  for (int t = 0; t <= degree; ++t) {
+  for (int t = 0; t <= D; ++t) {
     for (int b = 0; b <= t; ++b, ++k) height += c[k] * xs[t - b] * ys[b];
   }
   return height;
+}
+
+template <int D>
+void misfits_of_degree(FitScratch& s) {
+  const double* c = s.batch.c;
+  const jets::Point* q = s.points.data();
+  double* out = s.misfit.data();
+  const std::size_t n = s.points.size();
+  std::size_t p = 0;
+  for (; p + 1 < n; p += 2) {
+    const Pair x = {q[p].x, q[p + 1].x}, y = {q[p].y, q[p + 1].y}, z = {q[p].z, q[p + 1].z};
+    const Pair r = z - height_at<D>(c, x, y);
+    out[p] = r[0], out[p + 1] = r[1];
+  }
+  if (p < n) out[p] = q[p].z - height_at<D>(c, q[p].x, q[p].y);
 }
 
 /// The least-squares fit of `degree` to `points` (one lane of the scalar kernel) into s.batch.c.
@@ -46,9 +68,15 @@ bool fit_points(int degree, const jets::Points& points, FitScratch& s) {
 /// Each point's residual against the fit in s.batch.c into s.misfit (scaled units).
 void misfits(int degree, FitScratch& s) {
   s.misfit.resize(s.points.size());
-  for (std::size_t p = 0; p < s.points.size(); ++p) {
-    const jets::Point& q = s.points[p];
-    s.misfit[p] = q.z - height_at(s.batch.c, degree, q.x, q.y);
+  switch (degree) {
+    case 4:
+      return misfits_of_degree<4>(s);
+    case 3:
+      return misfits_of_degree<3>(s);
+    case 2:
+      return misfits_of_degree<2>(s);
+    default:
+      return misfits_of_degree<1>(s);
   }
 }
 
@@ -64,19 +92,26 @@ bool fit_kept(int degree, FitScratch& s) {
   return true;
 }
 
+/// Whether `value` exceeds both `floor` and `scales` robust scales (1.4826 x the median of
+/// |r| over the n residuals r, the median the element at n / 2 in ascending order), without
+/// ordering them: c x e is monotone in e, so c x median < value exactly where more than n / 2
+/// of the |r| have c x |r| < value (the same decision as selecting the median, bit for bit).
+bool beyond_robust_scales(const double* r, std::size_t n, double scales, double floor,
+                          double value) {
+  if (!(value > floor)) return false;
+  const double c = scales * 1.4826;
+  std::size_t below = 0;
+  for (std::size_t p = 0; p < n; ++p) below += c * std::abs(r[p]) < value;
+  return below > n / 2;
+}
+
 /// Whether a least-squares fit's residuals hint at outliers: one beyond kSuspectScales robust
 /// scales (and the floor). Gaussian residuals pass it in most fits; a point far off, or two
 /// that bend the fit towards them (masking each other), do not.
 bool suspect(const std::vector<double>& misfit, double floor) {
-  std::vector<double> magnitude(misfit.size());
   double largest = 0.0;
-  for (std::size_t p = 0; p < misfit.size(); ++p) {
-    magnitude[p] = std::abs(misfit[p]);
-    largest = std::max(largest, magnitude[p]);
-  }
-  const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
-  std::nth_element(magnitude.begin(), middle, magnitude.end());
-  return largest > std::max(kSuspectScales * 1.4826 * *middle, floor);
+  for (const double r : misfit) largest = std::max(largest, std::abs(r));
+  return beyond_robust_scales(misfit.data(), misfit.size(), kSuspectScales, floor, largest);
 }
 
 /// Whether the point itself (the origin) lies beyond kSuspectScales robust scales (and the
@@ -88,20 +123,20 @@ bool centre_off(int degree, double floor, FitScratch& s) {
   double c[jets::kMaxCoefficients];
   std::copy(s.batch.c, s.batch.c + m, c);
   s.saved_misfit = s.misfit;
-  s.keep.assign(s.points.size(), 1);
-  s.keep[0] = 0;
+  // The fit without the point itself from the least-squares fit's moments: the point is the
+  // origin, which adds 1 to the count and +0 to every other sum, so the sums without it are
+  // those with 1 taken off the count (the bits of a fit to the others alone).
+  jets::JetBatch& b = s.batch;
+  const double count = b.xy[0];
+  b.xy[0] = count - 1.0;
   bool off = false;
-  if (fit_kept(degree, s)) {
+  const bool solved = jets::solve_moments(degree, b, b.count[0] - 1);
+  b.xy[0] = count;
+  if (solved) {
+    misfits(degree, s);
     // The others' residuals alone set the scale.
-    const double centre = std::abs(s.misfit[0]);
-    std::vector<double>& magnitude = s.magnitude;
-    magnitude.clear();
-    for (std::size_t p = 1; p < s.misfit.size(); ++p) magnitude.push_back(std::abs(s.misfit[p]));
-    if (!magnitude.empty()) {
-      const auto middle = magnitude.begin() + static_cast<std::ptrdiff_t>(magnitude.size() / 2);
-      std::nth_element(magnitude.begin(), middle, magnitude.end());
-      off = centre > std::max(kSuspectScales * 1.4826 * *middle, floor);
-    }
+    off = beyond_robust_scales(s.misfit.data() + 1, s.misfit.size() - 1, kSuspectScales, floor,
+                               std::abs(s.misfit[0]));
   }
   std::copy(c, c + m, s.batch.c);
   s.misfit.swap(s.saved_misfit);
@@ -203,12 +238,12 @@ bool robust_refit(int degree, double scaled_floor, FitScratch& s) {
 
 }  // namespace
 
-LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
-                               const std::vector<int>& ring, int degree, bool robust, double floor,
-                               FitScratch& s) {
-  const kernels::Frame<double> frame = kernels::frame_of(kernels::vec3_of(n));
-  const double scale = jets::gather_points(V, i, frame, ring, s.points);
-  if (!(scale > 0.0) || !fit_points(degree, s.points, s)) return {};
+namespace {
+
+/// The rest of fit_local_surface after its least-squares fit (in s.batch, solved, over s.points
+/// in `frame`, scaled by `scale`): the residuals, the test for outliers and the robust refit.
+LocalSurface finish_fit(PositionsRef V, int i, const kernels::Frame<double>& frame, double scale,
+                        int degree, bool robust, double floor, FitScratch& s) {
   misfits(degree, s);
   s.keep.assign(s.points.size(), 1);
   const double scaled_floor = floor / scale;
@@ -228,6 +263,66 @@ LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
   s.misfit.swap(s.saved_misfit);
   s.keep.assign(s.points.size(), 1);
   return surface_of_fit(V, i, frame, scale, degree, s);
+}
+
+}  // namespace
+
+LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
+                               const std::vector<int>& ring, int degree, bool robust, double floor,
+                               FitScratch& s) {
+  const kernels::Frame<double> frame = kernels::frame_of(kernels::vec3_of(n));
+  const double scale = jets::gather_points(V, i, frame, ring, s.points);
+  if (!(scale > 0.0) || !fit_points(degree, s.points, s)) return {};
+  return finish_fit(V, i, frame, scale, degree, robust, floor, s);
+}
+
+LaneFits::LaneFits() : width(jets::batch_width(SimdIsa::best)) {}
+
+void LaneFits::queue(PositionsRef V, int i, const Eigen::Vector3d& n,
+                     const std::vector<int>& ring) {
+  const int l = queued++;
+  point[l] = i;
+  frame[l] = kernels::frame_of(kernels::vec3_of(n));
+  scale[l] = jets::gather_points(V, i, frame[l], ring, lane[l].points);
+}
+
+void LaneFits::run(PositionsRef V, int degree, bool robust, double floor, LocalSurface* out) {
+  jets::JetBatch& b = batch;
+  b.points_max = 0;
+  for (int l = 0; l < width; ++l) {
+    b.count[l] = l < queued && scale[l] > 0.0 ? static_cast<int>(lane[l].points.size()) : 0;
+    b.points_max = std::max(b.points_max, b.count[l]);
+  }
+  // Every lane's points padded with (0, 0, 0) to points_max (JetBatch::points).
+  const auto n = static_cast<std::size_t>(b.points_max);
+  if (zeros.size() < n) zeros.resize(n, jets::Point{0.0, 0.0, 0.0});
+  for (int l = 0; l < width; ++l) {
+    if (b.count[l] == 0) {
+      b.points[l] = zeros.data();
+    } else {
+      lane[l].points.resize(n, jets::Point{0.0, 0.0, 0.0});
+      b.points[l] = lane[l].points.data();
+    }
+  }
+  terms.resize(n * static_cast<std::size_t>(terms_stride(degree) * width));
+  b.terms = terms.data();
+  jets::top_degree_kernel(SimdIsa::best, degree)(b);
+  const int m = coefficient_count(degree), moments = coefficient_count(2 * degree);
+  for (int l = 0; l < queued; ++l) {
+    out[l] = {};
+    if (b.count[l] == 0 || !b.solved[l]) continue;
+    // Lane l as the scalar fit of its points would leave it (the same bits).
+    FitScratch& s = lane[l];
+    s.points.resize(static_cast<std::size_t>(b.count[l]));
+    jets::JetBatch& one = s.batch;
+    one.points[0] = s.points.data();
+    one.count[0] = one.points_max = b.count[l];
+    one.solved[0] = true;
+    for (int k = 0; k < moments; ++k) one.xy[k] = b.xy[k * width + l];
+    for (int k = 0; k < m; ++k) one.z[k] = b.z[k * width + l], one.c[k] = b.c[k * width + l];
+    out[l] = finish_fit(V, point[l], frame[l], scale[l], degree, robust, floor, s);
+  }
+  queued = 0;
 }
 
 }  // namespace focal::detail::smoothing

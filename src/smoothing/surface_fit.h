@@ -15,8 +15,10 @@ namespace focal::detail::smoothing {
 
 /// The surface fitted around one point.
 struct LocalSurface {
-  Eigen::Vector3d point{};       ///< the fitted graph's point over (0, 0): P + height * n
-  Eigen::Vector3d normal{};      ///< its unit normal there, on the frame normal's side
+  Eigen::Vector3d point =
+      Eigen::Vector3d::Zero();  ///< the fitted graph's point over (0, 0): P + height * n
+  Eigen::Vector3d normal =
+      Eigen::Vector3d::Zero();   ///< its unit normal there, on the frame normal's side
   double height = 0.0;           ///< signed offset from P to `point` along the frame normal
   double residual = 0.0;         ///< RMS height residual of the kept points (length units)
   int kept = 0;                  ///< points in the final fit
@@ -30,7 +32,7 @@ struct LocalSurface {
 struct FitScratch {
   jets::Points points, kept_points;
   std::vector<double> terms;
-  std::vector<double> misfit, saved_misfit, magnitude;
+  std::vector<double> misfit, saved_misfit;
   std::vector<char> keep;
   jets::JetBatch batch;
 };
@@ -62,5 +64,27 @@ int reject_far_points(const std::vector<double>& misfit, double floor, std::vect
 LocalSurface fit_local_surface(PositionsRef V, int i, const Eigen::Vector3d& n,
                                const std::vector<int>& ring, int degree, bool robust, double floor,
                                FitScratch& s);
+
+/// fit_local_surface at up to kMaxLanes points side by side, all of one degree: their
+/// least-squares fits in the lanes of the jets' kernel (each lane with the bits of the scalar
+/// fit), the rest point by point. Each result is fit_local_surface's, bit for bit.
+struct LaneFits {
+  LaneFits();
+  const int width;  ///< the kernel's lanes
+  int queued = 0;
+  /// Gathers point i's fit (fit_local_surface's arguments) into the next lane; queued < width.
+  void queue(PositionsRef V, int i, const Eigen::Vector3d& n, const std::vector<int>& ring);
+  /// The queued fits of `degree` into out[0 .. queued); empties the queue.
+  void run(PositionsRef V, int degree, bool robust, double floor, LocalSurface* out);
+
+ private:
+  FitScratch lane[jets::kMaxLanes];
+  kernels::Frame<double> frame[jets::kMaxLanes];
+  double scale[jets::kMaxLanes] = {};
+  int point[jets::kMaxLanes] = {};
+  jets::JetBatch batch;
+  std::vector<double> terms;
+  jets::Points zeros;
+};
 
 }  // namespace focal::detail::smoothing
