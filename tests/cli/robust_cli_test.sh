@@ -155,14 +155,20 @@ check "--k 0 is the default" cmp -s k0.csv kdefault.csv
 
 # ---- 7. Memory checked before large allocations --------------------------------------------------
 # An address-space limit stands for a small machine: the request is refused before anything is
-# allocated or written, with how much it needed.
-rc=0
-bash -c 'ulimit -v 3000000 && exec "$1" generate sphere --vertices 100000000 -o huge.ply' _ "$FOCAL" \
-  >"$OUT" 2>"$ERR" || rc=$?
-check "generate --vertices 100000000 on a 3 GB process: exit 2, how much it needed, nothing left" \
-  bash -c '[[ $1 -eq 2 && ! -e huge.ply ]] && grep -q "^Error: a surface of 100000000 vertices needs about 32 GB of memory, more than the .* this machine has available" "$2"' \
-  _ "$rc" "$ERR"
-check "  ... and no temporary file" no_temporaries
+# allocated or written, with how much it needed. AddressSanitizer reserves terabytes of shadow
+# address space at start, so a build with it cannot start under such a limit at all: there this
+# one check is left out (scripts/sanitize.sh), and `make test` runs it.
+if grep -q __asan_init "$FOCAL"; then
+  printf 'skip  generate under an address-space limit: not possible under AddressSanitizer\n'
+else
+  rc=0
+  bash -c 'ulimit -v 3000000 && exec "$1" generate sphere --vertices 100000000 -o huge.ply' _ "$FOCAL" \
+    >"$OUT" 2>"$ERR" || rc=$?
+  check "generate --vertices 100000000 on a 3 GB process: exit 2, how much it needed, nothing left" \
+    bash -c '[[ $1 -eq 2 && ! -e huge.ply ]] && grep -q "^Error: a surface of 100000000 vertices needs about 32 GB of memory, more than the .* this machine has available" "$2"' \
+    _ "$rc" "$ERR"
+  check "  ... and no temporary file" no_temporaries
+fi
 
 # A picture near the size limit: drawn (with fewer samples where the driver cannot hold 4), or
 # refused with what it needs, never 'framebuffer incomplete'. Skipped where focal has no render.
