@@ -24,6 +24,7 @@ int run(int argc, char** argv) {
   // is not a number) and a thread count clamped by a command's scope reported as a warning.
   focal::Execution settings;
   settings.warning = [&log](const std::string& message) { log.warning(message); };
+  settings.pass_progress = focal::cli::ProgressLine::report;
   const focal::ExecutionScope scope(settings);
   CLI::App app{
       "focal: principal curvatures, directions and focal meshes of triangle meshes\n"

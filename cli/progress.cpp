@@ -6,8 +6,6 @@
 #include <cstdio>
 #include <utility>
 
-#include "core/parallel.h"
-
 namespace focal::cli {
 namespace {
 
@@ -16,7 +14,19 @@ std::atomic<int> g_depth{0};
 constexpr auto kFirstDraw = std::chrono::seconds(1);
 constexpr auto kRedraw = std::chrono::milliseconds(250);
 
+/// The last pass the library reported (Execution::pass_progress, on the command's thread), read
+/// by the watchers (relaxed: only a display reads them).
+std::atomic<std::int64_t> g_pass_done{0};
+std::atomic<std::int64_t> g_pass_total{0};
+std::atomic<std::uint64_t> g_pass{0};
+
 }  // namespace
+
+void ProgressLine::report(const PassProgress& p) {
+  g_pass_total.store(p.total, std::memory_order_relaxed);
+  g_pass_done.store(p.done, std::memory_order_relaxed);
+  g_pass.store(p.pass, std::memory_order_relaxed);
+}
 
 bool ProgressLine::terminal() { return isatty(STDERR_FILENO) == 1; }
 
@@ -55,19 +65,20 @@ ProgressLine::~ProgressLine() {
 void ProgressLine::watch() {
   std::unique_lock lock(mutex_);
   auto next = start_ + kFirstDraw;
-  const std::uint64_t first_pass = detail::pass_progress().pass;
+  const std::uint64_t first_pass = g_pass.load(std::memory_order_relaxed);
   std::uint64_t pass = first_pass;
   auto pass_start = start_;
   while (!done_signal_.wait_until(lock, next, [this] { return done_; })) {
     next += kRedraw;
     if (g_depth.load() != depth_) continue;  // an inner stage draws its own line
     const auto now = std::chrono::steady_clock::now();
-    const detail::PassProgress p = detail::pass_progress();
+    const PassProgress p{g_pass_done.load(std::memory_order_relaxed),
+                         g_pass_total.load(std::memory_order_relaxed),
+                         g_pass.load(std::memory_order_relaxed)};
     if (p.pass != pass) pass = p.pass, pass_start = now;  // first seen now: a late start
     // Only a pass this stage started, and not finished, has a fraction of this stage's work.
-    const double fraction = p.pass != first_pass && p.total > 0 && p.done < p.total
-                                ? static_cast<double>(p.done) / static_cast<double>(p.total)
-                                : -1.0;
+    const double fraction =
+        p.pass != first_pass && p.total > 0 && p.done < p.total ? p.fraction() : -1.0;
     const std::string line =
         text(stage_, std::chrono::duration<double>(now - start_).count(), fraction,
              std::chrono::duration<double>(now - pass_start).count());

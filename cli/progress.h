@@ -2,14 +2,17 @@
 // The progress line of a long stage on a terminal: after a stage has run for a second, one line
 // on stderr, rewritten four times a second, with the stage, the seconds it has run, and, while a
 // parallel pass of the library runs, the fraction of it done and the time that pass has left
-// (core/parallel.h, pass_progress). Erased when the stage ends. Only when stderr is a terminal
-// (never on pipes or files) and neither --quiet nor -v (which prints its own lines) was given.
+// (Execution::pass_progress, which the command's outermost scope sends to report()). Erased when
+// the stage ends. Only when stderr is a terminal (never on pipes or files) and neither --quiet nor
+// -v (which prints its own lines) was given.
 
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <string>
 #include <thread>
+
+#include "focal/core/execution.h"
 
 namespace focal::cli {
 
@@ -21,6 +24,10 @@ class ProgressLine {
   ~ProgressLine();
   ProgressLine(const ProgressLine&) = delete;
   ProgressLine& operator=(const ProgressLine&) = delete;
+
+  /// Takes the library's latest report of a parallel pass (Execution::pass_progress), which the
+  /// line of the innermost stage shows.
+  static void report(const PassProgress& p);
 
   /// Whether stderr is a terminal (where the line may be drawn).
   [[nodiscard]] static bool terminal();

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <string>
 #include <thread>
@@ -187,6 +187,55 @@ TEST(ExecutionScope, ALoopsBodySeesTheScopeOfTheThreadThatStartedIt) {
     });
   });
   EXPECT_EQ(widest_slot.load(), 0);
+}
+
+// Execution::pass_progress: each outermost pass reported on the calling thread, from 0 chunks
+// done to all of them, never going back, on one thread as on several; a loop inside a loop's
+// body and a loop of up to 1024 elements are not passes.
+TEST(PassProgress, EachOutermostPassFromStartToEndOnTheCallingThread) {
+  for (const int threads : {1, 2, 3}) {
+    std::vector<PassProgress> reports;
+    const std::thread::id caller = std::this_thread::get_id();
+    bool elsewhere = false;
+    Execution e;
+    e.threads = threads;
+    e.pass_progress = [&](const PassProgress& p) {
+      reports.push_back(p);
+      elsewhere = elsewhere || std::this_thread::get_id() != caller;
+    };
+    const ExecutionScope scope(e);
+    std::atomic<std::int64_t> sum{0};
+    detail::parallel_for(1000, 0, [&](std::int64_t i) { sum += i; });
+    EXPECT_TRUE(reports.empty()) << "a loop of 1000 elements is no pass";
+    detail::parallel_for(200000, 0, [&](std::int64_t i) {
+      if (i % 50000 == 0) detail::parallel_for(5000, 0, [&](std::int64_t j) { sum += j; });
+    });
+    detail::parallel_for_blocks(300000, 4096, 0,
+                                [&](std::int64_t b, std::int64_t end) { sum += end - b; });
+    ASSERT_GE(reports.size(), 4U) << threads << " thread(s)";
+    EXPECT_FALSE(elsewhere);
+    // Two passes: parallel_for's (grain 781 of 200000: 257 chunks), then the blocks' (74).
+    const std::uint64_t first = reports.front().pass;
+    std::vector<std::uint64_t> passes;
+    for (std::size_t r = 0; r < reports.size(); ++r) {
+      const PassProgress& p = reports[r];
+      if (passes.empty() || passes.back() != p.pass) {
+        passes.push_back(p.pass);
+        EXPECT_EQ(p.done, 0);
+        if (r > 0) {
+          EXPECT_EQ(reports[r - 1].done, reports[r - 1].total);
+        }
+      } else {
+        EXPECT_GE(p.done, reports[r - 1].done);
+        EXPECT_EQ(p.total, reports[r - 1].total);
+      }
+      EXPECT_LE(p.done, p.total);
+    }
+    EXPECT_EQ(passes, (std::vector<std::uint64_t>{first, first + 1}));
+    EXPECT_EQ(reports.back().done, reports.back().total);
+    EXPECT_EQ(reports.back().total, (300000 + 4095) / 4096);
+    EXPECT_DOUBLE_EQ(reports.back().fraction(), 1.0);
+  }
 }
 
 TEST(ExecutionScope, TheSameBitsOnOneTwoAndThreeThreads) {

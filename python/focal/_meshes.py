@@ -23,6 +23,7 @@ from ._inputs import (
     _vector,
     _whole,
 )
+from ._progress import _progress
 from ._results import Curvature, FocalMesh, FocalMeshes, Mesh, MeshFindings, Surface
 
 
@@ -217,6 +218,7 @@ def curvature(
     outlier_ratio: float = 3.0,
     off_surface_ratio: float = 10.0,
     orient: str = "mst",
+    progress: Any = None,
 ) -> Curvature:
     """Per-vertex principal curvatures and directions, H and K of a mesh or, with ``F=None``, of
     a point cloud: what ``focal curvature`` computes (the same library call, focal::curvature in
@@ -253,6 +255,12 @@ def curvature(
     orient : point clouds only, as ``focal curvature``'s --k, --radius, --adaptive-radius,
         --cloud-normals, --viewpoint, --outlier-ratio, --off-surface-ratio, --orient; ``k=0``
         (with no radius) is the adaptive default of the command line (docs/POINTS.md).
+    progress : None (a tqdm bar on a terminal when tqdm is installed, else nothing), False
+        (nothing), or a callable ``progress(stage, pass_number, fraction)``, called on the
+        calling thread: ``(stage, 0, 0.0)`` when a stage begins, ``(stage, 0, 1.0)`` when it
+        ends, and ``(stage, k, f)`` as its k-th parallel pass advances (f of that pass done; a
+        stage runs one or more passes, how many depends on the input). An exception it raises
+        stops the call and is raised by it.
 
     Returns
     -------
@@ -295,6 +303,7 @@ def curvature(
     o = _estimate_options(estimator, threads, options)
     o["device"] = str(device)
     o["tile_vertices"] = _whole(tile_vertices, "tile_vertices", 0, 2**31 - 1)
+    o["progress"] = _progress(progress)
     if F is None:
         defaults = {**_PAPER_OPTIONS, **_COMMON_OPTIONS}
         given = [name for name in _MESH_ONLY if options[name] != defaults[name]]

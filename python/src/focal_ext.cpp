@@ -20,6 +20,7 @@
 
 #include "focal/core/error.h"
 #include "focal/core/execution.h"
+#include "focal/io/interrupted_writes.h"
 
 namespace nb = nanobind;
 
@@ -72,7 +73,6 @@ void translate_errors(const std::exception_ptr& p, void*) {
 
 }  // namespace
 
-
 NB_MODULE(_focal_ext, m) {
   m.doc() = "focal's C++ library (the focal package wraps it; use that).";
 
@@ -84,6 +84,10 @@ NB_MODULE(_focal_ext, m) {
           focal_error = base.inc_ref().ptr();
         });
   nb::register_exception_translator(&translate_errors);
+  // A process killed by SIGTERM or SIGHUP while focal writes a file leaves no temporary file
+  // (signals still at their default action only: Python's SIGINT handler, which raises
+  // KeyboardInterrupt once the call returns, and a handler of the program's are kept).
+  focal::remove_temporary_files_on_signals();
   // The one thread rule (focal/core/execution.h) for every threads= of the package.
   m.def("_resolve_threads", [](std::int64_t requested) {
     const focal::ThreadRequest r = focal::resolve_threads(requested);

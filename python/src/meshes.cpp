@@ -7,9 +7,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "bindings.h"
+#include "focal/core/error.h"
+#include "focal/core/execution.h"
 #include "focal/core/fields.h"
 #include "focal/curvature.h"
 #include "focal/curvature/estimate.h"
@@ -160,6 +165,61 @@ nb::dict cloud_plan_dict(const focal::CloudPlan& c) {
   return d;
 }
 
+/// focal.curvature's progress= callable (python/focal/_progress.py) behind the execution's
+/// progress and pass_progress: (stage, 0, 0.0) as a stage begins, (stage, 0, 1.0) as it ends,
+/// (stage, k, f) as its k-th parallel pass advances. Called on the calling thread, the GIL taken
+/// for each call. A Python exception it raises is kept and stops the call (Cancelled, from
+/// which rethrow() raises the kept exception again).
+class PythonProgress {
+ public:
+  explicit PythonProgress(nb::object callable) : callable_(std::move(callable)) {}
+
+  void attach(focal::Execution& e) {
+    if (callable_.is_none()) return;
+    e.progress = [this](const focal::Progress& p) {
+      const bool begins = p.fraction == 0.0;
+      if (begins) {
+        stages_.emplace_back(p.stage);
+        passes_.push_back(0);
+      }
+      call(std::string(p.stage), 0, p.fraction, begins);  // never throws as a stage ends
+      if (!begins && !stages_.empty()) stages_.pop_back(), passes_.pop_back();
+    };
+    e.pass_progress = [this](const focal::PassProgress& p) {
+      if (stages_.empty()) return;
+      if (p.pass != last_pass_) last_pass_ = p.pass, ++passes_.back();
+      call(stages_.back(), passes_.back(), p.fraction(), true);
+    };
+  }
+
+  /// After the call stopped by an exception (the GIL held): the callable's, when it raised one.
+  void rethrow() const {
+    if (failed_) throw nb::python_error();
+  }
+
+ private:
+  void call(const std::string& stage, int pass, double fraction, bool may_throw) {
+    if (failed_) {
+      if (may_throw) throw focal::Cancelled("cancelled: the progress callable raised");
+      return;
+    }
+    const nb::gil_scoped_acquire gil;
+    try {
+      callable_(stage, pass, fraction);
+    } catch (nb::python_error& error) {
+      error.restore();  // raised again by rethrow()
+      failed_ = true;
+      if (may_throw) throw focal::Cancelled("cancelled: the progress callable raised");
+    }
+  }
+
+  nb::object callable_;
+  std::vector<std::string> stages_;  ///< begun, innermost last
+  std::vector<int> passes_;          ///< passes seen of each
+  std::uint64_t last_pass_ = 0;
+  bool failed_ = false;
+};
+
 /// focal.curvature: the front door (focal::curvature) on the arrays, a cloud when F has no rows;
 /// its warnings collected for Python's warnings module.
 nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<DoubleRows>& N,
@@ -167,12 +227,18 @@ nb::dict curvature(const DoubleRows& V, const IntRows& F, const std::optional<Do
   focal::EstimateOptions o = estimate_options(options);
   std::vector<std::string> warnings;
   o.execution.warning = [&warnings](const std::string& w) { warnings.push_back(w); };
+  PythonProgress progress(options.contains("progress") ? nb::object(options["progress"])
+                                                       : nb::none());
+  progress.attach(o.execution);
   focal::Estimate e;
-  {
+  try {
     nb::gil_scoped_release release;
     const focal::ExecutionScope scope(o.execution);
     const focal::PreparedMesh mesh(view(V), view(F), normals_ref(N));
     e = focal::curvature(mesh, o);
+  } catch (...) {
+    progress.rethrow();
+    throw;
   }
   nb::dict d = curvature_dict(std::move(e.curvature));
   d["warnings"] = warnings;

@@ -14,6 +14,7 @@ import pytest
 import focal
 import focal._clouds
 import focal._meshes
+import focal._progress
 
 
 @pytest.fixture(scope="module")
@@ -188,3 +189,118 @@ def test_streamed_tiles_of_a_file_that_is_not_ply_say_so(sphere, tmp_path):
     focal.write_mesh(off, sphere.V, sphere.F)
     with pytest.raises(focal.InvalidInputError, match=r"s.off: streamed tiles .* read binary PLY"):
         focal.stream._open(off)
+
+
+@pytest.fixture(scope="module")
+def large_sphere():
+    # Over 1024 vertices: the library's loops run as parallel passes, whose progress is reported.
+    return focal.generate_surface("sphere", 20000)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_progress_callable_gets_stages_and_their_passes(large_sphere, threads):
+    calls = []
+    c = focal.curvature(large_sphere.V, large_sphere.F, estimator="paper", threads=threads,
+                        progress=lambda stage, k, f: calls.append((stage, k, f)))
+    plain = focal.curvature(large_sphere.V, large_sphere.F, estimator="paper", threads=threads)
+    np.testing.assert_array_equal(c.H, plain.H)  # reporting changes nothing
+    stages = [s for s, k, f in calls if k == 0 and f == 0.0]
+    assert stages and "curvature" in stages, calls
+    assert sorted(s for s, k, f in calls if k == 0 and f == 1.0) == sorted(stages)  # each ends
+    passes = [(s, k, f) for s, k, f in calls if k > 0]
+    assert passes, "no pass reported on %d thread(s)" % threads
+    assert all(0.0 <= f <= 1.0 for _, _, f in passes)
+    # Each pass starts at 0 and is reported done at 1; its fraction never goes back.
+    for stage in {s for s, _, _ in passes}:
+        for k in {k for s, k, _ in passes if s == stage}:
+            fractions = [f for s, kk, f in passes if s == stage and kk == k]
+            assert fractions[0] == 0.0 and fractions[-1] == 1.0, (stage, k, fractions)
+            assert fractions == sorted(fractions)
+
+
+def test_progress_callable_that_raises_stops_the_call(large_sphere):
+    def fail(stage, k, f):
+        if k > 0:
+            raise KeyError("stop here")
+
+    with pytest.raises(KeyError, match="stop here"):
+        focal.curvature(large_sphere.V, large_sphere.F, estimator="paper", progress=fail)
+
+
+def test_progress_must_be_a_callable(sphere):
+    with pytest.raises(focal.InvalidInputError, match="progress must be"):
+        focal.curvature(sphere.V, sphere.F, progress="yes")
+
+
+class _FakeTqdm:
+    made = []
+
+    def __init__(self, total, desc, **kwargs):
+        self.total, self.desc, self.kwargs, self.n, self.closed = total, desc, kwargs, 0, False
+        self.descriptions = [desc]
+        _FakeTqdm.made.append(self)
+
+    def reset(self, total):
+        self.n = 0
+
+    def set_description(self, desc, refresh=True):
+        self.descriptions.append(desc)
+
+    def update(self, n):
+        self.n += n
+
+    def close(self):
+        self.closed = True
+
+
+def test_a_tqdm_bar_on_a_terminal_when_tqdm_is_installed(large_sphere, monkeypatch):
+    import types
+
+    module = types.ModuleType("tqdm")
+    module.tqdm = _FakeTqdm
+    monkeypatch.setitem(sys.modules, "tqdm", module)
+    _FakeTqdm.made = []
+    monkeypatch.setattr(focal._progress, "_stderr_is_terminal", lambda: False)
+    focal.curvature(large_sphere.V, large_sphere.F, estimator="paper")
+    assert _FakeTqdm.made == []  # not on a pipe
+    focal.curvature(large_sphere.V, large_sphere.F, estimator="paper", progress=False)
+    monkeypatch.setattr(focal._progress, "_stderr_is_terminal", lambda: True)
+    focal.curvature(large_sphere.V, large_sphere.F, estimator="paper")
+    assert _FakeTqdm.made, "no bar on a terminal"
+    assert all(bar.closed for bar in _FakeTqdm.made)
+    assert all(bar.kwargs["delay"] == 1.0 for bar in _FakeTqdm.made)  # a second before drawing
+    bar = next(b for b in _FakeTqdm.made if b.desc == "curvature")
+    assert any(d.startswith("curvature, pass ") for d in bar.descriptions)
+    assert bar.n == 100  # its last pass done
+
+
+def test_a_process_killed_by_sigterm_while_writing_leaves_no_temporary(tmp_path):
+    import signal
+    import time
+
+    code = (
+        "import focal\n"
+        "s = focal.generate_surface('sphere', 2000000)\n"
+        "print('ready', flush=True)\n"
+        "while True:\n"
+        "    focal.write_mesh('big.obj', s.V, s.F, s.N)\n"
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "ready", p.stderr.read()
+        deadline = time.monotonic() + 120
+        seen = False
+        while time.monotonic() < deadline and not seen:
+            seen = any(n.startswith(".big.obj.tmp-") for n in os.listdir(tmp_path))
+            if not seen:
+                time.sleep(0.005)
+        assert seen, "the temporary file was never seen"
+        p.send_signal(signal.SIGTERM)
+        p.wait(60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == -signal.SIGTERM
+    assert [n for n in os.listdir(tmp_path) if ".tmp-" in n] == []

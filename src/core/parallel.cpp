@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <charconv>
+#include <chrono>
 #include <condition_variable>
 #include <cstdlib>
 #include <deque>
@@ -77,7 +78,7 @@ ExecutionScope::ExecutionScope(const Execution& execution)
     const ThreadRequest r = resolve_threads(execution.threads);
     execution_.threads = r.threads;
     if (!r.warning.empty()) {
-      const auto& warn = execution.warning ? execution.warning
+      const auto& warn = execution.warning       ? execution.warning
                          : enclosing_ != nullptr ? enclosing_->warning
                                                  : execution.warning;
       if (warn) warn(r.warning);
@@ -87,6 +88,7 @@ ExecutionScope::ExecutionScope(const Execution& execution)
     // Fields left at their defaults are the enclosing scope's.
     if (execution_.threads == 0) execution_.threads = enclosing_->threads;
     if (!execution_.progress) execution_.progress = enclosing_->progress;
+    if (!execution_.pass_progress) execution_.pass_progress = enclosing_->pass_progress;
     if (!execution_.warning) execution_.warning = enclosing_->warning;
     if (!execution_.info) execution_.info = enclosing_->info;
     if (execution_.cancel == nullptr) execution_.cancel = enclosing_->cancel;
@@ -107,6 +109,43 @@ namespace focal::detail {
 
 namespace {
 
+thread_local int t_depth = 0;  // > 0 while running chunks: a nested loop runs serially
+
+/// Reports the progress of an outermost pass of `total` chunks through the calling thread's
+/// Execution::pass_progress (nothing when it has none, or inside a loop's body): at the start,
+/// at most every kPeriod from the calling thread between its chunks, and at the end.
+class PassReporter {
+ public:
+  explicit PassReporter(std::int64_t total) : total_(total) {
+    if (t_depth == 0 && total > 1 && t_execution != nullptr && t_execution->pass_progress) {
+      callback_ = &t_execution->pass_progress;
+      static std::atomic<std::uint64_t> passes{0};
+      pass_ = passes.fetch_add(1, std::memory_order_relaxed) + 1;
+      last_ = std::chrono::steady_clock::now();
+      (*callback_)({0, total_, pass_});
+    }
+  }
+  [[nodiscard]] bool active() const { return callback_ != nullptr; }
+  /// After a chunk of the calling thread: `done` chunks of the pass done.
+  void advanced(std::int64_t done) {
+    if (callback_ == nullptr) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < kPeriod) return;
+    last_ = now;
+    (*callback_)({done, total_, pass_});
+  }
+  void finished() {
+    if (callback_ != nullptr) (*callback_)({total_, total_, pass_});
+  }
+
+ private:
+  static constexpr auto kPeriod = std::chrono::milliseconds(50);
+  const std::function<void(const PassProgress&)>* callback_ = nullptr;
+  std::int64_t total_;
+  std::uint64_t pass_ = 0;
+  std::chrono::steady_clock::time_point last_;
+};
+
 /// One parallel_chunks call, living on its caller's stack until every worker that joined it
 /// has left (Pool::run waits for that).
 struct Job {
@@ -116,21 +155,16 @@ struct Job {
   /// The caller's current Execution: current on each worker while it takes chunks, so that a
   /// loop's body sees the settings of the thread that started the loop.
   const Execution* execution = nullptr;
-  bool outermost = false;  ///< counted in pass_progress
+  PassReporter* reporter = nullptr;  ///< the caller's, told after each of its chunks
   std::atomic<std::int64_t> next{0};
-  int joined = 0;            ///< workers that joined; guarded by Pool::mutex
-  int inside = 0;            ///< workers still working on it; guarded by Pool::mutex
-  std::exception_ptr error;  ///< the first exception; guarded by error_mutex
+  std::atomic<std::int64_t> done{0};  ///< chunks finished, for the reporter
+  int joined = 0;                     ///< workers that joined; guarded by Pool::mutex
+  int inside = 0;                     ///< workers still working on it; guarded by Pool::mutex
+  std::exception_ptr error;           ///< the first exception; guarded by error_mutex
   std::mutex error_mutex;
 };
 
-thread_local int t_slot = 0;   // worker_slot()
-
-// pass_progress(): the outermost pass's chunk counts (relaxed: a display reads them).
-std::atomic<std::int64_t> g_pass_done{0};
-std::atomic<std::int64_t> g_pass_total{0};
-std::atomic<std::uint64_t> g_pass_count{0};
-thread_local int t_depth = 0;  // > 0 while running chunks: a nested loop runs serially
+thread_local int t_slot = 0;  // worker_slot()
 
 /// Takes chunks of `job` until none is left, as worker `slot` of it.
 void take_chunks(Job& job, int slot) {
@@ -140,7 +174,8 @@ void take_chunks(Job& job, int slot) {
   for (std::int64_t c; (c = job.next.fetch_add(1, std::memory_order_relaxed)) < job.chunks;) {
     try {
       (*job.chunk)(c);
-      if (job.outermost) g_pass_done.fetch_add(1, std::memory_order_relaxed);
+      const std::int64_t done = job.done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (slot == 0 && job.reporter != nullptr) job.reporter->advanced(done);
     } catch (...) {
       const std::scoped_lock lock(job.error_mutex);
       if (!job.error) job.error = std::current_exception();
@@ -232,26 +267,25 @@ int thread_count(int requested) {
 
 int worker_slot() { return t_slot; }
 
-PassProgress pass_progress() {
-  return {g_pass_done.load(std::memory_order_relaxed),
-          g_pass_total.load(std::memory_order_relaxed),
-          g_pass_count.load(std::memory_order_relaxed)};
-}
-
 void parallel_chunks(std::int64_t chunks, int threads,
                      const std::function<void(std::int64_t)>& chunk) {
   const int t = thread_count(threads);
   if (chunks <= 0) return;
+  PassReporter reporter(chunks);
   if (t <= 1 || chunks == 1 || t_depth > 0) {
     // Serial, also for a loop inside a loop's body: its thread is already one of the team.
     ++t_depth;
     try {
-      for (std::int64_t c = 0; c < chunks; ++c) chunk(c);
+      for (std::int64_t c = 0; c < chunks; ++c) {
+        chunk(c);
+        reporter.advanced(c + 1);
+      }
     } catch (...) {
       --t_depth;
       throw;
     }
     --t_depth;
+    reporter.finished();
     return;
   }
   Job job;
@@ -259,11 +293,9 @@ void parallel_chunks(std::int64_t chunks, int threads,
   job.chunk = &chunk;
   job.max_helpers = t - 1;
   job.execution = t_execution;
-  job.outermost = true;  // t_depth == 0 here: a nested loop ran serially above
-  g_pass_done.store(0, std::memory_order_relaxed);
-  g_pass_total.store(chunks, std::memory_order_relaxed);
-  g_pass_count.fetch_add(1, std::memory_order_relaxed);
+  if (reporter.active()) job.reporter = &reporter;
   Pool::instance().run(job);
+  reporter.finished();
 }
 
 }  // namespace focal::detail

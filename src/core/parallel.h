@@ -31,21 +31,10 @@ namespace focal::detail {
 /// CPUs this process may run on (its affinity mask), at least 1.
 int available_cpus();
 
-/// Threads to use: `requested` if > 0 (at most kMaxThreads), else the current ExecutionScope's threads if > 0
-/// (focal/core/execution.h), else FOCAL_NUM_THREADS if set, else available_cpus().
+/// Threads to use: `requested` if > 0 (at most kMaxThreads), else the current ExecutionScope's
+/// threads if > 0 (focal/core/execution.h), else FOCAL_NUM_THREADS if set, else available_cpus().
 /// At most this many threads work on one loop; fewer when the process-wide pool is busy.
 int thread_count(int requested);
-
-/// How far the outermost parallel pass (parallel_chunks, or parallel_for / _blocks over more
-/// than 1024 elements on more than one thread) started most recently in this process has come:
-/// chunks done of its total (0 of 0 before any). For a progress display only (a watcher thread
-/// may read it at any time); never for results.
-struct PassProgress {
-  std::int64_t done = 0;
-  std::int64_t total = 0;
-  std::uint64_t pass = 0;  ///< counts the passes started, so that a reader sees a new one
-};
-[[nodiscard]] PassProgress pass_progress();
 
 /// Index of the calling thread within the loop it is working on, in [0, thread_count(threads))
 /// of that loop (0 on the caller, and on any thread outside a loop). For per-thread scratch
@@ -54,7 +43,9 @@ int worker_slot();
 
 /// Runs chunk(c) for every c in [0, chunks) on up to `threads` threads (see thread_count):
 /// the calling thread and pool workers take chunks in turn until none is left; returns when
-/// all have run. An exception thrown by a chunk stops the taking of further chunks and is
+/// all have run. Outside every loop's body (the outermost pass) and with more than one chunk,
+/// its progress goes to the current Execution's pass_progress on the calling thread, on one
+/// thread too. An exception thrown by a chunk stops the taking of further chunks and is
 /// rethrown here (the first one, when several threads throw).
 void parallel_chunks(std::int64_t chunks, int threads,
                      const std::function<void(std::int64_t)>& chunk);
@@ -66,10 +57,11 @@ inline std::int64_t parallel_grain(std::int64_t n) {
 }
 
 /// Calls body(i) for i in [0, n) on `threads` threads (see thread_count), in chunks of
-/// parallel_grain(n) taken on demand. Serial below 1024 elements.
+/// parallel_grain(n) taken on demand (one after the other on one thread: the same chunks, whose
+/// progress is reported). A plain loop up to 1024 elements.
 template <class Body>
 void parallel_for(std::int64_t n, int threads, Body&& body) {
-  if (n <= 1024 || thread_count(threads) <= 1) {
+  if (n <= 1024) {
     for (std::int64_t i = 0; i < n; ++i) body(i);
     return;
   }
@@ -86,7 +78,7 @@ void parallel_for(std::int64_t n, int threads, Body&& body) {
 template <class Body>
 void parallel_for_blocks(std::int64_t n, std::int64_t block, int threads, Body&& body) {
   const std::int64_t blocks = (n + block - 1) / block;
-  if (n <= 1024 || thread_count(threads) <= 1) {
+  if (n <= 1024) {
     for (std::int64_t b = 0; b < blocks; ++b) body(b * block, std::min(n, (b + 1) * block));
     return;
   }

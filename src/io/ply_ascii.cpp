@@ -54,6 +54,20 @@ class AsciiBody {
     }
   }
 
+  /// After the last element: only blank lines may follow (more lines are a wrong count, or two
+  /// files in one; never silently dropped). \throw IoError naming the first such line.
+  void check_end(const PlyHeader& header) {
+    if (!next_line()) return;
+    std::string declared;
+    for (const PlyElement& e : header.elements) {
+      if (e.properties.empty()) continue;  // no text
+      declared += (declared.empty() ? "" : ", ") + std::to_string(e.count) + " " + e.name;
+    }
+    fail_at_line(path_, cursor_.line_number(),
+                 "data after the last element the header declares (" + declared + "): '" +
+                     std::string(tokens_[0]) + "'");
+  }
+
   /// Next line with tokens; false at the end of the text.
   bool next_line() {
     std::string_view line;
@@ -262,7 +276,8 @@ std::optional<Mesh> read_ascii_runs(const std::filesystem::path& path, const Ply
   const auto run = [&](std::size_t r) { return body.substr(cuts[r], cuts[r + 1] - cuts[r]); };
   const std::vector<std::int64_t> first =  // lines with tokens before each run
       io_detail::lines_before_runs(body, cuts, threads, io_detail::has_token);
-  if (static_cast<std::uint64_t>(first.back()) < layout.start.back()) return std::nullopt;
+  // Fewer element lines than declared, or more: the serial read reports where.
+  if (static_cast<std::uint64_t>(first.back()) != layout.start.back()) return std::nullopt;
 
   Mesh mesh;
   for (std::size_t j = 0; j < header.elements.size(); ++j) {
@@ -287,7 +302,9 @@ Mesh read_ascii_body(const std::filesystem::path& path, std::string_view data,
     return std::move(*mesh);
   }
   AsciiBody body(path, text, header.body_line);
-  return read_body(path, header, plan, body);
+  Mesh mesh = read_body(path, header, plan, body);
+  body.check_end(header);
+  return mesh;
 }
 
 }  // namespace focal::io_detail::ply

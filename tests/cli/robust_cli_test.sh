@@ -102,19 +102,39 @@ rm -f polygon.off polygon.csv
 # ---- 10. Progress on a terminal, nothing on pipes ---------------------------------------------------
 # `script` runs the command on a pseudo-terminal: stderr is a terminal there.
 # A run that has no stage over a second (a fast machine) has nothing to show: then skipped.
-if command -v script >/dev/null; then
+# on_terminal FILE ARGS...: focal ARGS on a pseudo-terminal, what it draws in FILE (carriage
+# returns as line ends, the erase codes dropped); $long is 1 when a progress line shows or the
+# run took over 4 s (a stage must have run over a second), else 0 ($elapsed_ms: its time).
+on_terminal() {
+  local file=$1 start
+  shift
   start=$(date +%s%N)
-  script -qec "'$FOCAL' curvature m.ply -o p.csv --paper" /dev/null | tr '\r' '\n' | sed 's/\x1b\[K//g' >tty.txt || true
+  script -qec "'$FOCAL' $*" /dev/null | tr '\r' '\n' | sed 's/\x1b\[K//g' >"$file" || true
   elapsed_ms=$((($(date +%s%N) - start) / 1000000))
-  if grep -qE ': [0-9]+ s' tty.txt || [[ $elapsed_ms -gt 4000 ]]; then
+  long=0
+  if grep -qE ': [0-9]+ s' "$file" || [[ $elapsed_ms -gt 4000 ]]; then long=1; fi
+}
+skip_short() { printf 'skip  %s: no stage ran over a second (%d ms in all)\n' "$1" "$elapsed_ms"; }
+if command -v script >/dev/null; then
+  on_terminal tty.txt curvature m.ply -o p.csv --paper
+  if [[ $long -eq 1 ]]; then
     check "a stage over a second on a terminal: a progress line with the stage and seconds" \
       grep -qE '^(read|check|curvature|write|normals): [0-9]+ s' tty.txt
     check "  ... the fraction of the running pass and the time it has left" \
       grep -qE '[0-9]+% of a pass, about [0-9]+ s left of it' tty.txt
   else
-    printf 'skip  progress line: no stage ran over a second (%d ms in all)\n' "$elapsed_ms"
+    skip_short "progress line"
   fi
-  script -qec "'$FOCAL' -q curvature m.ply -o pq.csv --paper" /dev/null | tr '\r' '\n' | sed 's/\x1b\[K//g' >tty-quiet.txt || true
+  # On one thread the passes run one chunk after the other: their fraction shows too.
+  on_terminal tty1.txt curvature m.ply -o p1.csv --paper --threads 1
+  if [[ $long -eq 1 ]]; then
+    check "--threads 1 on a terminal: the fraction of the running pass too" \
+      grep -qE '^[a-z ]+: [0-9]+ s, [0-9]+% of a pass' tty1.txt
+  else
+    skip_short "progress line on one thread"
+  fi
+  rm -f p1.csv
+  on_terminal tty-quiet.txt -q curvature m.ply -o pq.csv --paper
   check "--quiet: no progress line" bash -c '! grep -qE ": [0-9]+ s" tty-quiet.txt && cmp -s p.csv pq.csv'
 fi
 run curvature m.ply -o pipe.csv --paper
@@ -200,6 +220,12 @@ printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n' >junk.off
 expect_error "OFF with an element line after the declared ones: an error naming it" 2 \
   "line 7: data after the last of the 3 vertices and 1 faces the header declares: '3'" \
   junk.csv curvature junk.off -o junk.csv
+{ printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n'
+  printf 'property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+  printf '0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n3 0 2 1\n'; } >junk.ply
+expect_error "ascii PLY with a line after the declared elements: an error naming it" 2 \
+  "line 15: data after the last element the header declares (3 vertex, 1 face): '3'" \
+  junkply.csv curvature junk.ply -o junkply.csv
 { printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n'
   printf 'property float z\nend_header\n'; head -c 36 /dev/zero; printf 'junk after the data'; } >tail.ply
 run info tail.ply

@@ -20,6 +20,19 @@ struct Progress {
   double fraction = 0.0;   ///< 0 at the start of the stage, 1 at its end
 };
 
+/// How far one parallel pass of a stage has come. A stage runs one or more passes over its
+/// vertices, faces or points (how many depends on the input and the options), so this is the
+/// fraction of the pass running now, not of the stage: a display shows it as such.
+struct PassProgress {
+  std::int64_t done = 0;   ///< chunks of the pass done (each a fixed share of its elements)
+  std::int64_t total = 0;  ///< chunks of the pass, > 1
+  std::uint64_t pass = 0;  ///< counts the passes started in this process (from 1): a new value
+                           ///< is a new pass
+  [[nodiscard]] double fraction() const {
+    return total > 0 ? static_cast<double>(done) / static_cast<double>(total) : 0.0;
+  }
+};
+
 /// The most threads focal runs one loop on. A larger count (Execution::threads, --threads,
 /// FOCAL_NUM_THREADS, Python's threads=) is clamped to it with a warning: the worker pool has
 /// one thread per CPU anyway (docs/PERFORMANCE.md, "Threads"), and every thread counted costs
@@ -46,6 +59,11 @@ struct Execution {
   int threads = 0;
   /// Called on the calling thread as each stage begins and ends (none: nothing is reported).
   std::function<void(const Progress&)> progress{};
+  /// Called on the calling thread as a parallel pass advances (the outermost loops of more than
+  /// 1024 elements, on any thread count): when it starts (done 0), at most every 50 ms while it
+  /// runs, and when it has finished (done == total). The pass belongs to the innermost stage
+  /// that `progress` has begun. An exception thrown here stops the call, as a chunk's would.
+  std::function<void(const PassProgress&)> pass_progress{};
   /// Called on the calling thread with each warning about the input or a choice made on it (a
   /// sentence without the file's name, which a caller that knows it puts before it).
   std::function<void(const std::string&)> warning{};

@@ -12,7 +12,9 @@ namespace focal {
 /// writes in progress, then end the process by the same signal (the default action re-raised,
 /// so that the exit status says which signal ended it). A signal whose disposition is not the
 /// default (ignored, or a handler of the caller's, such as Python's SIGINT) is left alone.
-/// Call once, early, from a program's main thread (the focal command does); safe to call again.
+/// Call once, early, from a program's main thread (the focal command does, and importing the
+/// Python module focal does: there SIGTERM and SIGHUP, SIGINT being Python's); safe to call
+/// again.
 /// The handler is async-signal-safe: it only reads a fixed table of paths and calls unlink().
 void remove_temporary_files_on_signals();
 
