@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "core/parallel.h"
 #include "focal/core/error.h"
 #include "focal/curvature.h"
+#include "focal/io/mesh_io.h"
 #include "test_clouds.h"
 #include "test_identical.h"
 #include "test_meshes.h"
@@ -236,6 +238,41 @@ TEST(PassProgress, EachOutermostPassFromStartToEndOnTheCallingThread) {
     EXPECT_EQ(reports.back().total, (300000 + 4095) / 4096);
     EXPECT_DOUBLE_EQ(reports.back().fraction(), 1.0);
   }
+}
+
+// A ReportedPass makes the loops inside it one pass: a text writer's batches (32768 lines each)
+// show as one pass over all the lines, not as a pass per batch that starts at 0 again.
+TEST(PassProgress, AReportedPassMakesTheLoopsInsideItOnePass) {
+  std::vector<PassProgress> reports;
+  Execution e;
+  e.threads = 2;
+  e.pass_progress = [&](const PassProgress& p) { reports.push_back(p); };
+  const ExecutionScope scope(e);
+  {
+    detail::ReportedPass pass(3);
+    for (std::int64_t k = 0; k < 3; ++k) {
+      detail::parallel_for(100000, 0, [](std::int64_t) {});
+      pass.advance(k + 1);
+    }
+    pass.finish();
+  }
+  Mesh cloud;
+  cloud.V = Eigen::MatrixXd::Random(100000, 3);
+  const auto path =
+      std::filesystem::temp_directory_path() /
+      ("focal_pass_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+       std::to_string(reinterpret_cast<std::uintptr_t>(&reports)) + ".xyz");
+  write_xyz(path, cloud);
+  std::filesystem::remove(path);
+  ASSERT_GE(reports.size(), 4U);
+  std::vector<std::uint64_t> passes;
+  for (const PassProgress& p : reports) {
+    if (passes.empty() || passes.back() != p.pass) passes.push_back(p.pass);
+  }
+  ASSERT_EQ(passes.size(), 2U) << "the three loops, then the writer's four batches";
+  EXPECT_EQ(reports.front().total, 3);
+  EXPECT_EQ(reports.back().total, 100000);
+  EXPECT_EQ(reports.back().done, 100000);
 }
 
 TEST(ExecutionScope, TheSameBitsOnOneTwoAndThreeThreads) {

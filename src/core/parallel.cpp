@@ -111,40 +111,7 @@ namespace {
 
 thread_local int t_depth = 0;  // > 0 while running chunks: a nested loop runs serially
 
-/// Reports the progress of an outermost pass of `total` chunks through the calling thread's
-/// Execution::pass_progress (nothing when it has none, or inside a loop's body): at the start,
-/// at most every kPeriod from the calling thread between its chunks, and at the end.
-class PassReporter {
- public:
-  explicit PassReporter(std::int64_t total) : total_(total) {
-    if (t_depth == 0 && total > 1 && t_execution != nullptr && t_execution->pass_progress) {
-      callback_ = &t_execution->pass_progress;
-      static std::atomic<std::uint64_t> passes{0};
-      pass_ = passes.fetch_add(1, std::memory_order_relaxed) + 1;
-      last_ = std::chrono::steady_clock::now();
-      (*callback_)({0, total_, pass_});
-    }
-  }
-  [[nodiscard]] bool active() const { return callback_ != nullptr; }
-  /// After a chunk of the calling thread: `done` chunks of the pass done.
-  void advanced(std::int64_t done) {
-    if (callback_ == nullptr) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_ < kPeriod) return;
-    last_ = now;
-    (*callback_)({done, total_, pass_});
-  }
-  void finished() {
-    if (callback_ != nullptr) (*callback_)({total_, total_, pass_});
-  }
-
- private:
-  static constexpr auto kPeriod = std::chrono::milliseconds(50);
-  const std::function<void(const PassProgress&)>* callback_ = nullptr;
-  std::int64_t total_;
-  std::uint64_t pass_ = 0;
-  std::chrono::steady_clock::time_point last_;
-};
+thread_local int t_reported_passes = 0;  // ReportedPass objects alive on this thread
 
 /// One parallel_chunks call, living on its caller's stack until every worker that joined it
 /// has left (Pool::run waits for that).
@@ -155,7 +122,7 @@ struct Job {
   /// The caller's current Execution: current on each worker while it takes chunks, so that a
   /// loop's body sees the settings of the thread that started the loop.
   const Execution* execution = nullptr;
-  PassReporter* reporter = nullptr;  ///< the caller's, told after each of its chunks
+  ReportedPass* reporter = nullptr;  ///< the caller's, told after each of its chunks
   std::atomic<std::int64_t> next{0};
   std::atomic<std::int64_t> done{0};  ///< chunks finished, for the reporter
   int joined = 0;                     ///< workers that joined; guarded by Pool::mutex
@@ -175,7 +142,7 @@ void take_chunks(Job& job, int slot) {
     try {
       (*job.chunk)(c);
       const std::int64_t done = job.done.fetch_add(1, std::memory_order_relaxed) + 1;
-      if (slot == 0 && job.reporter != nullptr) job.reporter->advanced(done);
+      if (slot == 0 && job.reporter != nullptr) job.reporter->advance(done);
     } catch (...) {
       const std::scoped_lock lock(job.error_mutex);
       if (!job.error) job.error = std::current_exception();
@@ -271,21 +238,21 @@ void parallel_chunks(std::int64_t chunks, int threads,
                      const std::function<void(std::int64_t)>& chunk) {
   const int t = thread_count(threads);
   if (chunks <= 0) return;
-  PassReporter reporter(chunks);
+  ReportedPass reporter(chunks);
   if (t <= 1 || chunks == 1 || t_depth > 0) {
     // Serial, also for a loop inside a loop's body: its thread is already one of the team.
     ++t_depth;
     try {
       for (std::int64_t c = 0; c < chunks; ++c) {
         chunk(c);
-        reporter.advanced(c + 1);
+        reporter.advance(c + 1);
       }
     } catch (...) {
       --t_depth;
       throw;
     }
     --t_depth;
-    reporter.finished();
+    reporter.finish();
     return;
   }
   Job job;
@@ -295,7 +262,35 @@ void parallel_chunks(std::int64_t chunks, int threads,
   job.execution = t_execution;
   if (reporter.active()) job.reporter = &reporter;
   Pool::instance().run(job);
-  reporter.finished();
+  reporter.finish();
+}
+
+ReportedPass::ReportedPass(std::int64_t total) : total_(total) {
+  // Only the outermost: a loop inside a loop's body, or inside another reported pass, is a part
+  // of that pass, not a pass of its own.
+  if (t_depth == 0 && t_reported_passes == 0 && total > 1 && t_execution != nullptr &&
+      t_execution->pass_progress) {
+    callback_ = &t_execution->pass_progress;
+    static std::atomic<std::uint64_t> passes{0};
+    pass_ = passes.fetch_add(1, std::memory_order_relaxed) + 1;
+    last_ = std::chrono::steady_clock::now();
+    (*callback_)({0, total_, pass_});
+  }
+  ++t_reported_passes;
+}
+
+ReportedPass::~ReportedPass() { --t_reported_passes; }
+
+void ReportedPass::finish() {
+  if (callback_ != nullptr) (*callback_)({total_, total_, pass_});
+}
+
+void ReportedPass::advance(std::int64_t done) {
+  if (callback_ == nullptr) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_ < kPeriod) return;
+  last_ = now;
+  (*callback_)({done, total_, pass_});
 }
 
 }  // namespace focal::detail

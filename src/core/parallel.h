@@ -19,6 +19,7 @@
 // - a loop started inside a loop's body runs on the calling thread (no nested teams).
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -26,7 +27,39 @@
 #include <sys/mman.h>
 #endif
 
+namespace focal {
+struct PassProgress;
+}
+
 namespace focal::detail {
+
+/// One pass of `total` steps reported through the calling thread's Execution::pass_progress (when
+/// it has one): at the start, at most every 50 ms after that (advance), and at the end
+/// (finish; not from the destructor, since the callback may throw Cancelled). parallel_chunks makes
+/// each outermost loop one; work that runs as a sequence of short loops (a writer's batches) makes
+/// one around them, so that it shows as one pass and not as many that a display sampling a few
+/// times a second would see only at their start. Loops run inside a loop's body or while a
+/// ReportedPass is alive on the thread are no pass of their own. Only for the calling thread: it
+/// lives on its stack.
+class ReportedPass {
+ public:
+  explicit ReportedPass(std::int64_t total);
+  ~ReportedPass();
+  ReportedPass(const ReportedPass&) = delete;
+  ReportedPass& operator=(const ReportedPass&) = delete;
+  [[nodiscard]] bool active() const { return callback_ != nullptr; }
+  /// `done` of the pass's `total` steps are done.
+  void advance(std::int64_t done);
+  /// All `total` steps are done.
+  void finish();
+
+ private:
+  static constexpr auto kPeriod = std::chrono::milliseconds(50);
+  const std::function<void(const PassProgress&)>* callback_ = nullptr;
+  std::int64_t total_;
+  std::uint64_t pass_ = 0;
+  std::chrono::steady_clock::time_point last_;
+};
 
 /// CPUs this process may run on (its affinity mask), at least 1.
 int available_cpus();

@@ -178,6 +178,7 @@ void write_lines(OutputSink& sink, std::int64_t count, int threads,
   constexpr std::int64_t kBlock = 2048;
   constexpr std::int64_t kBlocksPerBatch = 16;
   std::vector<std::string> texts(static_cast<std::size_t>(kBlocksPerBatch));
+  detail::ReportedPass pass(count);  // the batches are one pass of the progress display
   for (std::int64_t first = 0; first < count; first += kBlock * kBlocksPerBatch) {
     const std::int64_t n = std::min<std::int64_t>(kBlock * kBlocksPerBatch, count - first);
     detail::parallel_for_blocks(n, kBlock, threads, [&](std::int64_t begin, std::int64_t end) {
@@ -192,7 +193,9 @@ void write_lines(OutputSink& sink, std::int64_t count, int threads,
       const std::string& text = texts[static_cast<std::size_t>(b)];
       sink.write(text.data(), text.size());
     }
+    pass.advance(first + n);
   }
+  pass.finish();
 }
 
 }  // namespace io_detail

@@ -7,6 +7,7 @@
 #include <memory>
 #include <system_error>
 
+#include "core/memory.h"
 #include "focal/core/error.h"
 
 namespace focal::io_detail {
@@ -93,6 +94,17 @@ void check_records_fit(const std::filesystem::path& path, std::string_view where
                        std::uint64_t count, std::uint64_t record_bytes, std::uint64_t available,
                        std::string_view what) {
   check_elements_fit(path, where, count, record_bytes, available, 0, what);
+}
+
+void require_memory_for(const std::filesystem::path& path, std::uint64_t count,
+                        std::uint64_t bytes_each, std::string_view what) {
+  const std::uint64_t available = detail::available_memory();
+  // count < 2^31 (the checks above) and bytes_each is a few hundred at most: no overflow.
+  const std::uint64_t needed = count * bytes_each;
+  if (available == 0 || needed <= available) return;
+  fail(path, "reading " + std::to_string(count) + " " + std::string(what) + " needs about " +
+                 detail::memory_text(needed) + " of memory, more than the " +
+                 detail::memory_text(available) + " this machine has available");
 }
 
 std::string quoted(std::string_view text) {

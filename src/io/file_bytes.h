@@ -54,6 +54,21 @@ void check_records_fit(const std::filesystem::path& path, std::string_view where
                        std::uint64_t count, std::uint64_t record_bytes, std::uint64_t available,
                        std::string_view what);
 
+/// Bytes a vertex takes in a Mesh (its row of V), its normal (a row of N) and a triangle (a row
+/// of F and its face_source), for require_memory_for.
+inline constexpr std::uint64_t kVertexBytes = 3 * sizeof(double);
+inline constexpr std::uint64_t kNormalBytes = 3 * sizeof(double);
+inline constexpr std::uint64_t kTriangleBytes = 3 * sizeof(std::int32_t) + sizeof(int);
+
+/// Throws IoError "<path>: reading <count> <what> needs about <bytes> of memory, more than the
+/// <available> this machine has available" when `count` elements taking `bytes_each` bytes once
+/// read (the arrays a reader fills for them) exceed detail::available_memory(). Called before a
+/// reader allocates for a declared count, after check_count_fits / check_records_fit, so that a
+/// file that is merely larger than the machine's memory fails with what it needs instead of an
+/// allocation failure (or the OOM killer) deep in the read.
+void require_memory_for(const std::filesystem::path& path, std::uint64_t count,
+                        std::uint64_t bytes_each, std::string_view what);
+
 /// `'text'`, for messages. (Also avoids "'" + std::string temporaries, on which GCC 12 gives a
 /// false -Wrestrict warning.)
 [[nodiscard]] std::string quoted(std::string_view text);

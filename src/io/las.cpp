@@ -96,6 +96,7 @@ LasHeader parse_header(const std::filesystem::path& path, std::string_view data)
   }
   io_detail::check_records_fit(path, "byte offset " + std::to_string(h.offset), h.points, h.record,
                                data.size() - h.offset, "points");
+  io_detail::require_memory_for(path, h.points, io_detail::kVertexBytes, "points");
   return h;
 }
 

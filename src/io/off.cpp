@@ -59,6 +59,10 @@ class OffReader {
     const std::string where = "line " + std::to_string(cursor_.line_number() + 1);
     io_detail::check_count_fits(path_, where, vertex_count, 2, rest, "vertices");
     io_detail::check_count_fits(path_, where, face_count, 2, rest, "faces");
+    const std::uint64_t normal_bytes = layout.normals ? io_detail::kNormalBytes : 0;
+    io_detail::require_memory_for(path_, vertex_count, io_detail::kVertexBytes + normal_bytes,
+                                  "vertices");
+    io_detail::require_memory_for(path_, face_count, io_detail::kTriangleBytes, "faces");
     return {layout, static_cast<std::int64_t>(vertex_count), static_cast<std::int64_t>(face_count)};
   }
 

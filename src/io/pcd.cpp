@@ -309,6 +309,9 @@ class PcdReader {
 
   /// Called once the body is known to hold the points (so the count is bounded by its bytes).
   void reserve_points() {
+    const std::uint64_t normal_bytes = roles_.normal ? io_detail::kNormalBytes : 0;
+    io_detail::require_memory_for(path_, header_.points, io_detail::kVertexBytes + normal_bytes,
+                                  "points");
     positions_.reserve(3 * header_.points);
     if (roles_.normal) normals_.reserve(3 * header_.points);
   }

@@ -282,7 +282,10 @@ std::optional<Mesh> read_ascii_runs(const std::filesystem::path& path, const Ply
   Mesh mesh;
   for (std::size_t j = 0; j < header.elements.size(); ++j) {
     if (plan.element_roles[j] == ElementRole::vertices) {
-      allocate_vertices(mesh, header.elements[j], plan.has_normals);
+      allocate_vertices(path, mesh, header.elements[j], plan.has_normals);
+    } else if (plan.element_roles[j] == ElementRole::faces) {
+      io_detail::require_memory_for(path, header.elements[j].count, io_detail::kTriangleBytes,
+                                    "faces");
     }
   }
   const bool read = io_detail::read_runs_joined(

@@ -84,8 +84,7 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view data)
       }
       // 1.0 is the only PLY version there is; another is not a file this reader understands.
       if (tokens[2] != "1.0" && tokens[2] != "1") {
-        fail_at_line(path, n,
-                     "PLY version '" + std::string(tokens[2]) + "': only 1.0 is known");
+        fail_at_line(path, n, "PLY version '" + std::string(tokens[2]) + "': only 1.0 is known");
       }
       have_format = true;
     } else if (key == "element") {
@@ -200,7 +199,10 @@ BodyPlan plan_body(const std::filesystem::path& path, const PlyHeader& header) {
   return plan;
 }
 
-void allocate_vertices(Mesh& mesh, const PlyElement& e, bool normals) {
+void allocate_vertices(const std::filesystem::path& path, Mesh& mesh, const PlyElement& e,
+                       bool normals) {
+  io_detail::require_memory_for(
+      path, e.count, io_detail::kVertexBytes + (normals ? io_detail::kNormalBytes : 0), "vertices");
   mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
   detail::advise_huge_pages(mesh.V.data(), sizeof(double) * mesh.V.size());
   if (normals) {

@@ -19,6 +19,7 @@
 
 #include "focal/core/mesh.h"
 #include "io/bytes.h"
+#include "io/file_bytes.h"
 #include "io/format_readers.h"
 #include "io/ply.h"
 #include "io/text_scan.h"
@@ -147,7 +148,9 @@ struct BodyPlan {
 BodyPlan plan_body(const std::filesystem::path& path, const PlyHeader& header);
 
 /// mesh.V (and mesh.N) for the vertex element, advised onto huge pages before they are written.
-void allocate_vertices(Mesh& mesh, const PlyElement& e, bool normals);
+/// \throw IoError when the machine cannot hold them (io_detail::require_memory_for).
+void allocate_vertices(const std::filesystem::path& path, Mesh& mesh, const PlyElement& e,
+                       bool normals);
 
 /// How the face lists of an element of `role` are read.
 FaceLists face_lists(ElementRole role, const BodyPlan& plan);
@@ -166,9 +169,12 @@ Mesh read_body(const std::filesystem::path& path, const PlyHeader& header, const
     const ElementRole role = plan.element_roles[j];
     body.check_fits(e);
     if (role == ElementRole::vertices) {
-      allocate_vertices(mesh, e, plan.has_normals);
+      allocate_vertices(path, mesh, e, plan.has_normals);
       body.read_vertices(e, plan.roles, mesh.V.data(), plan.has_normals ? mesh.N.data() : nullptr);
     } else if (role == ElementRole::faces || role == ElementRole::strips) {
+      if (role == ElementRole::faces) {
+        io_detail::require_memory_for(path, e.count, io_detail::kTriangleBytes, "faces");
+      }
       const std::size_t list_prop = face_list_property(path, e);
       if constexpr (std::is_same_v<Body, BinaryBody>) {
         if (role == ElementRole::faces && !plan.has_strips) {

@@ -103,6 +103,8 @@ Mesh read_binary(const std::filesystem::path& path, std::string_view data, int t
   if (3 * count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
     fail(path, "too many facets for 32-bit vertex indices");
   }
+  io_detail::require_memory_for(path, count,
+                                3 * io_detail::kVertexBytes + io_detail::kTriangleBytes, "facets");
   Mesh mesh;
   const auto facets = static_cast<Eigen::Index>(count);
   mesh.V.resize(3 * facets, 3);
@@ -362,10 +364,11 @@ Mesh parse_stl(const std::filesystem::path& path, std::string_view data, int thr
     // Text with `solid` after something other than blanks and # comments: an ascii STL with a
     // line before it, not the binary file whose size error would otherwise be reported.
     const std::string_view first = skip_leading_comments(data);
-    fail(path, "an ascii STL must start with 'solid' (blank and # comment lines may "
-               "come before it), but it starts with '" +
-                   std::string(first.substr(0, std::min(first.find('\n'), std::size_t{40}))) +
-                   "'; not a binary STL either (its size does not match its facet count)");
+    fail(path,
+         "an ascii STL must start with 'solid' (blank and # comment lines may "
+         "come before it), but it starts with '" +
+             std::string(first.substr(0, std::min(first.find('\n'), std::size_t{40}))) +
+             "'; not a binary STL either (its size does not match its facet count)");
   }
   return read_binary(path, data, threads);  // reports the size mismatch
 }

@@ -188,6 +188,15 @@ else
     bash -c '[[ $1 -eq 2 && ! -e huge.ply ]] && grep -q "^Error: a surface of 100000000 vertices needs about 32 GB of memory, more than the .* this machine has available" "$2"' \
     _ "$rc" "$ERR"
   check "  ... and no temporary file" no_temporaries
+  # A file whose declared vertices fit its bytes but not the memory left: 40M ascii vertices
+  # (240 MB of text) need 960 MB as doubles, more than a 900 MB process has once the file is read.
+  { printf 'OFF\n40000000 0 0\n'; yes '0 0 0' | head -n 40000000; } >big.off
+  rc=0
+  bash -c 'ulimit -v 900000 && exec "$1" info big.off' _ "$FOCAL" >"$OUT" 2>"$ERR" || rc=$?
+  check "reading 40M declared vertices on a 900 MB process: an error that says what they need" \
+    bash -c '[[ $1 -ne 0 ]] && grep -q "^Error: big.off: reading 40000000 vertices needs about 960 MB of memory, more than the .* this machine has available" "$2"' \
+    _ "$rc" "$ERR"
+  rm -f big.off
 fi
 
 # A picture near the size limit: drawn (with fewer samples where the driver cannot hold 4), or
