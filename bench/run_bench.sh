@@ -29,6 +29,13 @@ torus() {
   echo "$path"
 }
 
+# The same torus without normals (issue 36's targets hold there too).
+torus_without_normals() {
+  local n=$1 path=$data/torus-$1-no-normals.ply
+  [[ -f $path ]] || "$focal" generate torus --vertices "$n" --no-normals -o "$path" >&2
+  echo "$path"
+}
+
 bunny() {
   local level=$1 path=$data/bunny-sub$1.ply
   if [[ ! -f $path ]]; then
@@ -54,7 +61,7 @@ run_once() {
          for (i = 1; i <= n; i++) s = s * 60 + t[i]; print s}' "$scratch/time")
   rss=$(awk -F': ' '/Maximum resident set size/ {print $2}' "$scratch/time")
   # The final "  name: 123.4 ms" line of a stage, not its "running for" progress lines.
-  stage() { awk -v s="$1:" '$1 == s && $NF == "ms" {t = $2} END {print t + 0}' "$scratch/log"; }
+  stage() { awk -v s="$1:" '$(NF - 2) == s && $NF == "ms" {t = $2} END {print t + 0}' "$scratch/log"; }
   echo "$wall $rss $(stage read) $(stage check) $(stage normals) $(stage curvature) $(stage write)"
 }
 
@@ -77,6 +84,15 @@ report() {
       rate = w > 0 ? sprintf("%5.2f", n / w / 1e6) : "    -"
       printf "| %-10s | %9d | %d | %6.2f | %s | %6.0f | %5.0f | %5.0f | %5.0f | %5.0f | %5.0f |\n",
              name, n, t, w, rate, rss / 1024, a, k, b, c, d }'
+  best_wall=$wall  # for the ratio lines below
+}
+
+# One line of the targets table: "| name | a / b | target |", nothing when a value is missing.
+ratio_line() {
+  local name=$1 a=$2 b=$3 target=$4
+  [[ -n $a && -n $b ]] || return 0
+  awk -v name="$name" -v a="$a" -v b="$b" -v target="$target" \
+    'BEGIN { printf "| %s | %.2f | %s |\n", name, a / b, target }'
 }
 
 echo "Whole runs: focal -v curvature IN -o OUT.ply --threads T --paper (the paper's closed-form"
@@ -104,13 +120,35 @@ echo "The default (recommended estimator): focal -v curvature IN -o OUT.ply --th
 echo
 echo "| mesh       |  vertices | T | wall s | M v/s | RSS MB |  read | check | normals | curvature | write |"
 echo "|------------|----------:|--:|-------:|------:|-------:|------:|------:|------:|------:|------:|"
-for n in 100000 1000000; do
+default_1m="" default_10m="" cloud_default="" cloud_k16=""
+for n in 100000 1000000 10000000; do
   ((n <= max)) || continue
   mesh=$(torus "$n")
-  for t in 1 2; do report "torus" "$mesh" "$t" ""; done
+  # 10M on 2 threads only: it is there for the ratio to 1M (issue 36: <= 12x).
+  if ((n > 1000000)); then threads_list=2; else threads_list="1 2"; fi
+  for t in $threads_list; do report "torus" "$mesh" "$t" ""; done
+  ((n == 1000000)) && default_1m=$best_wall
+  ((n == 10000000)) && default_10m=$best_wall
 done
 mesh=$(bunny 0)
 for t in 1 2; do report "bunny/0" "$mesh" "$t" ""; done
+# A 1M-point cloud with normals (no faces): the default against --k 16 (the nearest-neighbour fit).
+if ((max >= 1000000)); then
+  cloud=$data/cloud-1000000.ply
+  [[ -f $cloud ]] || "$focal" generate torus --cloud --vertices 1000000 -o "$cloud" >&2
+  report "cloud" "$cloud" 2 ""
+  cloud_default=$best_wall
+  report "cloud k16" "$cloud" 2 "--k 16"
+  cloud_k16=$best_wall
+fi
+echo
+echo "Targets of issue 36 from the tables above (2 threads, fastest of $reps); the ratios to"
+echo "trueform follow with the peers (bench/peers/targets.py)."
+echo
+echo "| ratio of whole runs | value | target |"
+echo "|---|---:|---|"
+ratio_line "default, torus 10M / 1M" "$default_10m" "$default_1m" "<= 12"
+ratio_line "cloud 1M with normals: default / --k 16" "$cloud_default" "$cloud_k16" "<= 2"
 
 # Readers: the read stage of `focal -v info FILE` (parse, and for STL the weld) on the 1M torus in
 # every format, 1 and 2 threads (FOCAL_NUM_THREADS), fastest of $reps; OBJ and OFF from `focal
@@ -184,6 +222,13 @@ if [[ -x $peers/.venv/bin/python ]]; then
       --runs "${FOCAL_BENCH_PEER_REPS:-3}" --threads 2 --trueform --cgal "$cgal" \
       --only libigl "pymeshlab Taubin" "pymeshlab quadric" VTK trueform ||
       echo "Peers at 1M failed (exit $?); see the messages above."
+    # Issue 36's targets against trueform, with and without the file's normals.
+    for mesh in "$(torus 1000000)" "$(torus_without_normals 1000000)"; do
+      echo
+      "$peers/.venv/bin/python" "$peers/targets.py" mesh "$mesh" --focal "$focal" \
+        --runs "${FOCAL_BENCH_PEER_REPS:-3}" --threads 2 ||
+        echo "Targets on $mesh failed (exit $?); see the messages above."
+    done
   fi
 else
   echo "Peers skipped: no $peers/.venv (bench/peers/setup.sh creates it)."

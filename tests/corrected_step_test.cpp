@@ -7,7 +7,9 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "core/result_rows.h"
@@ -16,6 +18,7 @@
 #include "focal/evaluation/evaluation.h"
 #include "focal/mesh/neighbourhood.h"
 #include "focal/mesh/prepared.h"
+#include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "test_meshes.h"
 
@@ -57,6 +60,63 @@ TEST(CorrectedStep, StencilAsymmetrySeparatesGridsFromRandomSamplings) {
     // takes the other ball, a small change, see corrected_step.h).
     EXPECT_LT(a.maxCoeff(), detail::kSymmetricStencil);
     EXPECT_GT(b.minCoeff(), detail::kSymmetricStencil);
+  }
+}
+
+/// stencil_asymmetry written out: every ordered pair of neighbours, no table.
+Eigen::VectorXd plain_asymmetry(const Mesh& m, const RowMatrixX3d& N, const Neighbourhoods& ring) {
+  Eigen::VectorXd own(m.V.rows()), out(m.V.rows());
+  for (int i = 0; i < m.V.rows(); ++i) {
+    const Eigen::Vector3d n = N.row(i).transpose();
+    double total = 0.0;
+    for (const int* j = ring.begin(i); j != ring.end(i); ++j) {
+      const Eigen::Vector3d e = (m.V.row(*j) - m.V.row(i)).transpose();
+      double best = INFINITY;
+      for (const int* k = ring.begin(i); k != ring.end(i); ++k) {
+        if (k == j) continue;
+        Eigen::Vector3d d = e + (m.V.row(*k) - m.V.row(i)).transpose();
+        d -= n * n.dot(d);
+        best = std::min(best, d.norm());
+      }
+      total += best / e.norm();
+    }
+    own[i] = total / ring.size(i);
+  }
+  for (int i = 0; i < m.V.rows(); ++i) {
+    double sum = own[i];
+    int count = 1;
+    for (const int* j = ring.begin(i); j != ring.end(i); ++j, ++count) sum += own[*j];
+    out[i] = sum / count;
+  }
+  return out;
+}
+
+// Each pair's term is taken once for both of its orders (e_j + e_k is e_k + e_j, bit for bit):
+// the same bits as the plain formula, on 1-rings within the pair table and on a fan centre
+// beyond it (a cone of 40 sides closed by a fan: valence 40).
+TEST(CorrectedStep, StencilAsymmetryHasThePlainFormulasBits) {
+  const AnalyticSurface irr = surface(SurfaceKind::torus, Triangulation::irregular, 3000);
+  constexpr int kSides = 40;
+  Mesh cone;
+  cone.V.resize(kSides + 2, 3);
+  cone.F.resize(2 * kSides, 3);
+  cone.V.row(0) << 0.0, 0.0, 1.0;
+  cone.V.row(kSides + 1) << 0.0, 0.0, 0.0;
+  for (int s = 0; s < kSides; ++s) {
+    const double a = 2.0 * M_PI * s / kSides;
+    cone.V.row(1 + s) << std::cos(a), std::sin(a) * 1.1, 0.1 * std::sin(3.0 * a);
+    cone.F.row(s) << 0, 1 + s, 1 + (s + 1) % kSides;
+    cone.F.row(kSides + s) << kSides + 1, 1 + (s + 1) % kSides, 1 + s;
+  }
+  for (const Mesh* m : {static_cast<const Mesh*>(&irr.mesh), static_cast<const Mesh*>(&cone)}) {
+    const RowMatrixX3d N = vertex_normals(m->V, m->F);
+    const Neighbourhoods ring = vertex_adjacency(static_cast<int>(m->V.rows()), m->F);
+    const Eigen::VectorXd got = detail::stencil_asymmetry(m->V, N, ring, 2);
+    const Eigen::VectorXd want = plain_asymmetry(*m, N, ring);
+    for (Eigen::Index i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(got[i]), std::bit_cast<std::uint64_t>(want[i]))
+          << "vertex " << i << " of " << got.size() << ": " << got[i] << " vs " << want[i];
+    }
   }
 }
 

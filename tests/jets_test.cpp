@@ -7,7 +7,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -18,6 +20,8 @@
 #include "focal/mesh/neighbourhood.h"
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
+#include "normals/jet_points.h"
+#include "test_meshes.h"
 #include "test_threads.h"
 
 namespace focal {
@@ -280,6 +284,42 @@ TEST(JetCurvature, SphereOfRadiusTwoAndSigns) {
     ASSERT_NEAR(r.d1.row(i).cross(r.d2.row(i)).dot(s.mesh.N.row(i)), 1.0, 1e-6);
   }
   EXPECT_LT(worst, 0.01);  // measured 2.2e-3 (cubic jets over the 2-ring)
+}
+
+// The jets' neighbourhoods (jet_points.h): v and its k-ring, ascending, as k_ring lists them;
+// only v where the k-ring is over kMaxNeighbourhoodSize (k_ring's empty list). A fan of 3,072
+// rim vertices puts every rim vertex's 2-ring over the cap and gives the centre a 1-ring of
+// 3,072; a grid beside it (another component) has rings within the cap; `sort_rows` reversed
+// sorts by row.
+TEST(Jets, GatheredRingsAreTheKRingsWithTheirCentre) {
+  constexpr int kRim = 3072;
+  const Mesh grid = test::flat_grid(20);
+  const auto g = static_cast<int>(grid.V.rows());
+  RowMatrixX3i F(kRim + grid.F.rows(), 3);
+  for (int i = 0; i < kRim; ++i) F.row(i) << 0, 1 + i, 1 + (i + 1) % kRim;
+  F.bottomRows(grid.F.rows()) = (grid.F.array() + (kRim + 1)).matrix();
+  const int n = kRim + 1 + g;
+  const Neighbourhoods one = vertex_adjacency(n, F);
+  std::vector<int> reversed(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) reversed[static_cast<std::size_t>(v)] = n - 1 - v;
+  for (const int rings : {1, 2, 3}) {
+    const Neighbourhoods k = k_ring(one, rings);
+    std::vector<std::uint64_t> marks;
+    std::vector<int> ring, sorted;
+    for (int v = 0; v < n; ++v) {
+      std::vector<int> expected(k.begin(v), k.end(v));
+      expected.push_back(v);
+      std::sort(expected.begin(), expected.end());
+      detail::jets::gather_ring(one, v, rings, marks, nullptr, ring);
+      ASSERT_EQ(ring, expected) << "vertex " << v << ", " << rings << " rings";
+      detail::jets::gather_ring(one, v, rings, marks, &reversed, sorted);
+      std::reverse(expected.begin(), expected.end());
+      ASSERT_EQ(sorted, expected) << "vertex " << v << ", " << rings << " rings, by row";
+    }
+    // Every mark is cleared after each ring: none is left set.
+    EXPECT_TRUE(std::all_of(marks.begin(), marks.end(), [](std::uint64_t w) { return w == 0; }));
+  }
+  EXPECT_EQ(k_ring(one, 2).size(1), 0) << "the rim's 2-rings are over the cap";
 }
 
 }  // namespace

@@ -16,23 +16,57 @@
 namespace focal::detail {
 namespace {
 
-/// stencil_asymmetry of vertex i alone.
+/// |P (a + b)| for the offsets a, b of two neighbours from the vertex (P the projection onto the
+/// plane of the unit normal n): how far they are from opposing each other. The normal part is
+/// the curvature's (|e|^2 k), not the sampling's. Symmetric bit for bit (a + b is b + a).
+[[gnu::always_inline]] inline double opposition(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                const Eigen::Vector3d& n) {
+  Eigen::Vector3d d = a + b;
+  d -= n * n.dot(d);
+  return d.norm();
+}
+
+/// 1-rings up to this size take each pair's opposition once (vertex_asymmetry); larger ones
+/// (fan centres) compute it for each order of the pair, with no arrays of their size.
+constexpr int kPairsOnce = 32;
+
+/// stencil_asymmetry of vertex i alone. Each neighbour's term takes the least opposition with
+/// another: a minimum, whatever the order its candidates come in (oppositions are norms, never
+/// -0; a NaN one is passed over by std::min in any order).
 double vertex_asymmetry(PositionsRef V, const RowMatrixX3d& N, const Neighbourhoods& ring, int i) {
   const Eigen::Vector3d n = N.row(i).transpose();
   if (!n.allFinite() || ring.begin(i) == ring.end(i)) return NAN;
+  const int* first = ring.begin(i);
+  const auto count = static_cast<int>(ring.end(i) - first);
+  const auto offset = [&](int a) {
+    return Eigen::Vector3d((V.row(first[a]) - V.row(i)).transpose());
+  };
   double total = 0.0;
-  int count = 0;
-  for (const int* j = ring.begin(i); j != ring.end(i); ++j, ++count) {
-    const Eigen::Vector3d e = (V.row(*j) - V.row(i)).transpose();
-    double best = INFINITY;  // a 1-ring of one vertex has no opposite: infinite, not symmetric
-    for (const int* k = ring.begin(i); k != ring.end(i); ++k) {
-      if (k == j) continue;
-      Eigen::Vector3d d = e + (V.row(*k) - V.row(i)).transpose();
-      d -= n * n.dot(d);  // the normal part is the curvature's (|e|^2 k), not the sampling's
-      best = std::min(best, d.norm());
+  if (count > kPairsOnce) {
+    for (int a = 0; a < count; ++a) {
+      const Eigen::Vector3d e = offset(a);
+      double best = INFINITY;  // a 1-ring of one vertex has no opposite: infinite, not symmetric
+      for (int b = 0; b < count; ++b) {
+        if (b != a) best = std::min(best, opposition(e, offset(b), n));
+      }
+      total += best / e.norm();
     }
-    total += best / e.norm();
+    return total / count;
   }
+  std::array<Eigen::Vector3d, kPairsOnce> e;
+  std::array<double, kPairsOnce> best;
+  for (int a = 0; a < count; ++a) {
+    e[static_cast<std::size_t>(a)] = offset(a);
+    best[static_cast<std::size_t>(a)] = INFINITY;
+  }
+  for (std::size_t a = 0; a < static_cast<std::size_t>(count); ++a) {
+    for (std::size_t b = a + 1; b < static_cast<std::size_t>(count); ++b) {
+      const double o = opposition(e[a], e[b], n);
+      best[a] = std::min(best[a], o);
+      best[b] = std::min(best[b], o);
+    }
+  }
+  for (std::size_t a = 0; a < static_cast<std::size_t>(count); ++a) total += best[a] / e[a].norm();
   return total / count;
 }
 

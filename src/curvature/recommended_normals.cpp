@@ -240,6 +240,8 @@ std::vector<char> crease_vertices(const Context& c) {
 
 std::vector<int> near_flagged(const Context& c, const std::vector<char>& flagged, int rings) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  // Nothing flagged (a mesh without creases): nothing near, without the search over every ring.
+  if (std::none_of(flagged.begin(), flagged.end(), [](char f) { return f != 0; })) return {};
   const Eigen::VectorXi distance =
       rings_to_boundary(*c.one_ring, std::vector<bool>(flagged.begin(), flagged.end()), rings);
   std::vector<int> out;

@@ -34,37 +34,53 @@ bool read_marks_in_order(std::vector<int>& ring, std::uint64_t* bits) {
   return true;
 }
 
+/// Neighbours of one vertex that gather_ring adds between two checks of its cap.
+constexpr std::ptrdiff_t kCapRun = 64;
+
 }  // namespace
 
 void gather_ring(const Neighbourhoods& one, int v, int rings, std::vector<std::uint64_t>& in_ring,
                  const std::vector<int>* sort_rows, std::vector<int>& ring) {
   if (in_ring.empty()) in_ring.assign(static_cast<std::size_t>(one.vertex_count()) / 64 + 1, 0);
   std::uint64_t* bits = in_ring.data();
-  const auto test_and_set = [bits](int w) {
-    std::uint64_t& word = bits[static_cast<std::size_t>(w) / 64];
-    const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(w) % 64);
-    const bool was = (word & bit) != 0;
-    word |= bit;
-    return was;
-  };
   ring.assign(1, v);
-  test_and_set(v);
+  bits[static_cast<std::size_t>(v) / 64] |= std::uint64_t{1} << (static_cast<unsigned>(v) % 64);
   // Past the cap (rings >= 2) the search stops and v keeps no neighbours: no jet, as k_ring().
   // Past it the ring is dropped either way, so where the search stops does not change a result.
   const std::size_t cap = rings >= 2 ? std::size_t{kMaxNeighbourhoodSize} + 1 : SIZE_MAX;
+  std::size_t size = 1;  // the entries of `ring` gathered; the rest is room to write into
   std::size_t begin = 0;
-  for (int depth = 0; depth < rings && begin < ring.size(); ++depth) {
-    const std::size_t end = ring.size();
-    for (std::size_t k = begin; k < end && ring.size() <= cap; ++k) {
-      const int u = ring[k];
-      // Also within one vertex's neighbours: the centre of a fan of 100,000 corners would
-      // otherwise add them all to the ring of each of its 100,000 neighbours (quadratic).
-      for (const int* w = one.begin(u); w != one.end(u) && ring.size() <= cap; ++w) {
-        if (!test_and_set(*w)) ring.push_back(*w);
+  for (int depth = 0; depth < rings && begin < size && size <= cap; ++depth) {
+    const std::size_t end = size;
+    // Room for every neighbour of this depth's vertices, or up to the last run past the cap.
+    std::size_t room = size;
+    for (std::size_t k = begin; k < end; ++k) room += static_cast<std::size_t>(one.size(ring[k]));
+    if (rings >= 2) room = std::min(room, cap + static_cast<std::size_t>(kCapRun));
+    if (ring.size() < room) ring.resize(room);
+    int* const first = ring.data();
+    int* out = first + size;
+    const auto within_cap = [&] { return static_cast<std::size_t>(out - first) <= cap; };
+    for (std::size_t k = begin; k < end && within_cap(); ++k) {
+      const int u = first[k];
+      // The cap is checked after each run of kCapRun neighbours: the centre of a fan of 100,000
+      // corners would otherwise add them all to the ring of each of its 100,000 neighbours.
+      for (const int *w = one.begin(u), *last = one.end(u); w != last && within_cap();) {
+        const int* const run_end = w + std::min<std::ptrdiff_t>(kCapRun, last - w);
+        for (; w != run_end; ++w) {
+          // Each neighbour is written; the end moves past it only where it was not marked.
+          const int x = *w;
+          std::uint64_t& word = bits[static_cast<std::size_t>(x) / 64];
+          const std::uint64_t bit = std::uint64_t{1} << (static_cast<unsigned>(x) % 64);
+          *out = x;
+          out += (word & bit) == 0 ? 1 : 0;
+          word |= bit;
+        }
       }
     }
+    size = static_cast<std::size_t>(out - first);
     begin = end;
   }
+  ring.resize(size);
   if (!sort_rows && ring.size() <= cap && read_marks_in_order(ring, bits)) return;
   for (const int w : ring) bits[static_cast<std::size_t>(w) / 64] = 0;  // whole words: cheaper
   if (ring.size() > cap) ring.resize(1);
