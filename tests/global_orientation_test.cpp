@@ -136,11 +136,12 @@ int flipped(const test::Solid& s, CloudOrientation orientation) {
 }
 
 // The two small cases, clean and with noise of 0.1 spacing, seeds 1-3: the tree alone turns a
-// whole side (plate: 1729-1845 of 3520 points flipped; spheres: one sphere, 800 of 1600); the
-// global orientation leaves 47-143 (1.3-4.1%) and 41-61 (2.6-3.8%, where the spheres are within
-// about a spacing of each other) flipped, NaN counted (docs/notes/points-log.md, "Global
-// orientation"). Asserted: at most 5%, and the tree's failure itself (at least 45%), so that
-// the case stays a hard one. The issue's target, 1%, is not reached.
+// whole side (plate: 1729-1845 of 3520 points flipped; spheres: one sphere, 800-802 of 1600);
+// the global orientation leaves 10-19 (0.3-0.5%) and 13-20 (0.8-1.25%, where the spheres are
+// within a fraction of a spacing of each other) flipped, NaN counted (docs/notes/points-log.md,
+// "Global orientation"). Asserted: the issue's 1% on the plate, 2% on the spheres (whose 1% is
+// not reached on every seed), and the tree's failure itself (at least 45%), so that the case
+// stays a hard one.
 TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
   for (const Shape shape : {Shape::plate, Shape::touching_spheres}) {
     for (std::uint64_t seed : {1, 2, 3}) {
@@ -149,7 +150,8 @@ TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
         const auto n = static_cast<int>(s.V.rows());
         EXPECT_GE(flipped(s, CloudOrientation::mst), n * 45 / 100)
             << shape_name(shape) << " seed " << seed << " noise " << noise;
-        EXPECT_LE(flipped(s, CloudOrientation::global), n * 5 / 100)
+        const int limit = shape == Shape::plate ? n / 100 : n * 2 / 100;
+        EXPECT_LE(flipped(s, CloudOrientation::global), limit)
             << shape_name(shape) << " seed " << seed << " noise " << noise;
       }
     }
@@ -212,6 +214,29 @@ TEST(GlobalOrientation, DISABLED_Table) {
   }
 }
 
+// The thicknesses of the issue's cases (docs/notes/points-log.md, "Global orientation"): plates
+// 40 x 40, coins of radius 15 and rings of major radius 12, t = 2, 3, 5, 7 spacings thick (the
+// ring's tube t / 2 in radius), clean and with noise of 0.1 spacing, seeds 1-3.
+TEST(GlobalOrientation, DISABLED_Thickness) {
+  const char* names[] = {"plate", "coin", "ring"};
+  for (int kind = 0; kind < 3; ++kind) {
+    for (const double t : {2.0, 3.0, 5.0, 7.0}) {
+      for (const double noise : {0.0, 0.1}) {
+        for (std::uint64_t seed : {1, 2, 3}) {
+          test::SolidBuilder b(seed);
+          if (kind == 0) b.box({40, 40, t});
+          if (kind == 1) b.coin(15, t);
+          if (kind == 2) b.ring(12, 0.5 * t);
+          const test::Solid s = b.take(noise);
+          std::printf("%-5s t %.0f noise %.1f seed %d  points %6d  mst %5d  global %5d\n",
+                      names[kind], t, noise, static_cast<int>(seed), static_cast<int>(s.V.rows()),
+                      flipped(s, CloudOrientation::mst), flipped(s, CloudOrientation::global));
+        }
+      }
+    }
+  }
+}
+
 double env(const char* name, double otherwise) {
   const char* v = std::getenv(name);
   return v ? std::atof(v) : otherwise;
@@ -227,6 +252,8 @@ TEST(GlobalOrientation, DISABLED_Explore) {
   o.sweeps = static_cast<int>(env("FOCAL_WO_SWEEPS", o.sweeps));
   o.smoothing = env("FOCAL_WO_SMOOTHING", o.smoothing);
   o.beta = env("FOCAL_WO_BETA", o.beta);
+  o.jump_offset = env("FOCAL_WO_JUMP_OFFSET", o.jump_offset);
+  o.jump_rounds = static_cast<int>(env("FOCAL_WO_JUMP_ROUNDS", o.jump_rounds));
   const int k = static_cast<int>(env("FOCAL_WO_K", 16));
   const int only = static_cast<int>(env("FOCAL_WO_SHAPE", -1));
   for (const Shape shape :
@@ -263,9 +290,9 @@ TEST(GlobalOrientation, DISABLED_Explore) {
                     bad_lines, static_cast<int>(N.rows()), good_flipped);
         std::printf(
             "%-22s noise %.1f seed %d mst %5d global %5d residual truth %.3f mst %.3f "
-            "global %.3f\n",
+            "global %.3f jumps %d\n",
             shape_name(shape), noise, static_cast<int>(seed), mst, test::flipped_against(N, s.N),
-            truth, r.residual_before, r.residual_after);
+            truth, r.residual_before, r.residual_after, r.jump_turned);
       }
     }
   }

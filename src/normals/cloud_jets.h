@@ -18,8 +18,10 @@ namespace focal::detail {
 /// the cloud's would be.
 /// `global`: orient_normals_global after the tree (on the cloud in its own order too, each
 /// point's area from its list in `neighbours`).
+/// `decided` (when not null): whether the global orientation ran and its field decided.
 int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                       int threads, const CloudCopy* copy_of = nullptr, bool global = false);
+                       int threads, const CloudCopy* copy_of = nullptr, bool global = false,
+                       bool* decided = nullptr);
 
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
 /// `copy_of` as orient_normals_mst; each jet's points are then summed in the cloud's order
@@ -32,8 +34,9 @@ JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
 /// of oriented by orient_normals_mst (serial, the plan's one serial step), for a plan that may
 /// only need the jets' residuals and lines: a jet is fitted in the frame of its own start normal,
 /// and a start normal of the other sign gives the same residual and the opposite normal, bit for
-/// bit (docs/notes/points-log.md, "The default's cost"). With a viewpoint, cloud_jets itself. `copy_of`
-/// as orient_normals_mst (the jets' points summed in the cloud's order: jet_normals_from).
+/// bit (docs/notes/points-log.md, "The default's cost"). With a viewpoint, cloud_jets itself.
+/// `copy_of` as orient_normals_mst (the jets' points summed in the cloud's order:
+/// jet_normals_from).
 JetNormals cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
                             const CloudNormalOptions& options, NormalsRef side,
                             const CloudCopy* copy_of = nullptr);

@@ -282,12 +282,15 @@ int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d&
 
 namespace {
 
-/// Tells the verbose log (Execution::info) what the global orientation did.
-void tell(const detail::WindingOrientationReport& r) {
+/// Tells the verbose log (Execution::info) what the global orientation did, and `decided`
+/// (when not null) whether its field decided.
+void tell(const detail::WindingOrientationReport& r, bool* decided) {
+  if (decided) *decided = r.decided;
   const Execution& execution = current_execution();
   if (!execution.info) return;
   const std::string verdict =
-      r.decided ? std::to_string(r.flipped) + " normals turned"
+      r.decided ? std::to_string(r.flipped) + " normals turned (" + std::to_string(r.jump_turned) +
+                      " turns by the jumps across points)"
       : r.residual_after <= detail::WindingOrientationOptions{}.closed_residual
           ? "the tree's signs kept (the field's fit them hardly better)"
           : "the tree's signs kept (the field does not decide: an open or noisy cloud)";
@@ -301,7 +304,7 @@ void tell(const detail::WindingOrientationReport& r) {
 }  // namespace
 
 int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
-                               int threads, const CloudCopy* copy_of, bool global) {
+                               int threads, const CloudCopy* copy_of, bool global, bool* decided) {
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
   // The areas from the lists as given (sorted by distance), before N is taken anywhere.
@@ -309,7 +312,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
       global ? detail::patch_areas(V, neighbours, N, threads) : Eigen::VectorXd();
   if (!copy_of) {
     const int components = orient_over_graph(V, symmetric(neighbours, threads), N);
-    if (global) tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads));
+    if (global) tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads), decided);
     return components;
   }
   // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
@@ -326,7 +329,8 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   }
   if (global) {
     tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
-                                   detail::rows_from(area, p.position, threads), own, threads));
+                                   detail::rows_from(area, p.position, threads), own, threads),
+         decided);
   }
   N = detail::rows_from(own, p.order, threads);
   return components;
@@ -366,14 +370,33 @@ void check_jet_options(PositionsRef V, const Neighbourhoods& neighbours,
 }
 
 /// Orients PCA normals N as `options` say (no viewpoint in orient_sided_jets' calls).
-void orient(PositionsRef V, const Neighbourhoods& neighbours, const CloudNormalOptions& options,
+/// Returns whether the global orientation ran and its field decided.
+bool orient(PositionsRef V, const Neighbourhoods& neighbours, const CloudNormalOptions& options,
             RowMatrixX3d& N, const detail::CloudCopy* copy_of) {
+  bool decided = false;
   if (options.viewpoint) {
     orient_towards_viewpoint(V, *options.viewpoint, N);
   } else {
     detail::orient_normals_mst(V, neighbours, N, 0, copy_of,
-                               options.orientation == CloudOrientation::global);
+                               options.orientation == CloudOrientation::global, &decided);
   }
+  return decided;
+}
+
+/// Where the global orientation decided: the jets' sides by the field of the oriented PCA
+/// normals N (detail::side_by_jumps), on the cloud in its own order as the orientation was.
+void side_jets(PositionsRef V, const Neighbourhoods& neighbours, const RowMatrixX3d& N,
+               RowMatrixX3d& jets, const detail::CloudCopy* copy_of) {
+  const Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, 0);
+  if (!copy_of) {
+    detail::side_by_jumps(V, area, N, jets, 0);
+    return;
+  }
+  const auto& p = copy_of->permutation;
+  RowMatrixX3d own = detail::rows_from(jets, p.position, 0);
+  detail::side_by_jumps(copy_of->cloud, detail::rows_from(area, p.position, 0),
+                        detail::rows_from(N, p.position, 0), own, 0);
+  jets = detail::rows_from(own, p.order, 0);
 }
 
 /// Whether cloud_jets_sided turns point i's PCA normal `n` over: towards its row of `side`.
@@ -400,8 +423,12 @@ JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
                               const CloudNormalOptions& options, const CloudCopy* copy_of) {
   check_jet_options(V, neighbours, options);
   RowMatrixX3d N = pca_normals(V, neighbours);
-  orient(V, neighbours, options, N, copy_of);
-  return jets_from_start(V, neighbours, options, std::move(N), copy_of);
+  if (!orient(V, neighbours, options, N, copy_of) || options.method == CloudNormalMethod::pca) {
+    return jets_from_start(V, neighbours, options, std::move(N), copy_of);
+  }
+  JetNormals jets = jets_from_start(V, neighbours, options, N, copy_of);
+  side_jets(V, neighbours, N, jets.N, copy_of);
+  return jets;
 }
 
 JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
@@ -424,7 +451,7 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
   // The PCA normals again (cheap, parallel) rather than kept through the plan: 24 B a point.
   const RowMatrixX3d pca = pca_normals(V, neighbours);
   RowMatrixX3d mst = pca;
-  orient(V, neighbours, options, mst, copy_of);
+  const bool decided = orient(V, neighbours, options, mst, copy_of);
   detail::parallel_for(V.rows(), 0, [&](std::int64_t i) {
     // A unit row flipped by the MST is exactly -pca; NaN rows (no normal) never compare equal.
     const bool by_mst = (mst.row(i).array() == -pca.row(i).array()).all();
@@ -433,6 +460,8 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
       jets.N.row(i) *= -1.0;
     }
   });
+  if (decided && options.method == CloudNormalMethod::jet)
+    side_jets(V, neighbours, mst, jets.N, copy_of);
 }
 
 RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,

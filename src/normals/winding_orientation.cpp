@@ -79,7 +79,83 @@ double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return s;
 }
 
+/// Whether point i carries a dipole: a finite position and normal and a positive area.
+bool has_dipole(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, Eigen::Index i) {
+  return V.row(i).allFinite() && area[i] > 0.0 && N.row(i).allFinite();
+}
+
+/// a_i n_i per point (#V x 3), zero where there is no dipole.
+RowMatrixX3d dipoles(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N) {
+  RowMatrixX3d A = RowMatrixX3d::Zero(V.rows(), 3);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (has_dipole(V, area, N, i)) A.row(i) = area[i] * N.row(i).normalized();
+  }
+  return A;
+}
+
+/// The tree over V, each dipole smoothed by options.smoothing times the square root of its area.
+WindingTree tree_of(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N,
+                    const WindingOrientationOptions& o) {
+  Eigen::VectorXd smoothing = Eigen::VectorXd::Zero(V.rows());
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (has_dipole(V, area, N, i)) smoothing[i] = o.smoothing * std::sqrt(area[i]);
+  }
+  return WindingTree(V, smoothing, o.beta);
+}
+
+/// The jumps' offsets (#V x 3): along each row of `lines`, jump_offset times the square root of
+/// the point's area; zero where A has no dipole or the line is zero or not finite.
+RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& area, const RowMatrixX3d& A,
+                     const WindingOrientationOptions& o) {
+  RowMatrixX3d E = RowMatrixX3d::Zero(A.rows(), 3);
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    const double l = lines.row(i).norm();
+    if (!A.row(i).isZero() && l > 0.0 && std::isfinite(l)) {
+      E.row(i) = o.jump_offset * std::sqrt(area[i]) / l * lines.row(i);
+    }
+  }
+  return E;
+}
+
+/// Rounds of per-point turns: each point takes the side that the field's jump across it says
+/// (positive: its signed normal points out), all at once, until a round turns none. The jump
+/// leaves the point's own dipole out, so a point alone in a consistent sheet follows the sheet,
+/// and across a thin part or a contact the nearer sheet's jump outweighs the other's. Returns
+/// the turns made.
+int turn_by_jumps(const WindingTree& tree, const Eigen::VectorXd& area, const RowMatrixX3d& A,
+                  const WindingOrientationOptions& options, Eigen::VectorXd& s, int threads) {
+  const Eigen::Index n = A.rows();
+  const RowMatrixX3d E = offsets(A, area, A, options);
+  int total = 0;
+  for (int round = 0; round < options.jump_rounds; ++round) {
+    const Eigen::VectorXd J = tree.jump(E, A, s, threads);
+    int turned = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (A.row(i).isZero() || s[i] * J[i] >= 0.0) continue;
+      s[i] = -s[i];
+      ++turned;
+    }
+    total += turned;
+    if (turned == 0) break;
+  }
+  return total;
+}
+
 }  // namespace
+
+int side_by_jumps(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, RowMatrixX3d& L,
+                  int threads, const WindingOrientationOptions& options) {
+  const RowMatrixX3d A = dipoles(V, area, N);
+  const Eigen::VectorXd J = tree_of(V, area, N, options)
+                                .jump(offsets(L, area, A, options), A, Eigen::VectorXd(), threads);
+  int turned = 0;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (J[i] >= 0.0) continue;
+    L.row(i) *= -1.0;
+    ++turned;
+  }
+  return turned;
+}
 
 Eigen::VectorXd patch_areas(PositionsRef V, const Neighbourhoods& neighbours, NormalsRef N,
                             int threads) {
@@ -119,19 +195,10 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   WindingOrientationReport report;
   // a_j n_j per point (zero where there is no dipole), the smoothing lengths, the target 1/2 at
   // every finite point.
-  RowMatrixX3d A = RowMatrixX3d::Zero(n, 3);
+  const RowMatrixX3d A = dipoles(V, area, N);
+  const WindingTree tree = tree_of(V, area, N, options);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
-  const WindingTree tree = [&] {
-    Eigen::VectorXd smoothing = Eigen::VectorXd::Zero(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (!V.row(i).allFinite()) continue;
-      b[i] = 0.5;
-      if (!(area[i] > 0.0) || !N.row(i).allFinite()) continue;
-      A.row(i) = area[i] * N.row(i).normalized();
-      smoothing[i] = options.smoothing * std::sqrt(area[i]);
-    }
-    return WindingTree(V, smoothing, options.beta);
-  }();
+  for (Eigen::Index i = 0; i < n; ++i) b[i] = V.row(i).allFinite() ? 0.5 : 0.0;
   const auto K = [&](const Eigen::VectorXd& s) { return tree.winding(A, s, threads); };
   const auto Kt = [&](const Eigen::VectorXd& r) { return tree.transpose(A, r, threads); };
   const double lambda = options.damping;
@@ -218,6 +285,7 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   report.decided = report.residual_after <= options.closed_residual &&
                    report.residual_after <= options.closed_gain * report.residual_before;
   if (!report.decided) return report;
+  report.jump_turned = turn_by_jumps(tree, area, A, options, s, threads);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (s[i] > 0.0) continue;
     N.row(i) *= -1.0;

@@ -41,12 +41,18 @@ struct WindingOrientationOptions {
   double closed_residual = 0.4;
   double closed_gain = 0.4;
   double smoothing = 0.5;  ///< smoothing length of each point, times sqrt of its area
+  /// Where the field decides, rounds of per-point turns by the field's jump across the point
+  /// (WindingTree::jump over its normal line, offsets jump_offset times sqrt of its area), at
+  /// most jump_rounds.
+  double jump_offset = 0.5;
+  int jump_rounds = 3;
 };
 
 /// What orient_by_winding did.
 struct WindingOrientationReport {
   bool decided = false;          ///< the field decided (the options' closed_* tests passed)
   int flipped = 0;               ///< rows of N turned (0 unless decided)
+  int jump_turned = 0;           ///< of those, turns by the jumps (counted per round)
   double residual_before = NAN;  ///< |K s0 - 1/2| / |1/2| over the finite points
   double residual_after = NAN;   ///< the same for the signs found
 };
@@ -68,5 +74,14 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
                                            const Eigen::VectorXd& area, RowMatrixX3d& N,
                                            int threads,
                                            const WindingOrientationOptions& options = {});
+
+/// Turns rows of L (#V x 3: lines refined from N's, e.g. the jets fitted in the frames of N) to
+/// the side that the field's jump across each point says (WindingTree::jump along the row, the
+/// dipoles a_i n_i of N as orient_by_winding left them where its field decided; `area` as
+/// patch_areas): a line's side decided by the solid, not by the side of the normal it was
+/// refined from, which a line refined through more than 90 degrees loses. Rows without a dipole
+/// or a finite line are left as they are. Returns the rows turned.
+int side_by_jumps(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, RowMatrixX3d& L,
+                  int threads, const WindingOrientationOptions& options = {});
 
 }  // namespace focal::detail

@@ -15,6 +15,10 @@ constexpr double kInvFourPi = 0.25 * std::numbers::inv_pi;
 /// Nodes deeper than this are leaves whatever their count (coincident points).
 constexpr int kMaxDepth = 48;
 
+/// The term of one dipole m at a point q, m . (p - q) = mr, rho2 = |p - q|^2 plus the smoothing:
+/// 4 pi times its winding number.
+inline double dipole_term(double mr, double rho2) { return mr / (rho2 * std::sqrt(rho2)); }
+
 }  // namespace
 
 WindingTree::WindingTree(PositionsRef V, const Eigen::VectorXd& smoothing, double beta)
@@ -126,68 +130,99 @@ void WindingTree::visit(const Eigen::Vector3d& q, Far&& far, Near&& near) const 
   }
 }
 
-Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
-                                     int threads) const {
+WindingTree::Moments WindingTree::moments(const RowMatrixX3d& M,
+                                          const Eigen::VectorXd& sign) const {
   if (M.rows() != rows_) throw InvalidInput("WindingTree::winding: M does not have #V rows");
   if (sign.size() != 0 && sign.size() != rows_) {
     throw InvalidInput("WindingTree::winding: sign is neither empty nor #V long");
   }
   const auto n = static_cast<Eigen::Index>(order_.size());
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
-  if (n == 0) return out;
-  RowMatrixX3d Mt(n, 3);
+  Moments d;
+  d.M.resize(n, 3);
   for (Eigen::Index t = 0; t < n; ++t) {
     const int row = order_[static_cast<std::size_t>(t)];
     const Eigen::RowVector3d m = sign.size() != 0 ? Eigen::RowVector3d(sign[row] * M.row(row))
                                                   : Eigen::RowVector3d(M.row(row));
-    Mt.row(t) = m.allFinite() ? m : Eigen::RowVector3d::Zero();
+    d.M.row(t) = m.allFinite() ? m : Eigen::RowVector3d::Zero();
   }
-  // Moments about each node's centre, children before parents (they come after them).
+  // Children before parents (they come after them).
   const auto count = static_cast<std::size_t>(nodes_.size());
-  std::vector<Eigen::Vector3d> sum(count);
-  std::vector<Eigen::Matrix3d> second(count);
+  d.sum.resize(count);
+  d.second.resize(count);
   for (std::size_t k = count; k-- > 0;) {
     const Node& node = nodes_[k];
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
     Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
     if (node.first_child < 0) {
       for (int t = node.begin; t < node.end; ++t) {
-        const Eigen::Vector3d m = Mt.row(t).transpose();
+        const Eigen::Vector3d m = d.M.row(t).transpose();
         s += m;
         T += m * (P_.row(t).transpose() - node.centre).transpose();
       }
     } else {
       for (int c = node.first_child; c < node.first_child + node.children; ++c) {
         const auto cs = static_cast<std::size_t>(c);
-        s += sum[cs];
-        T += second[cs] + sum[cs] * (nodes_[cs].centre - node.centre).transpose();
+        s += d.sum[cs];
+        T += d.second[cs] + d.sum[cs] * (nodes_[cs].centre - node.centre).transpose();
       }
     }
-    sum[k] = s;
-    second[k] = T;
+    d.sum[k] = s;
+    d.second[k] = T;
   }
+  return d;
+}
+
+double WindingTree::winding_sum(const Eigen::Vector3d& q, double own, const Moments& d) const {
+  double w = 0.0;
+  visit(
+      q,
+      [&](const Node& node, std::size_t k, double d2) {
+        const Eigen::Vector3d x = node.centre - q;
+        const double rho2 = d2 + own + node.s2;
+        const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
+        const Eigen::Matrix3d& T = d.second[k];
+        w += inv3 * (d.sum[k].dot(x) + T.trace() - 3.0 * inv2 * x.dot(T * x));
+      },
+      [&](const Node& node) {
+        for (int j = node.begin; j < node.end; ++j) {
+          const double rx = P_(j, 0) - q.x(), ry = P_(j, 1) - q.y(), rz = P_(j, 2) - q.z();
+          const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[j];
+          if (rho2 == 0.0) continue;  // a coincident point without smoothing: no term
+          w += dipole_term(d.M(j, 0) * rx + d.M(j, 1) * ry + d.M(j, 2) * rz, rho2);
+        }
+      });
+  return w;
+}
+
+Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                     int threads) const {
+  const Moments d = moments(M, sign);
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
   parallel_for(n, threads, [&](std::int64_t t) {
-    const Eigen::Vector3d q = P_.row(t).transpose();
-    const double own = s2_[t];
-    double w = 0.0;
-    visit(
-        q,
-        [&](const Node& node, std::size_t k, double d2) {
-          const Eigen::Vector3d x = node.centre - q;
-          const double rho2 = d2 + own + node.s2;
-          const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
-          const Eigen::Matrix3d& T = second[k];
-          w += inv3 * (sum[k].dot(x) + T.trace() - 3.0 * inv2 * x.dot(T * x));
-        },
-        [&](const Node& node) {
-          for (int j = node.begin; j < node.end; ++j) {
-            const double rx = P_(j, 0) - q.x(), ry = P_(j, 1) - q.y(), rz = P_(j, 2) - q.z();
-            const double rho2 = rx * rx + ry * ry + rz * rz + own + s2_[j];
-            if (rho2 == 0.0) continue;  // a coincident point without smoothing: no term
-            w += (Mt(j, 0) * rx + Mt(j, 1) * ry + Mt(j, 2) * rz) / (rho2 * std::sqrt(rho2));
-          }
-        });
+    const double w = winding_sum(P_.row(t).transpose(), s2_[t], d);
     out[order_[static_cast<std::size_t>(t)]] = kInvFourPi * w;
+  });
+  return out;
+}
+
+Eigen::VectorXd WindingTree::jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
+                                  const Eigen::VectorXd& sign, int threads) const {
+  if (E.rows() != rows_) throw InvalidInput("WindingTree::jump: E does not have #V rows");
+  const Moments d = moments(M, sign);
+  const auto n = static_cast<Eigen::Index>(order_.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
+  parallel_for(n, threads, [&](std::int64_t t) {
+    const int row = order_[static_cast<std::size_t>(t)];
+    const Eigen::Vector3d e = E.row(row).transpose();
+    if (!e.allFinite() || e.isZero()) return;
+    const Eigen::Vector3d p = P_.row(t).transpose(), m = d.M.row(t).transpose();
+    const double own = s2_[t];
+    // The own dipole's term at p -/+ e is +/- m . e / rho^3: left out of both.
+    const double self = dipole_term(m.dot(e), e.squaredNorm() + 2.0 * own);
+    const double inside = winding_sum(p - e, own, d) - self;
+    const double outside = winding_sum(p + e, own, d) + self;
+    out[row] = kInvFourPi * (inside - outside);
   });
   return out;
 }
@@ -283,7 +318,7 @@ Eigen::VectorXd WindingTree::near_column_norms(const RowMatrixX3d& M, int thread
             const Eigen::Vector3d r = p - P_.row(i).transpose();
             const double rho2 = r.squaredNorm() + own + s2_[i];
             if (rho2 == 0.0) continue;
-            const double k = m.dot(r) / (rho2 * std::sqrt(rho2));
+            const double k = dipole_term(m.dot(r), rho2);
             sum += k * k;
           }
         });

@@ -38,6 +38,14 @@ class WindingTree {
   [[nodiscard]] Eigen::VectorXd winding(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
                                         int threads) const;
 
+  /// w(p_i - e_i) - w(p_i + e_i) at every point p_i of V for offsets E (#V x 3), dipoles M
+  /// times `sign` as in winding(), the term of point i's own dipole left out, each offset point
+  /// smoothed as p_i: the field's jump across the surface along e_i, about 1 where e_i (shorter
+  /// than the distance to any other sheet) points out of a closed surface sampled with outward
+  /// dipoles, about -1 where it points in. 0 where E's row is zero or not finite.
+  [[nodiscard]] Eigen::VectorXd jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
+                                     const Eigen::VectorXd& sign, int threads) const;
+
   /// g_j (#V x 3) at every point of V for charges q (#V).
   [[nodiscard]] RowMatrixX3d field(const Eigen::VectorXd& q, int threads) const;
 
@@ -62,6 +70,16 @@ class WindingTree {
     int children = 0;
     double s2 = 0.0;  ///< the mean of its points' half squared smoothing lengths
   };
+  /// The dipoles in tree order (rows times their sign, zero where not finite) and their
+  /// moments about each node's centre.
+  struct Moments {
+    RowMatrixX3d M;
+    std::vector<Eigen::Vector3d> sum;     ///< sum m_j
+    std::vector<Eigen::Matrix3d> second;  ///< sum m_j (p_j - c)^T
+  };
+  [[nodiscard]] Moments moments(const RowMatrixX3d& M, const Eigen::VectorXd& sign) const;
+  /// 4 pi w at q, smoothed by `own` (half its squared smoothing length), of the dipoles `d`.
+  [[nodiscard]] double winding_sum(const Eigen::Vector3d& q, double own, const Moments& d) const;
   /// Splits `node` (its rows in order_, its cube's corner `low` and side `size`) into octants.
   void build(PositionsRef V, int node, const Eigen::Vector3d& low, double size, int depth);
   /// The cells for a point q, in the tree's fixed order: far(node, index, |q - centre|^2) for
