@@ -32,11 +32,20 @@ std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
 }
 
 /// Opens a new temporary file; "x" makes the create exclusive so no existing file is reused.
-std::FILE* open_temporary(const std::filesystem::path& path, std::filesystem::path& temp) {
+/// Its path is in the signal handler's table (`slot`) before the file exists, so that no signal
+/// can come between the two and leave a file the handler does not know of (unlinking a path
+/// not yet created is harmless).
+std::FILE* open_temporary(const std::filesystem::path& path, std::filesystem::path& temp,
+                          int& slot) {
   for (int attempt = 0; attempt < 16; ++attempt) {
     temp = temporary_path_for(path);
+    slot = register_temporary(temp.c_str());
     std::FILE* file = std::fopen(temp.c_str(), "wbx");
     if (file != nullptr) return file;
+    const int saved_errno = errno;
+    release_temporary(slot);  // not ours: another file of that name, or none
+    slot = -1;
+    errno = saved_errno;
     if (errno != EEXIST) break;
   }
   fail(path, std::string("cannot create a temporary file in its folder: ") + std::strerror(errno));
@@ -53,16 +62,17 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
     target_ = std::filesystem::canonical(target, ec);
     if (ec) fail(target, "is a symbolic link to a missing file or folder; not written");
   }
-  file_ = open_temporary(target_, temporary_);
-  slot_ = register_temporary(temporary_.c_str());
+  file_ = open_temporary(target_, temporary_, slot_);
 }
 
 AtomicFile::~AtomicFile() {
+  if (!committed_) {
+    if (file_ != nullptr) std::fclose(file_);
+    std::error_code ignored;
+    std::filesystem::remove(temporary_, ignored);
+  }
+  // Out of the table only once the file is gone: a signal before then still removes it.
   release_temporary(slot_);
-  if (committed_) return;
-  if (file_ != nullptr) std::fclose(file_);
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
 }
 
 void AtomicFile::commit() {
