@@ -58,13 +58,20 @@ constexpr double kMaxCreaseMove = 4.0;
 /// gathered once for all passes (the positions move, the neighbourhoods do not) and packed: the
 /// gaps between consecutive entries (the first: v minus it) as LEB128 varints, one byte each for
 /// gaps below 128 (a few bytes an entry where nearby vertices have nearby indices, at most five).
+/// In blocks of kBlock vertices, each block's bytes their own array (gathered in parallel, kept
+/// as they are: no joined copy).
 struct PackedRings {
-  std::vector<std::uint64_t> offsets;  ///< #V + 1, into bytes
-  std::vector<std::uint8_t> bytes;
+  static constexpr std::int64_t kBlock = 4096;
+  /// #V: the end of each vertex's bytes in its block (a vertex starts where the one before ends,
+  /// the first of a block at 0).
+  std::vector<std::uint32_t> ends;
+  std::vector<std::vector<std::uint8_t>> blocks;
 
   void unpack(int v, std::vector<int>& ring) const {
-    const std::uint8_t* p = bytes.data() + offsets[static_cast<std::size_t>(v)];
-    const std::uint8_t* end = bytes.data() + offsets[static_cast<std::size_t>(v) + 1];
+    const auto k = static_cast<std::size_t>(v);
+    const std::uint8_t* block = blocks[k / kBlock].data();
+    const std::uint8_t* p = block + (k % kBlock == 0 ? 0 : ends[k - 1]);
+    const std::uint8_t* end = block + ends[k];
     ring.resize(static_cast<std::size_t>(end - p));  // at most one entry a byte
     int* out = ring.data();
     const auto gap = [&p] {
@@ -124,52 +131,52 @@ void neighbourhood_of(const Neighbours& nb, int i, Scratch& s) {
   }
 }
 
-/// The rings of every vertex, packed (PackedRings): per block of vertices, then joined in order.
+/// The rings of every vertex, packed (PackedRings), a block of vertices at a time.
 PackedRings gathered_rings(const Neighbourhoods& one, int rings) {
   const int n = one.vertex_count();
-  constexpr std::int64_t kBlock = 4096;
-  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+  constexpr std::int64_t kBlock = PackedRings::kBlock;
   struct Gather {
     std::vector<std::uint64_t> in_ring;
     std::vector<int> ring;
   };
   detail::PerThread<Gather> scratch(0);
-  std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(blocks));
   PackedRings out;
-  out.offsets.resize(static_cast<std::size_t>(n) + 1);
+  out.ends.resize(static_cast<std::size_t>(n));
+  out.blocks.resize(static_cast<std::size_t>((n + kBlock - 1) / kBlock));
   detail::parallel_for_blocks(n, kBlock, 0, [&](std::int64_t begin, std::int64_t end) {
     Gather& g = scratch.local();
-    std::vector<std::uint8_t>& bytes = packed[static_cast<std::size_t>(begin / kBlock)];
+    std::vector<std::uint8_t>& bytes = out.blocks[static_cast<std::size_t>(begin / kBlock)];
     for (std::int64_t v = begin; v < end; ++v) {
       detail::jets::gather_ring(one, static_cast<int>(v), rings, g.in_ring, nullptr, g.ring);
       pack_ring(static_cast<int>(v), g.ring, bytes);
-      out.offsets[static_cast<std::size_t>(v) + 1] = bytes.size();  // within the block
+      out.ends[static_cast<std::size_t>(v)] = static_cast<std::uint32_t>(bytes.size());
     }
+    bytes.shrink_to_fit();
   });
-  std::size_t total = 0;
-  for (const auto& bytes : packed) total += bytes.size();
-  out.bytes.reserve(total);
-  out.offsets[0] = 0;
-  for (std::int64_t k = 0; k < blocks; ++k) {
-    const std::uint64_t base = out.bytes.size();
-    for (std::int64_t v = k * kBlock; v < std::min<std::int64_t>(n, (k + 1) * kBlock); ++v)
-      out.offsets[static_cast<std::size_t>(v) + 1] += base;
-    auto& bytes = packed[static_cast<std::size_t>(k)];
-    out.bytes.insert(out.bytes.end(), bytes.begin(), bytes.end());
-    std::vector<std::uint8_t>().swap(bytes);
-  }
   return out;
 }
 
 /// One pass: every point's surface, in the frame of its row of `frames`.
 struct Pass {
-  RowMatrixX3d V, N;
+  RowMatrixX3d V;
+  /// The fitted normals; at points without a fit their frames (so that N is the next pass's
+  /// frames as it is: a point without a fit keeps its frame), `fitted` 0 there.
+  RowMatrixX3d N;
   Eigen::VectorXd residual;       ///< per point, while the pass runs (freed after: its median kept)
   double median_residual = kNaN;  ///< of the fitted points
+  std::vector<char> fitted;       ///< the point had a well-posed fit
   std::vector<char> outlier;      ///< the point itself lay far off its surface
   VectorXu8 crease;               ///< on several sides of a crease
   int crease_points = 0, unfitted = 0;
 };
+
+/// A pass's normals as a result: NaN rows at the points without a fit.
+RowMatrixX3d result_normals(RowMatrixX3d N, const std::vector<char>& fitted) {
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    if (!fitted[static_cast<std::size_t>(i)]) N.row(i).setConstant(kNaN);
+  }
+  return N;
+}
 
 /// The surface of point i: over its whole neighbourhood; or, where its neighbours' normals fall
 /// into sides of a crease (keep_creases), each side's surface, the point moved onto the one it
@@ -277,6 +284,7 @@ Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
   p.V.resize(n, 3);
   p.N.resize(n, 3);
   p.residual.resize(n);
+  p.fitted.assign(static_cast<std::size_t>(n), 0);
   p.outlier.assign(static_cast<std::size_t>(n), 0);
   p.crease = VectorXu8::Zero(n);
   detail::PerThread<Scratch> scratch(0);
@@ -285,13 +293,14 @@ Pass run_pass(PositionsRef V, const RowMatrixX3d& frames, const Neighbours& nb,
     const auto store = [&](int i, const LocalSurface& f) {
       if (!f.ok) {
         p.V.row(i) = V.row(i);
-        p.N.row(i).setConstant(kNaN);
+        p.N.row(i) = frames.row(i);
         p.residual[i] = kNaN;
         return;
       }
       p.V.row(i) = f.point.transpose();
       p.N.row(i) = f.normal.transpose();
       p.residual[i] = f.residual;
+      p.fitted[static_cast<std::size_t>(i)] = 1;
       p.outlier[static_cast<std::size_t>(i)] = f.centre_rejected;
     };
     int row[detail::jets::kMaxLanes];
@@ -363,11 +372,11 @@ void to_side_of(NormalsRef reference, RowMatrixX3d& N) {
   if (against > along) N = -N;
 }
 
-/// The result of a pass as the smoothing's result.
-void keep(const Pass& p, SmoothResult& out) {
-  out.V = p.V;
-  out.N = p.N;
-  out.crease = p.crease;
+/// The result of a pass as the smoothing's result (the pass is not needed after).
+void keep(Pass&& p, SmoothResult& out) {
+  out.V = std::move(p.V);
+  out.N = result_normals(std::move(p.N), p.fitted);
+  out.crease = std::move(p.crease);
   out.crease_points = p.crease_points;
   out.unfitted = p.unfitted;
 }
@@ -376,7 +385,8 @@ void keep(const Pass& p, SmoothResult& out) {
 /// `scale` the mean edge length or spacing. Pass t fits P_t (measuring its noise r_t) and gives
 /// P_t+1 with its normals. Automatic stop: P_t is kept while r_t <= min_noise_fall x r_t-1; the
 /// first P_t that is not stops the passes with P_t-1 (P_0, the input, but for the first pass's
-/// outliers, which are moved whatever the noise).
+/// outliers, which are moved whatever the noise). Held while a pass runs: the kept result, the
+/// pass's input P_t with its normals (its frames) and its output.
 SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, const SmoothOptions& o,
                  double scale, bool refine_frames) {
   const Execution& e = current_execution();
@@ -389,19 +399,17 @@ SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, cons
     // Noisy input: Max's normals tilt with the faces (beyond 45 degrees under noise of an edge),
     // and a quadric over a tilted frame fits the surface badly; the first pass then runs in the
     // frame of a first fit's normals (the recommended jets' second fit, recommended.h).
-    const Pass first = run_pass(V, frames, nb, o, scale);
-    for (Eigen::Index i = 0; i < V.rows(); ++i) {
-      if (first.N.row(i).allFinite()) frames.row(i) = first.N.row(i);
-    }
+    frames = run_pass(V, frames, nb, o, scale).N;
   }
-  Pass next;  // the last pass: P_t+1 and its normals
+  Pass next;  // the last pass: P_t+1 and its normals, the frames of the next pass
   for (int t = 0; t < passes; ++t) {
     check_cancel(e, t);
     if (e.progress) e.progress({"smooth", static_cast<double>(t) / passes});
-    Pass p = run_pass(t == 0 ? V : PositionsRef(next.V), frames, nb, o, scale);
+    Pass p = t == 0 ? run_pass(V, frames, nb, o, scale) : run_pass(next.V, next.N, nb, o, scale);
     const double noise = p.median_residual / scale;
     if (t == 0) {
-      out.N = p.N;
+      frames = RowMatrixX3d();  // p.N from now on
+      out.N = result_normals(p.N, p.fitted);
       out.unfitted = p.unfitted;
       for (const char c : p.outlier) out.outliers_moved += c;
       if (automatic) {
@@ -412,18 +420,14 @@ SmoothResult run(PositionsRef V, RowMatrixX3d frames, const Neighbours& nb, cons
       }
     } else if (automatic) {
       if (!(noise <= o.min_noise_fall * out.noise.back())) break;
-      keep(next, out);  // P_t is kept
+      keep(std::move(next), out);  // P_t is kept
       out.iterations = t;
     }
     out.noise.push_back(noise);
-    // Rows without a fit keep their frame (and are not moved) in the next pass.
-    for (Eigen::Index i = 0; i < V.rows(); ++i) {
-      if (p.N.row(i).allFinite()) frames.row(i) = p.N.row(i);
-    }
     next = std::move(p);
   }
   if (!automatic) {
-    keep(next, out);
+    keep(std::move(next), out);
     out.iterations = passes;
   }
   if (e.progress) e.progress({"smooth", 1.0});
@@ -438,14 +442,18 @@ RowMatrixX3d face_normals(const PreparedMesh& mesh) {
 
 SmoothResult smooth_mesh(const PreparedMesh& mesh, const SmoothOptions& o) {
   const double h = mesh.mean_edge_length();
-  const std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
+  std::shared_ptr<const Neighbourhoods> one = detail::one_ring(mesh);
   const RecommendedPlan plan = recommended_plan(mesh.with_normals(std::nullopt));
+  RowMatrixX3d max = face_normals(mesh);
+  // The passes need neither the incidence nor (but for the crease sides) the 1-ring: their
+  // memory goes to the passes' arrays (it is built again if the mesh's owner asks for it).
+  detail::PreparedAccess::release_incidence(mesh);
   const int rings = o.rings > 0 ? o.rings : plan.rings > 1 ? plan.jet_rings : kCleanRings;
   const PackedRings packed = gathered_rings(*one, rings);
+  if (!o.keep_creases) one.reset();
   Neighbours nb;
   nb.one_ring = one.get();
   nb.rings = &packed;
-  RowMatrixX3d max = face_normals(mesh);
   // Without keep_creases the input's normals are the first frames only (no copy kept).
   nb.sides_of = o.keep_creases ? &max : nullptr;
   SmoothResult out = run(mesh.V(), o.keep_creases ? RowMatrixX3d(max) : std::move(max), nb, o, h,

@@ -80,6 +80,20 @@ void misfits(int degree, FitScratch& s) {
   }
 }
 
+/// The fitted height at the origin, as misfits() evaluates it for the point at (0, 0).
+double height_at_origin(int degree, const double* c) {
+  switch (degree) {
+    case 4:
+      return height_at<4>(c, 0.0, 0.0);
+    case 3:
+      return height_at<3>(c, 0.0, 0.0);
+    case 2:
+      return height_at<2>(c, 0.0, 0.0);
+    default:
+      return height_at<1>(c, 0.0, 0.0);
+  }
+}
+
 /// Refits s.points flagged in s.keep; the residuals of all points against it into s.misfit.
 bool fit_kept(int degree, FitScratch& s) {
   s.kept_points.clear();
@@ -122,7 +136,6 @@ bool centre_off(int degree, double floor, FitScratch& s) {
   const int m = coefficient_count(degree);
   double c[jets::kMaxCoefficients];
   std::copy(s.batch.c, s.batch.c + m, c);
-  s.saved_misfit = s.misfit;
   // The fit without the point itself from the least-squares fit's moments: the point is the
   // origin, which adds 1 to the count and +0 to every other sum, so the sums without it are
   // those with 1 taken off the count (the bits of a fit to the others alone).
@@ -132,14 +145,17 @@ bool centre_off(int degree, double floor, FitScratch& s) {
   bool off = false;
   const bool solved = jets::solve_moments(degree, b, b.count[0] - 1);
   b.xy[0] = count;
-  if (solved) {
+  // The point's own residual against that fit (misfits' value at the origin, the same bits):
+  // within the floor it is no outlier, and the others' residuals need not be evaluated.
+  if (solved && std::abs(0.0 - height_at_origin(degree, b.c)) > floor) {
+    s.saved_misfit = s.misfit;
     misfits(degree, s);
     // The others' residuals alone set the scale.
     off = beyond_robust_scales(s.misfit.data() + 1, s.misfit.size() - 1, kSuspectScales, floor,
                                std::abs(s.misfit[0]));
+    s.misfit.swap(s.saved_misfit);
   }
   std::copy(c, c + m, s.batch.c);
-  s.misfit.swap(s.saved_misfit);
   s.keep.assign(s.points.size(), 1);
   return off;
 }
