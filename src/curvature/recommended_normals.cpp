@@ -15,6 +15,7 @@
 #include "focal/normals/jets.h"
 #include "mesh/prepared_access.h"
 #include "normals/jet_normals_from.h"
+#include "normals/jet_points.h"
 
 namespace focal::detail::recommended {
 namespace {
@@ -135,6 +136,78 @@ RowMatrixX3d turned_with_neighbours(const Context& c, RowMatrixX3d N) {
   });
   for (Eigen::Index i = 0; i < N.rows(); ++i) {
     if (turn[static_cast<std::size_t>(i)]) N.row(i) = -N.row(i);
+  }
+  return N;
+}
+
+/// Rows of a jet's normal more than this angle from their patch normal (acos 0.5 = 60 degrees):
+/// no smooth surface turns so much over a jet's rings; such a jet fitted a graph over a frame
+/// that folded faces tilted.
+constexpr double kRealignCosine = 0.5;
+
+/// A patch's vector area against its area at least this (a patch that does not fold onto
+/// itself: a thin part's two sides within the rings cancel) for its normal to judge a jet's.
+constexpr double kFlatPatch = 0.5;
+
+/// The unit vector area (the sum of the faces' area vectors) of the faces with every corner
+/// within `rings` rings of v, or zero where they fold onto themselves (kFlatPatch). A disc's
+/// vector area is set by its boundary alone: folded faces inside the patch, as strong noise
+/// makes them at a regular mesh's pole, do not turn it. `ring`, `in_ring`: scratch.
+Eigen::Vector3d patch_normal(const Context& c, const detail::VertexFaces& incidence, int v,
+                             int rings, std::vector<int>& ring,
+                             std::vector<std::uint64_t>& in_ring) {
+  const PositionsRef& V = c.mesh.V();
+  const FacesRef& F = c.mesh.F();
+  detail::jets::gather_ring(*c.one_ring, v, rings, in_ring, nullptr, ring);
+  const auto inside = [&](int x) { return std::binary_search(ring.begin(), ring.end(), x); };
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const int w : ring) {
+    for (int k = incidence.begin(w); k < incidence.end(w); ++k) {
+      const int f = incidence.faces[static_cast<std::size_t>(k)];
+      const int a = F(f, 0), b = F(f, 1), d = F(f, 2);
+      // Each face once, at its smallest corner.
+      if (std::min({a, b, d}) != w || !inside(a) || !inside(b) || !inside(d)) continue;
+      const Eigen::Vector3d pa = V.row(a).transpose();
+      const Eigen::Vector3d n = (V.row(b).transpose() - pa).cross(V.row(d).transpose() - pa);
+      if (!n.allFinite()) continue;
+      sum += n;
+      area += n.norm();
+    }
+  }
+  return area > 0.0 && sum.norm() >= kFlatPatch * area ? Eigen::Vector3d(sum.normalized())
+                                                       : Eigen::Vector3d::Zero();
+}
+
+/// `N` (jets of options `o`) turned to the side of each row's patch normal over the jets'
+/// rings where there is one, and each row still far from it (kRealignCosine) fitted again in
+/// its frame, kept where the new jet is nearer to it. Folded faces come in clusters (a pole's
+/// fan) whose Max normals, the jets' first frames, turn or tilt together, so that the 1-ring's
+/// normals cannot tell; the patch reaches past the cluster.
+RowMatrixX3d oriented_by_patches(const Context& c, RowMatrixX3d N, const JetOptions& o) {
+  const auto& incidence = *detail::incidence(c.mesh);
+  RowMatrixX3d patch(N.rows(), 3);
+  detail::parallel_for_blocks(N.rows(), 1024, 0, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<int> ring;
+    std::vector<std::uint64_t> in_ring;
+    for (std::int64_t i = begin; i < end; ++i) {
+      patch.row(i) = patch_normal(c, incidence, static_cast<int>(i), o.rings, ring, in_ring);
+    }
+  });
+  std::vector<int> far;
+  for (Eigen::Index i = 0; i < N.rows(); ++i) {
+    const Eigen::RowVector3d p = patch.row(i);
+    if (p.isZero() || !N.row(i).allFinite()) continue;
+    if (N.row(i).dot(p) < 0.0) N.row(i) = -N.row(i);
+    if (N.row(i).dot(p) < kRealignCosine) far.push_back(static_cast<int>(i));
+  }
+  if (far.empty()) return N;
+  // The refits' first frames: the patch normals (rows other than `far` are not read).
+  const JetNormals refit = detail::jet_normals_at(c.mesh.V(), *c.one_ring, patch, o, far);
+  for (std::size_t k = 0; k < far.size(); ++k) {
+    const int v = far[k];
+    const Eigen::RowVector3d n = refit.N.row(static_cast<Eigen::Index>(k));
+    if (n.allFinite() && n.dot(patch.row(v)) > N.row(v).dot(patch.row(v))) N.row(v) = n;
   }
   return N;
 }
@@ -273,8 +346,10 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
       // Noisy positions: normals from wider, lower-degree jets that average the noise.
       JetOptions o = jet_options(out.plan.jet_rings, out.plan.jet_degree);
       o.iterations = out.plan.jet_iterations;
-      out.N =
-          turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N);
+      out.N = oriented_by_patches(
+          c,
+          turned_with_neighbours(c, detail::jet_normals_from(c.mesh.V(), *c.one_ring, c.max, o).N),
+          o);
     } else {
       // The jets where Max's normals are not clearly smoother: Max's are exact on spheres, but
       // first-order (rough) on irregular meshes.
