@@ -15,7 +15,6 @@
 #include "focal/normals/jets.h"
 #include "mesh/prepared_access.h"
 #include "normals/jet_normals_from.h"
-#include "normals/jet_points.h"
 
 namespace focal::detail::recommended {
 namespace {
@@ -149,34 +148,45 @@ constexpr double kRealignCosine = 0.5;
 /// itself: a thin part's two sides within the rings cancel) for its normal to judge a jet's.
 constexpr double kFlatPatch = 0.5;
 
-/// The unit vector area (the sum of the faces' area vectors) of the faces with every corner
-/// within `rings` rings of v, or zero where they fold onto themselves (kFlatPatch). A disc's
-/// vector area is set by its boundary alone: folded faces inside the patch, as strong noise
-/// makes them at a regular mesh's pole, do not turn it. `ring`, `in_ring`: scratch.
-Eigen::Vector3d patch_normal(const Context& c, const detail::VertexFaces& incidence, int v,
-                             int rings, std::vector<int>& ring,
-                             std::vector<std::uint64_t>& in_ring) {
+/// Each vertex's patch normal over `rings` rings: the faces' area vectors at each vertex
+/// (columns 0-2) with their areas (column 3), summed over the vertex and its 1-ring `rings`
+/// times: a weighted vector area of the faces within `rings` + 1 rings, unit, or zero where it
+/// folds onto itself (kFlatPatch). Folded slivers, as strong noise makes them at a regular
+/// mesh's pole, weigh by their small areas and do not turn it.
+RowMatrixX3d patch_normals(const Context& c, int rings) {
   const PositionsRef& V = c.mesh.V();
   const FacesRef& F = c.mesh.F();
-  detail::jets::gather_ring(*c.one_ring, v, rings, in_ring, nullptr, ring);
-  const auto inside = [&](int x) { return std::binary_search(ring.begin(), ring.end(), x); };
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double area = 0.0;
-  for (const int w : ring) {
-    for (int k = incidence.begin(w); k < incidence.end(w); ++k) {
+  const auto& incidence = *detail::incidence(c.mesh);
+  using Sums = Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>;
+  Sums sums(V.rows(), 4), next(V.rows(), 4);
+  detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    for (int k = incidence.begin(v); k < incidence.end(v); ++k) {
       const int f = incidence.faces[static_cast<std::size_t>(k)];
-      const int a = F(f, 0), b = F(f, 1), d = F(f, 2);
-      // Each face once, at its smallest corner.
-      if (std::min({a, b, d}) != w || !inside(a) || !inside(b) || !inside(d)) continue;
-      const Eigen::Vector3d pa = V.row(a).transpose();
-      const Eigen::Vector3d n = (V.row(b).transpose() - pa).cross(V.row(d).transpose() - pa);
-      if (!n.allFinite()) continue;
-      sum += n;
-      area += n.norm();
+      const Eigen::Vector3d a = V.row(F(f, 0)).transpose();
+      const Eigen::Vector3d n =
+          (V.row(F(f, 1)).transpose() - a).cross(V.row(F(f, 2)).transpose() - a);
+      if (n.allFinite()) sum += Eigen::Vector4d(n.x(), n.y(), n.z(), n.norm());
     }
+    sums.row(v) = sum.transpose();
+  });
+  for (int r = 0; r < rings; ++r) {
+    detail::parallel_for(V.rows(), 0, [&](std::int64_t v) {
+      Eigen::RowVector4d sum = sums.row(v);
+      const int u = static_cast<int>(v);
+      for (const int* j = c.one_ring->begin(u); j != c.one_ring->end(u); ++j) sum += sums.row(*j);
+      next.row(v) = sum;
+    });
+    sums.swap(next);
   }
-  return area > 0.0 && sum.norm() >= kFlatPatch * area ? Eigen::Vector3d(sum.normalized())
-                                                       : Eigen::Vector3d::Zero();
+  RowMatrixX3d out(V.rows(), 3);
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d n = sums.row(v).head<3>().transpose();
+    const double area = sums(v, 3);
+    out.row(v) = area > 0.0 && n.norm() >= kFlatPatch * area ? Eigen::RowVector3d(n.normalized())
+                                                             : Eigen::RowVector3d::Zero();
+  }
+  return out;
 }
 
 /// `N` (jets of options `o`) turned to the side of each row's patch normal over the jets'
@@ -185,15 +195,7 @@ Eigen::Vector3d patch_normal(const Context& c, const detail::VertexFaces& incide
 /// fan) whose Max normals, the jets' first frames, turn or tilt together, so that the 1-ring's
 /// normals cannot tell; the patch reaches past the cluster.
 RowMatrixX3d oriented_by_patches(const Context& c, RowMatrixX3d N, const JetOptions& o) {
-  const auto& incidence = *detail::incidence(c.mesh);
-  RowMatrixX3d patch(N.rows(), 3);
-  detail::parallel_for_blocks(N.rows(), 1024, 0, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<int> ring;
-    std::vector<std::uint64_t> in_ring;
-    for (std::int64_t i = begin; i < end; ++i) {
-      patch.row(i) = patch_normal(c, incidence, static_cast<int>(i), o.rings, ring, in_ring);
-    }
-  });
+  const RowMatrixX3d patch = patch_normals(c, o.rings);
   std::vector<int> far;
   for (Eigen::Index i = 0; i < N.rows(); ++i) {
     const Eigen::RowVector3d p = patch.row(i);
