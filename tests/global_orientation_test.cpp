@@ -137,9 +137,9 @@ int flipped(const test::Solid& s, CloudOrientation orientation) {
 
 // The two small cases, clean and with noise of 0.1 spacing, seeds 1-3: the tree alone turns a
 // whole side (plate: 1729-1845 of 3520 points flipped; spheres: one sphere, 800-802 of 1600);
-// the global orientation leaves 10-19 (0.3-0.5%) and 13-20 (0.8-1.25%, where the spheres are
+// the global orientation leaves 10-19 (0.3-0.5%) and 11-19 (0.7-1.2%, where the spheres are
 // within a fraction of a spacing of each other) flipped, NaN counted (docs/notes/points-log.md,
-// "Global orientation"). Asserted: the 1% on the plate, 2% on the spheres (whose 1% is
+// "Global orientation"). Asserted: the 1% on the plate, 1.5% on the spheres (whose 1% is
 // not reached on every seed), and the tree's failure itself (at least 45%), so that the case
 // stays a hard one.
 TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
@@ -150,7 +150,7 @@ TEST(GlobalOrientation, ThinPlateAndTouchingSpheres) {
         const auto n = static_cast<int>(s.V.rows());
         EXPECT_GE(flipped(s, CloudOrientation::mst), n * 45 / 100)
             << shape_name(shape) << " seed " << seed << " noise " << noise;
-        const int limit = shape == Shape::plate ? n / 100 : n * 2 / 100;
+        const int limit = shape == Shape::plate ? n / 100 : n * 3 / 200;
         EXPECT_LE(flipped(s, CloudOrientation::global), limit)
             << shape_name(shape) << " seed " << seed << " noise " << noise;
       }

@@ -103,16 +103,46 @@ WindingTree tree_of(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N,
   return WindingTree(V, smoothing, o.beta);
 }
 
-/// The jumps' offsets (#V x 3): along each row of `lines`, jump_offset times the square root of
-/// the point's area; zero where A has no dipole or the line is zero or not finite.
-RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& area, const RowMatrixX3d& A,
-                     const WindingOrientationOptions& o) {
+/// The jumps' lengths (#V): jump_offset times the square root of each point's area.
+Eigen::VectorXd jump_lengths(const Eigen::VectorXd& area, const WindingOrientationOptions& o) {
+  return o.jump_offset * area.cwiseMax(0.0).cwiseSqrt();
+}
+
+/// jump_lengths, each at most jump_gap times |n_i . e| over the point's neighbours in `graph`
+/// (renamed as in `segments`) whose chord e runs along both normals (|n . e| >= kAcrossChord |e|
+/// for n_i and n_j): the distance to another sheet across the point, where an offset that
+/// reaches past that sheet also reads its jump, of the opposite sign where two sheets face
+/// each other (a contact).
+Eigen::VectorXd contact_lengths(PositionsRef V, const Neighbourhoods& graph,
+                                const std::vector<int>* rename, const Eigen::VectorXd& area,
+                                const RowMatrixX3d& N, const WindingOrientationOptions& o) {
+  const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
+  Eigen::VectorXd length = jump_lengths(area, o);
+  for (int row = 0; row < static_cast<int>(V.rows()); ++row) {
+    const int i = name(row);
+    if (!N.row(i).allFinite()) continue;
+    const Eigen::RowVector3d n = N.row(i).normalized();
+    for (const int* jr = graph.begin(row); jr != graph.end(row); ++jr) {
+      const int j = name(*jr);
+      if (!N.row(j).allFinite()) continue;
+      const Eigen::RowVector3d e = V.row(j) - V.row(i);
+      const double along = std::abs(n.dot(e)), limit = kAcrossChord * e.norm();
+      if (along > 0.0 && along >= limit && std::abs(N.row(j).normalized().dot(e)) >= limit) {
+        length[i] = std::min(length[i], o.jump_gap * along);
+      }
+    }
+  }
+  return length;
+}
+
+/// The jumps' offsets (#V x 3): along each row of `lines`, its entry of `length`; zero where A
+/// has no dipole or the line is zero or not finite.
+RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
+                     const RowMatrixX3d& A) {
   RowMatrixX3d E = RowMatrixX3d::Zero(A.rows(), 3);
   for (Eigen::Index i = 0; i < A.rows(); ++i) {
     const double l = lines.row(i).norm();
-    if (!A.row(i).isZero() && l > 0.0 && std::isfinite(l)) {
-      E.row(i) = o.jump_offset * std::sqrt(area[i]) / l * lines.row(i);
-    }
+    if (!A.row(i).isZero() && l > 0.0 && std::isfinite(l)) E.row(i) = length[i] / l * lines.row(i);
   }
   return E;
 }
@@ -122,10 +152,10 @@ RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& area, con
 /// leaves the point's own dipole out, so a point alone in a consistent sheet follows the sheet,
 /// and across a thin part or a contact the nearer sheet's jump outweighs the other's. Returns
 /// the turns made.
-int turn_by_jumps(const WindingTree& tree, const Eigen::VectorXd& area, const RowMatrixX3d& A,
+int turn_by_jumps(const WindingTree& tree, const Eigen::VectorXd& length, const RowMatrixX3d& A,
                   const WindingOrientationOptions& options, Eigen::VectorXd& s, int threads) {
   const Eigen::Index n = A.rows();
-  const RowMatrixX3d E = offsets(A, area, A, options);
+  const RowMatrixX3d E = offsets(A, length, A);
   int total = 0;
   for (int round = 0; round < options.jump_rounds; ++round) {
     const Eigen::VectorXd J = tree.jump(E, A, s, threads);
@@ -147,7 +177,8 @@ int side_by_jumps(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, Row
                   int threads, const WindingOrientationOptions& options) {
   const RowMatrixX3d A = dipoles(V, area, N);
   const Eigen::VectorXd J = tree_of(V, area, N, options)
-                                .jump(offsets(L, area, A, options), A, Eigen::VectorXd(), threads);
+                                .jump(offsets(L, jump_lengths(area, options), A), A,
+                                      Eigen::VectorXd(), threads);
   int turned = 0;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (J[i] >= 0.0) continue;
@@ -285,7 +316,8 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   report.decided = report.residual_after <= options.closed_residual &&
                    report.residual_after <= options.closed_gain * report.residual_before;
   if (!report.decided) return report;
-  report.jump_turned = turn_by_jumps(tree, area, A, options, s, threads);
+  report.jump_turned = turn_by_jumps(tree, contact_lengths(V, graph, rename, area, N, options), A,
+                                     options, s, threads);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (s[i] > 0.0) continue;
     N.row(i) *= -1.0;

@@ -42,9 +42,12 @@ struct WindingOrientationOptions {
   double closed_gain = 0.4;
   double smoothing = 0.5;  ///< smoothing length of each point, times sqrt of its area
   /// Where the field decides, rounds of per-point turns by the field's jump across the point
-  /// (WindingTree::jump over its normal line, offsets jump_offset times sqrt of its area), at
-  /// most jump_rounds.
+  /// (WindingTree::jump over its normal line, offsets jump_offset times sqrt of its area, but at
+  /// most jump_gap times the distance to another sheet across the point), at most jump_rounds.
+  /// The jets' sides (side_by_jumps) take the offsets without the gap's limit: with it, thin
+  /// rings' jets came out worse (docs/notes/points-log.md, "Global orientation").
   double jump_offset = 0.5;
+  double jump_gap = 0.35;
   int jump_rounds = 3;
 };
 
