@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "core/result_rows.h"
 #include "curvature/corrected_step.h"
+#include "curvature/hermite_fit.h"
 #include "curvature/recommended_steps.h"
 #include "curvature/robust_fit.h"
 #include "curvature/spike_repair.h"
@@ -140,32 +141,77 @@ void refit_beside_creases(const Context& c, const PreparedMesh& fitted, const Ve
   robust_refit(c, fitted, 1, false, skip, near_flagged(c, skip, 1), false, fit);
 }
 
+/// Vertices within 2 rings of a crease vertex, set (empty: crease handling is off). The
+/// Hermite fit's rings and the corrected step's balls would reach across the crease there;
+/// refit_beside_creases and the per-triangle pass stay.
+std::vector<char> near_creases(const Context& c, const VectorXu8& crease) {
+  std::vector<char> out(crease.begin(), crease.end());
+  if (!out.empty()) {
+    for (const int v : near_flagged(c, out, 2)) out[static_cast<std::size_t>(v)] = 1;
+  }
+  return out;
+}
+
+/// Trusted file normals on clean positions: the quartic Hermite fit (curvature/hermite_fit.h)
+/// where the two-slit fit is not exact, except near creases, with the `repaired` spikes'
+/// positions (exact to third order only) and the normals that are not the file's in no other
+/// vertex's fit; returns the rows it wrote.
+std::vector<char> hermite(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
+                          const std::vector<int>& repaired, CurvatureResult& fit) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+  const auto count = static_cast<std::size_t>(c.mesh.vertex_count());
+  std::vector<char> moved;
+  if (!repaired.empty()) {
+    moved.assign(count, 0);
+    for (const int v : repaired) moved[static_cast<std::size_t>(v)] = 1;
+  }
+  // The fitted normals that are not the file's (outliers replaced by the positions' normals).
+  std::vector<char> guessed(count, 0);
+  const NormalsRef file = *c.mesh.normals();
+  detail::parallel_for(c.mesh.vertex_count(), 0, [&](std::int64_t v) {
+    const Eigen::RowVector3d n = file.row(v);
+    guessed[static_cast<std::size_t>(v)] = !(unit.N.row(v).dot(n) >= (1.0 - 1e-12) * n.norm());
+  });
+  return detail::prefer_hermite_fit(fitted.V(), unit.N, unit.ok, *c.one_ring,
+                                    *detail::incidence(c.mesh), near_creases(c, crease), moved,
+                                    guessed, kExactFitResidual,
+                                    detail::class_tolerances(paper_options(c), c.edge_length), fit);
+}
+
 /// Trusted file normals on clean positions: the corrected curvature measures
-/// (curvature/corrected_step.h) where the fit is not exact, except within 2 rings of a crease
-/// (their balls would reach across it; refit_beside_creases and the per-triangle pass stay).
-/// `asymmetry`: detail::stencil_asymmetry of the fitted normals.
+/// (curvature/corrected_step.h) where the fit is not exact, except near creases and where
+/// `written` (the Hermite fit's rows) is set; no measure, and no stencil asymmetry, where no
+/// vertex is left (a clean mesh the Hermite fit covers).
 detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
-                                const VectorXu8& crease, Eigen::VectorXd asymmetry,
+                                const VectorXu8& crease, const std::vector<char>& written,
                                 const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
-  std::vector<char> keep(crease.begin(), crease.end());  // empty: crease handling is off
-  if (!keep.empty()) {
-    for (const int v : near_flagged(c, keep, 2)) keep[static_cast<std::size_t>(v)] = 1;
-  }
+  std::vector<char> keep = near_creases(c, crease);
   // A vertex of one face keeps that face's operator (its spread, the residual, is 0: the
   // per-triangle pass's row counts as exact, as it did when the pass ran first).
   keep.resize(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
   const auto incidence = detail::incidence(c.mesh);
+  bool any = false;
   for (int v = 0; v < c.mesh.vertex_count(); ++v) {
-    if (incidence->size(v) < 2) keep[static_cast<std::size_t>(v)] = 1;
+    const auto i = static_cast<std::size_t>(v);
+    if (incidence->size(v) < 2 || written[i]) keep[i] = 1;
+    any = any || (!keep[i] && !(fit.residual[v] <= kExactFitResidual));
   }
-  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual, fit,
-                                std::move(asymmetry));
+  if (!any) return {{}, std::vector<char>(keep.size(), 0)};
+  return detail::corrected_rows(fitted, *c.one_ring, paper_options(c), keep, kExactFitResidual,
+                                fit);
 }
+
+/// Positions with spikes moved back, and the spikes (ascending).
+struct Repaired {
+  RowMatrixX3d V;
+  std::vector<int> spikes;
+};
 
 /// Spikes on trusted file normals (spike_repair.h): the positions with each spike moved back
 /// onto the surface its neighbours and the normals describe, or nothing when there is none.
-std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
+std::optional<Repaired> spike_repaired(const Context& c) {
   // Unit rows of its own, not the mesh's kept ones: nothing after this step reads them, and kept
   // they would stay alive through the fit and the per-triangle pass (24 B a vertex).
   std::vector<char> ok;
@@ -173,13 +219,13 @@ std::optional<RowMatrixX3d> spike_repaired(const Context& c) {
   const Eigen::VectorXd offset = detail::normal_offsets(c.mesh.V(), N, *c.one_ring, 0);
   const std::vector<int> spikes = detail::find_spikes(c.mesh.V(), N, *c.one_ring, offset);
   if (spikes.empty()) return std::nullopt;
-  return detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes);
+  return Repaired{detail::repaired_positions(c.mesh.V(), N, *c.one_ring, offset, spikes), spikes};
 }
 
 /// Spikes without trusted normals (mesh/position_spikes.h, judged from the positions with Max's
 /// normals as the screen's directions): the positions with each spike moved onto the quadric
 /// of its 2-ring without it, or nothing when there is none.
-std::optional<RowMatrixX3d> position_spike_repaired(const Context& c) {
+std::optional<Repaired> position_spike_repaired(const Context& c) {
   const detail::PositionSpikes spikes = detail::position_spikes(
       c.mesh.V(), c.mesh.F(), *c.one_ring, *detail::incidence(c.mesh), c.max, 0);
   if (spikes.vertices.empty()) return std::nullopt;
@@ -187,32 +233,33 @@ std::optional<RowMatrixX3d> position_spike_repaired(const Context& c) {
   for (std::size_t k = 0; k < spikes.vertices.size(); ++k) {
     V.row(spikes.vertices[k]) = spikes.repaired[k].transpose();
   }
-  return V;
+  return Repaired{std::move(V), spikes.vertices};
 }
 
 }  // namespace
 
 namespace {
 
-/// estimate_curvature_recommended; `repair_spikes`: step 4 may start again on repaired positions.
+/// estimate_curvature_recommended; `repair_spikes`: step 7 may start again on repaired
+/// positions; `repaired`: the vertices it moved, when it did.
 RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& options,
-                           bool repair_spikes) {
+                           bool repair_spikes, const std::vector<int>& repaired = {}) {
   Context c = make_context(mesh, options);
   RecommendedResult out;
   const RecommendedMeshWide mesh_wide = choose_normals(c, out);
   if (repair_spikes && out.plan.rings == 1) {
-    // Spikes (step 4): the whole estimate again on the repaired positions, with this mesh's
+    // Spikes (step 7): the whole estimate again on the repaired positions, with this mesh's
     // mesh-wide choices and scale (away from the spikes the positions, and so the estimate, are
     // the same). With trusted normals the normals tell where a spike belongs; without, the
     // positions around it.
-    if (const std::optional<RowMatrixX3d> V =
+    if (const std::optional<Repaired> r =
             out.file_normals_used ? spike_repaired(c) : position_spike_repaired(c)) {
       RecommendedOptions o = options;
       o.mesh_wide = mesh_wide;
       const PreparedMesh repaired = detail::PreparedAccess::make(
-          *V, mesh.F(), mesh.normals(), {.mean_edge_length = c.edge_length},
+          r->V, mesh.F(), mesh.normals(), {.mean_edge_length = c.edge_length},
           "estimate_curvature_recommended");
-      return estimate(repaired, o, false);
+      return estimate(repaired, o, false, r->spikes);
     }
   }
   // Max's normals served the choice of normals only: their memory is the later steps'.
@@ -221,23 +268,17 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
   const PreparedMesh fitted = mesh.with_normals(out.N);
   const std::vector<char> no_skip;
   if (out.plan.rings == 1) {
-    // The corrected step's stencil asymmetry before the fit: its two arrays are then not alive
-    // beside the fit's result (the peak of a run at 1M).
-    Eigen::VectorXd asymmetry;
-    if (out.file_normals_used) {
-      asymmetry =
-          detail::stencil_asymmetry(fitted.V(), detail::unit_normals(fitted).N, *c.one_ring, 0);
-    }
     out.curvature = two_slit_fit(c, fitted, out.plan.rings, out.plan.gaussian);
-    // The corrected step first: the per-triangle pass then skips the rows it replaces. Both
-    // judge the fit's residual (whether it is exact) of rows the other does not write, so the
-    // measures are written (and their whole-mesh result freed) before the pass runs.
+    // The Hermite fit, then the corrected step where it wrote no row: the per-triangle pass
+    // then skips the rows they replace. Each judges the fit's residual (whether it is exact) of
+    // rows the others do not write, so the measures are written (and their whole-mesh result
+    // freed) before the pass runs.
     std::vector<char> replaced;
     if (out.file_normals_used) {
-      detail::CorrectedRows measures =
-          corrected(c, fitted, out.crease, std::move(asymmetry), out.curvature);
+      replaced = hermite(c, fitted, out.crease, repaired, out.curvature);
+      detail::CorrectedRows measures = corrected(c, fitted, out.crease, replaced, out.curvature);
       detail::apply_corrected_rows(measures, 0, out.curvature);
-      replaced = std::move(measures.replace);
+      for (std::size_t v = 0; v < replaced.size(); ++v) replaced[v] |= measures.replace[v];
     }
     // The 1-ring's memory is the per-triangle pass's (later steps rebuild it if they need it).
     c.one_ring.reset();

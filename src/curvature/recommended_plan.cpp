@@ -261,7 +261,8 @@ int recommended_reach(const RecommendedPlan& plan) {
   //    their neighbours' mean, one ring further;
   //  - on clean positions with trusted normals, the corrected step (corrected_step.h) reads the
   //    fitted normals at the corners of the faces of its ball's vertices (at most
-  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings);
+  //    kCorrectedBallRings + 1 rings) and the stencil asymmetry of v's 1-ring (2 rings), the
+  //    Hermite fit (hermite_fit.h) the positions and fitted normals of v's 2-ring at most;
   //  - on clean positions each position read may be a repaired spike's: with trusted normals
   //    (spike_repair.h) a spike's offset reads its 1-ring, whether it is isolated the offsets
   //    of that 1-ring, 2 rings in all; without them (mesh/position_spikes.h)

@@ -70,7 +70,7 @@ struct RecommendedOptions {
   /// Step 3: among used file normals, one more than this many times the noise from its jet normal
   /// (and rougher than the positions' normal by half) is an outlier, replaced.
   double outlier_disagreement = 10.0;
-  /// Step 7: on clean positions, an edge whose two faces' normals differ by more than this
+  /// Step 8: on clean positions, an edge whose two faces' normals differ by more than this
   /// (radians; 0 turns crease handling off) is a crease; its corners are crease vertices.
   /// 60 degrees: above the 46 degrees that faces of the coarsest suite meshes (spacing 0.8 /
   /// max |curvature|) turn between neighbours on smooth surfaces.
@@ -197,7 +197,7 @@ struct RecommendedResult {
   /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
   /// their side.
   bool file_normals_used = false;
-  /// #V flags, 1 at crease vertices (step 7; clean positions only, else all 0 or empty): the
+  /// #V flags, 1 at crease vertices (step 8; clean positions only, else all 0 or empty): the
   /// curvature does not exist there, their values are not to be trusted.
   VectorXu8 crease;
 };

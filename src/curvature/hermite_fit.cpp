@@ -1,0 +1,362 @@
+#include "curvature/hermite_fit.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <type_traits>
+#include <utility>
+
+#include "core/parallel.h"
+
+namespace focal::detail {
+namespace {
+
+/// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4.
+constexpr int kTerms = 12;
+constexpr std::array<std::array<int, 2>, kTerms> kPowers{{{2, 0},
+                                                          {1, 1},
+                                                          {0, 2},
+                                                          {3, 0},
+                                                          {2, 1},
+                                                          {1, 2},
+                                                          {0, 3},
+                                                          {4, 0},
+                                                          {3, 1},
+                                                          {2, 2},
+                                                          {1, 3},
+                                                          {0, 4}}};
+
+/// Points a fit takes at most (a 1-ring, or a 2-ring where the 1-ring is too small); more: no
+/// fit.
+constexpr std::size_t kMaxPoints = 96;
+
+using Terms = std::array<double, kTerms>;
+
+/// f(integral_constant<0>), ..., f(integral_constant<N - 1>): loops over the fit's fixed sizes
+/// unrolled, with every index a constant.
+template <std::size_t N, class F>
+void unroll(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (f(std::integral_constant<std::size_t, I>{}), ...);
+  }
+  (std::make_index_sequence<N>{});
+}
+
+/// Exponents (a, b) of the monomials u^a v^b with lo <= a + b <= hi, by degree.
+template <int lo, int hi>
+constexpr auto monomials() {
+  std::array<std::array<int, 2>, ((hi + 1) * (hi + 2) - lo * (lo + 1)) / 2> out{};
+  std::size_t k = 0;
+  for (int n = lo; n <= hi; ++n) {
+    for (int a = n; a >= 0; --a) out[k++] = {a, n - a};
+  }
+  return out;
+}
+
+/// Index of u^a v^b in monomials<lo, hi>().
+constexpr int monomial_index(int lo, int a, int b) {
+  const int n = a + b;
+  return (n * (n + 1) - lo * (lo + 1)) / 2 + (n - a);
+}
+
+/// The moments the normal matrix needs: heights' of degree 4 to 8 (weight 1 / d^4), slopes' of
+/// degree 2 to 6 (weight 1 / d^2); the right side's: z u^a v^b of degree 2 to 4 (1 / d^4), the
+/// slopes' zu, zv times u^a v^b of degree 1 to 3 (1 / d^2).
+constexpr auto kHeightMoments = monomials<4, 8>();
+constexpr auto kSlopeMoments = monomials<2, 6>();
+constexpr auto kHeightRight = monomials<2, 4>();
+constexpr auto kSlopeRight = monomials<1, 3>();
+static_assert(kHeightRight.size() == kTerms);
+
+/// The tables as types, for unroll's constant indices.
+template <const auto& table>
+struct Table {
+  static constexpr const auto& value = table;
+};
+using HeightMoments = Table<kHeightMoments>;
+using SlopeMoments = Table<kSlopeMoments>;
+using HeightRight = Table<kHeightRight>;
+using SlopeRight = Table<kSlopeRight>;
+
+/// Entry (i, j) of A^T A: heights[kH] + ai aj slopes[kU] + bi bj slopes[kV] (an index of -1:
+/// no such term).
+struct NormalEntry {
+  int i, j, height, u_slope, v_slope;
+  double u_factor, v_factor;
+};
+constexpr auto normal_entries() {
+  std::array<NormalEntry, kTerms*(kTerms + 1) / 2> out{};
+  std::size_t k = 0;
+  for (int i = 0; i < kTerms; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      const auto [ai, bi] = kHeightRight[static_cast<std::size_t>(i)];
+      const auto [aj, bj] = kHeightRight[static_cast<std::size_t>(j)];
+      const int a = ai + aj, b = bi + bj;
+      out[k++] = {i,
+                  j,
+                  monomial_index(4, a, b),
+                  ai > 0 && aj > 0 ? monomial_index(2, a - 2, b) : -1,
+                  bi > 0 && bj > 0 ? monomial_index(2, a, b - 2) : -1,
+                  static_cast<double>(ai * aj),
+                  static_cast<double>(bi * bj)};
+    }
+  }
+  return out;
+}
+constexpr auto kNormalEntries = normal_entries();
+
+/// The least-squares system of the fit, kept as moments: a point at scaled offset (u, v) with
+/// d = |(u, v)| gives a height row m_i / d^2 (m_i = u^a_i v^b_i) and two slope rows
+/// (dm_i/du) / d, (dm_i/dv) / d, so every entry of A^T A is a moment of degree 4 to 8 weighted
+/// by 1 / d^4 plus moments of degree 2 to 6 weighted by 1 / d^2, and A^T b is made of 30 more:
+/// 90 sums a point instead of three rank-one updates of a 12 x 12 matrix.
+///
+/// With `free_height`, the height at the vertex is an unknown too (its position is known to
+/// third order only, as a repaired spike's), eliminated from the normal equations (its Schur
+/// complement): its column, the height rows' 1 / d^2, is summed from the rows themselves (the
+/// case is rare).
+struct System {
+  bool free_height = false;
+  double free_free = 0.0;   ///< the free column's square
+  Terms free_terms{};       ///< its products with the terms' columns
+  double free_right = 0.0;  ///< its product with b
+  std::array<double, kHeightMoments.size()> heights{};
+  std::array<double, kSlopeMoments.size()> slopes{};
+  std::array<double, kHeightRight.size()> height_right{};
+  std::array<double, kSlopeRight.size()> u_right{}, v_right{};
+  double btb = 0.0;
+  int rows = 0;
+
+  /// A point at scaled offset (u, v), height z, slopes (zu, zv).
+  void add_point(double u, double v, double z, double zu, double zv) {
+    const double g = 1.0 / (u * u + v * v), h = g * g;
+    std::array<double, 9> pu, pv;
+    pu[0] = pv[0] = 1.0;
+    for (std::size_t k = 1; k < 9; ++k) {
+      pu[k] = pu[k - 1] * u;
+      pv[k] = pv[k - 1] * v;
+    }
+    const auto at = [&](auto table, auto k) {
+      constexpr std::array<int, 2> e = decltype(table)::value[k];
+      return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
+    };
+    const double hz = h * z, gu = g * zu, gv = g * zv;
+    unroll<kHeightMoments.size()>([&](auto k) { heights[k] += h * at(HeightMoments{}, k); });
+    unroll<kSlopeMoments.size()>([&](auto k) { slopes[k] += g * at(SlopeMoments{}, k); });
+    unroll<kTerms>([&](auto k) { height_right[k] += hz * at(HeightRight{}, k); });
+    unroll<kSlopeRight.size()>([&](auto k) {
+      const double m = at(SlopeRight{}, k);
+      u_right[k] += gu * m;
+      v_right[k] += gv * m;
+    });
+    if (free_height) {
+      // The free column is 1 / d^2 in the height row, 0 in the slope rows.
+      free_free += h;
+      unroll<kTerms>([&](auto k) { free_terms[k] += h * at(HeightRight{}, k); });
+      free_right += hz;
+    }
+    btb += hz * z + g * (zu * zu + zv * zv);
+    rows += 3;
+  }
+
+  /// A^T A from the moments.
+  [[nodiscard]] std::array<Terms, kTerms> normal_matrix() const {
+    std::array<Terms, kTerms> out;
+    unroll<kNormalEntries.size()>([&](auto k) {
+      constexpr NormalEntry e = kNormalEntries[k];
+      double x = heights[static_cast<std::size_t>(e.height)];
+      if constexpr (e.u_slope >= 0) x += e.u_factor * slopes[static_cast<std::size_t>(e.u_slope)];
+      if constexpr (e.v_slope >= 0) x += e.v_factor * slopes[static_cast<std::size_t>(e.v_slope)];
+      out[static_cast<std::size_t>(e.i)][static_cast<std::size_t>(e.j)] = x;
+      out[static_cast<std::size_t>(e.j)][static_cast<std::size_t>(e.i)] = x;
+    });
+    if (free_height) {
+      for (std::size_t i = 0; i < kTerms; ++i) {
+        for (std::size_t j = 0; j < kTerms; ++j)
+          out[i][j] -= free_terms[i] * free_terms[j] / free_free;
+      }
+    }
+    return out;
+  }
+
+  /// A^T b from the moments: term u^a v^b's height row times z, its u-slope row (a u^(a-1) v^b)
+  /// times zu, its v-slope row (b u^a v^(b-1)) times zv.
+  [[nodiscard]] Terms right_side() const {
+    Terms out;
+    unroll<kTerms>([&](auto i) {
+      constexpr int a = kHeightRight[i][0], b = kHeightRight[i][1];
+      double x = height_right[i];
+      if constexpr (a > 0) x += a * u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
+      if constexpr (b > 0) x += b * v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
+      out[i] = x;
+    });
+    if (free_height) {
+      for (std::size_t i = 0; i < kTerms; ++i) out[i] -= free_terms[i] * free_right / free_free;
+    }
+    return out;
+  }
+
+  /// The least-squares coefficients (Cholesky of A^T A), or nothing where a pivot is below
+  /// kHermiteMinPivot times the largest.
+  [[nodiscard]] std::optional<Terms> solve() const {
+    std::array<Terms, kTerms> l = normal_matrix();
+    double largest = 0.0, smallest = INFINITY;
+    bool positive = true;
+    unroll<kTerms>([&](auto k) {
+      double pivot = l[k][k];
+      unroll<k>([&](auto j) { pivot -= l[k][j] * l[k][j]; });
+      positive = positive && pivot > 0.0;
+      largest = std::max(largest, pivot);
+      smallest = std::min(smallest, pivot);
+      l[k][k] = std::sqrt(pivot);
+      const double inverse = 1.0 / l[k][k];
+      unroll<kTerms - k - 1>([&](auto r) {
+        constexpr std::size_t i = k + 1 + r;
+        double v = l[i][k];
+        unroll<k>([&](auto j) { v -= l[i][j] * l[k][j]; });
+        l[i][k] = v * inverse;
+      });
+    });
+    if (!positive) return std::nullopt;
+    if (!(smallest >= kHermiteMinPivot * largest)) return std::nullopt;
+    const Terms atb = right_side();
+    Terms c = atb;
+    unroll<kTerms>([&](auto i) {  // L y = A^T b
+      unroll<i>([&](auto j) { c[i] -= l[i][j] * c[j]; });
+      c[i] /= l[i][i];
+    });
+    unroll<kTerms>([&](auto r) {  // L^T c = y
+      constexpr std::size_t i = kTerms - 1 - r;
+      unroll<kTerms - 1 - i>([&](auto k) { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
+      c[i] /= l[i][i];
+    });
+    return c;
+  }
+
+  /// The RMS misfit of the rows at coefficients c: r^T r = b^T b - c^T A^T b at the
+  /// least-squares solution.
+  [[nodiscard]] double misfit(const Terms& c) const {
+    const Terms atb = right_side();
+    double ctb = 0.0;
+    for (std::size_t i = 0; i < kTerms; ++i) ctb += c[i] * atb[i];
+    const double bb = free_height ? btb - free_right * free_right / free_free : btb;
+    return std::sqrt(std::max(0.0, bb - ctb) / rows);
+  }
+};
+
+/// Why a stencil gave no operator: too few rows to fix the quartic (a wider stencil may), or
+/// rows it does not fit (a wider one would not help).
+enum class Refusal { none, underdetermined, unfit };
+
+/// The shape operator [a b; b c] of the fit over `stencil` in the vertex's frame; `refusal`
+/// says why there is none.
+std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX3d& N,
+                                                const std::vector<char>& ok,
+                                                const std::vector<int>& stencil, int v,
+                                                const TangentFrame& frame, bool free_height,
+                                                Refusal& refusal) {
+  refusal = Refusal::underdetermined;
+  if (stencil.size() < 5 || stencil.size() > kMaxPoints) return std::nullopt;
+  refusal = Refusal::unfit;
+  const Eigen::Vector3d p = V.row(v).transpose();
+  // Offsets (x, y, z) and slopes in the frame, and the scale that makes the offsets O(1) (their
+  // RMS tangential length).
+  std::array<Eigen::Vector3d, kMaxPoints> local;
+  std::array<Eigen::Vector2d, kMaxPoints> slope;
+  double spread = 0.0;
+  for (std::size_t k = 0; k < stencil.size(); ++k) {
+    const int j = stencil[k];
+    if (!ok[static_cast<std::size_t>(j)]) return std::nullopt;
+    const Eigen::Vector3d m = N.row(j).transpose();
+    const double mz = m.dot(frame.n);
+    if (!(mz >= kHermiteMaxTurnCosine)) return std::nullopt;
+    const Eigen::Vector3d e = V.row(j).transpose() - p;
+    local[k] = {e.dot(frame.x), e.dot(frame.y), e.dot(frame.n)};
+    slope[k] = {-m.dot(frame.x) / mz, -m.dot(frame.y) / mz};
+    spread += local[k].head<2>().squaredNorm();
+  }
+  const double s = std::sqrt(spread / static_cast<double>(stencil.size()));
+  if (!(s > 0.0)) return std::nullopt;
+  System sys;
+  sys.free_height = free_height;
+  for (std::size_t j = 0; j < stencil.size(); ++j) {
+    const double u = local[j].x() / s, w = local[j].y() / s;
+    if (!(u * u + w * w > 0.0)) return std::nullopt;
+    sys.add_point(u, w, local[j].z() / s, slope[j].x(), slope[j].y());
+  }
+  const std::optional<Terms> c = sys.solve();
+  if (!c) {
+    refusal = Refusal::underdetermined;
+    return std::nullopt;
+  }
+  const Terms& k = *c;
+  if (!std::isfinite(k[0] + k[1] + k[2]) || !(sys.misfit(k) <= kHermiteMaxMisfit)) {
+    return std::nullopt;
+  }
+  refusal = Refusal::none;
+  // h(x, y) = s h~(x / s, y / s): second derivatives are h~'s over s.
+  return Eigen::Vector3d(-2.0 * k[0] / s, -k[1] / s, -2.0 * k[2] / s);
+}
+
+/// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` and `guessed`
+/// vertices, into `out`.
+void stencil_of(const Neighbourhoods& one_ring, int v, bool wide, const std::vector<char>& moved,
+                const std::vector<char>& guessed, std::vector<int>& out) {
+  out.assign(one_ring.begin(v), one_ring.end(v));
+  if (wide) {
+    const std::size_t first = out.size();
+    for (std::size_t k = 0; k < first; ++k) {
+      for (const int* j = one_ring.begin(out[k]); j != one_ring.end(out[k]); ++j) {
+        if (*j != v) out.push_back(*j);
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  const auto left_out = [&](int j) {
+    const auto k = static_cast<std::size_t>(j);
+    return (!moved.empty() && moved[k]) || (!guessed.empty() && guessed[k]);
+  };
+  if (!moved.empty() || !guessed.empty()) std::erase_if(out, left_out);
+}
+
+}  // namespace
+
+std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
+                                     const std::vector<char>& ok, const Neighbourhoods& one_ring,
+                                     const VertexFaces& incidence, const std::vector<char>& keep,
+                                     const std::vector<char>& moved,
+                                     const std::vector<char>& guessed, double exact_residual,
+                                     const ClassTolerances& tol, CurvatureResult& fit) {
+  std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
+  parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {
+    std::vector<int> stencil;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const auto v = static_cast<std::size_t>(i);
+      const int vi = static_cast<int>(i);
+      if (!ok[v] || (!keep.empty() && keep[v]) || (!guessed.empty() && guessed[v]) ||
+          fit.residual[i] <= exact_residual) {
+        continue;
+      }
+      if (incidence.size(i) != static_cast<int>(one_ring.end(vi) - one_ring.begin(vi))) continue;
+      const TangentFrame frame = tangent_frame(N.row(i).transpose());
+      Refusal refusal = Refusal::none;
+      std::optional<Eigen::Vector3d> op;
+      // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
+      for (const bool wide : {false, true}) {
+        stencil_of(one_ring, vi, wide, moved, guessed, stencil);
+        op = hermite_operator(V, N, ok, stencil, vi, frame, !moved.empty() && moved[v], refusal);
+        if (refusal != Refusal::underdetermined) break;
+      }
+      if (!op) continue;
+      store_vertex(fit, i, frame, principal_from_symmetric((*op)[0], (*op)[1], (*op)[2]),
+                   fit.residual[i], tol);
+      written[v] = 1;
+    }
+  });
+  return written;
+}
+
+}  // namespace focal::detail

@@ -1,0 +1,60 @@
+#pragma once
+// Internal: the recommended estimator's fourth-order step on trusted normals (hermite_fit.cpp).
+
+#include <vector>
+
+#include "curvature/vertex_rows.h"
+#include "focal/core/mesh.h"
+#include "focal/curvature/curvature.h"
+#include "focal/mesh/neighbourhood.h"
+#include "mesh/topology.h"
+
+namespace focal::detail {
+
+/// Largest angle between a vertex's normal and a neighbour's for the Hermite fit (cos 30
+/// degrees). The height of the surface over the vertex's tangent plane is a power series in
+/// the tangential offset over the curvature radius, sin of the turn; the quartic leaves terms of
+/// relative size sin^4 (1/16 at 30 degrees) where the per-triangle pass leaves sin^2. Beyond it
+/// the 1-ring wraps around the surface (a coarse thin tube) and the quartic loses.
+constexpr double kHermiteMaxTurnCosine = 0.8660254037844386;
+
+/// Smallest pivot of the fit's normal equations against the largest (after the rows are made
+/// dimensionless): below it the 1-ring does not fix the quartic (a vertex of valence 4 gives 12
+/// equations for 12 unknowns, nearly singular on most layouts).
+constexpr double kHermiteMinPivot = 1e-12;
+
+/// Largest RMS misfit of the fit's rows (slope units, as the two-slit fit's residual) for its
+/// operator to be used. On clean meshes with exact normals the quartic meets the rows to within
+/// its truncation: at most 0.005 (measured on the hard suite's clean cases: 20:1 strips 0.005,
+/// coarse meshes 0.003, others below 0.001); a spike's height or a wild normal left in the ring
+/// shows as 0.01 to 0.6, and the per-triangle pass there stays.
+constexpr double kHermiteMaxMisfit = 0.005;
+
+/// The quartic Hermite fit of a vertex's closed 1-ring: the height h(x, y) over the tangent
+/// plane of the vertex's unit normal, h = sum of the 12 monomials of degree 2 to 4 (h and its
+/// gradient vanish at the vertex: the normal is the plane's), fitted in least squares to each
+/// neighbour's height and to the two slopes its normal gives (-m_x / m_z, -m_y / m_z), each row
+/// divided by the neighbour's distance (heights by its square) so that every row is a
+/// curvature. The shape operator is minus h's Hessian at the vertex. With exact normals its
+/// error is third order in the edge length (the per-triangle pass and the 1-ring fit: first
+/// and second), on irregular, strip and graded meshes alike.
+///
+/// Writes the rows of `fit` at vertices with `ok` normals whose 1-ring is closed (as many
+/// faces as neighbours in `incidence`), where neither `keep` nor `guessed` (below) is set and the
+/// row's residual is above `exact_residual` (the two-slit fit is exact there already). The
+/// stencil is the 1-ring, or the 2-ring where the 1-ring does not fix the quartic
+/// (kHermiteMinPivot; a vertex of valence 4), less the `moved` and `guessed` vertices (each
+/// empty or #V flags: positions known to third order only, such as repaired spikes; normals
+/// estimated from the positions, such as a file normal replaced as an outlier; a moved vertex's
+/// own fit takes the height at it as one more unknown): at least 5 and at most 96
+/// points, all with `ok` normals within kHermiteMaxTurnCosine of the vertex's, whose quartic
+/// meets its rows (kHermiteMaxMisfit). The row keeps its residual. Returns, per vertex,
+/// whether its row was written.
+std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
+                                     const std::vector<char>& ok, const Neighbourhoods& one_ring,
+                                     const VertexFaces& incidence, const std::vector<char>& keep,
+                                     const std::vector<char>& moved,
+                                     const std::vector<char>& guessed, double exact_residual,
+                                     const ClassTolerances& tol, CurvatureResult& fit);
+
+}  // namespace focal::detail
