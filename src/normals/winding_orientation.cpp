@@ -342,8 +342,9 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   report.decided = report.residual_after <= options.closed_residual &&
                    report.residual_after <= options.closed_gain * report.residual_before;
   if (!report.decided) return report;
-  report.jump_turned = turn_by_jumps(tree, graph, rename, contact_lengths(V, graph, rename, area, N, options), A,
-                                     options, s, threads);
+  report.jump_turned =
+      turn_by_jumps(tree, graph, rename, contact_lengths(V, graph, rename, area, N, options), A,
+                    options, s, threads);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (s[i] > 0.0) continue;
     N.row(i) *= -1.0;

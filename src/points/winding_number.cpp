@@ -193,8 +193,16 @@ WindingTree::Moments WindingTree::moments(const RowMatrixX3d& M,
     }
     sum[k] = s;
     second[k] = T;
-    d.far[k] = {s.x(),   s.y(),   s.z(),           T.trace(),       T(0, 0),
-                T(1, 1), T(2, 2), T(0, 1) + T(1, 0), T(0, 2) + T(2, 0), T(1, 2) + T(2, 1)};
+    d.far[k] = {s.x(),
+                s.y(),
+                s.z(),
+                T.trace(),
+                T(0, 0),
+                T(1, 1),
+                T(2, 2),
+                T(0, 1) + T(1, 0),
+                T(0, 2) + T(2, 0),
+                T(1, 2) + T(2, 1)};
   }
   return d;
 }
@@ -209,8 +217,8 @@ double WindingTree::winding_sum(const Eigen::Vector3d& q, double own, const Mome
         const double rho2 = d2 + own + node.s2;
         const double inv2 = 1.0 / rho2, inv3 = inv2 / std::sqrt(rho2);
         const std::array<double, 10>& f = d.far[k];
-        const double xTx = f[4] * x * x + f[5] * y * y + f[6] * z * z + f[7] * x * y +
-                           f[8] * x * z + f[9] * y * z;
+        const double xTx =
+            f[4] * x * x + f[5] * y * y + f[6] * z * z + f[7] * x * y + f[8] * x * z + f[9] * y * z;
         w += inv3 * (f[0] * x + f[1] * y + f[2] * z + f[3] - 3.0 * inv2 * xTx);
       },
       [&](const Node& node) {

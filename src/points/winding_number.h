@@ -69,7 +69,7 @@ class WindingTree {
     int begin = 0, end = 0;  ///< its points: order_[begin, end)
     int first_child = -1;    ///< children first_child ... first_child + children - 1; -1: leaf
     int children = 0;
-    double s2 = 0.0;  ///< the mean of its points' half squared smoothing lengths
+    double s2 = 0.0;     ///< the mean of its points' half squared smoothing lengths
     double open2 = 0.0;  ///< beta^2 radius^2: taken as a whole beyond this squared distance
   };
   /// The dipoles in tree order (rows times their sign, zero where not finite) and their
