@@ -14,6 +14,7 @@
 #include "focal/core/error.h"
 #include "focal/normals/cloud_normals.h"
 #include "focal/points/neighbours.h"
+#include "normals/cloud_jets.h"
 #include "normals/winding_orientation.h"
 #include "points/winding_number.h"
 #include "test_threads.h"
@@ -177,6 +178,26 @@ TEST(GlobalOrientation, SameBitsForAnyThreadCount) {
     return cloud_normals(s.V, nb, {.orientation = CloudOrientation::global});
   };
   EXPECT_EQ(test::on_threads(1, run), test::on_threads(2, run));
+}
+
+// The plan's global orientation after a fit from the tree's signs (orient_jets_globally) gives
+// the jets of the global orientation itself, bit for bit, for jets and PCA normals.
+TEST(GlobalOrientation, AfterTheTreeAsDirect) {
+  for (const CloudNormalMethod method : {CloudNormalMethod::jet, CloudNormalMethod::pca}) {
+    for (const Shape shape : {Shape::plate, Shape::touching_spheres, Shape::thick_plate}) {
+      const test::Solid s = solid(shape, 2, 0.1);
+      const Neighbourhoods nb = nearest_neighbours(s.V, 16);
+      const CloudNormalOptions global{.method = method, .orientation = CloudOrientation::global};
+      CloudNormalOptions tree = global;
+      tree.orientation = CloudOrientation::mst;
+      RowMatrixX3d start;
+      JetNormals jets = detail::cloud_jets(s.V, nb, tree, nullptr, &start);
+      detail::orient_jets_globally(s.V, nb, global, std::move(start), jets);
+      const JetNormals direct = detail::cloud_jets(s.V, nb, global);
+      EXPECT_EQ(jets.N, direct.N) << shape_name(shape);
+      EXPECT_EQ(jets.residual, direct.residual) << shape_name(shape);
+    }
+  }
 }
 
 TEST(GlobalOrientation, RejectsConflictingOptions) {

@@ -246,13 +246,27 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
     return N ? detail::cloud_jets_sided(V, out.neighbours, normals, *N, copy_of)
              : detail::cloud_jets(V, out.neighbours, normals, copy_of);
   };
-  JetNormals jets = fit_jets();
+  // The global orientation only on the fit that is kept: the first fit, whose residuals may
+  // call for another, starts from the tree's signs (the residuals do not depend on them).
+  const bool deferred = !N && normals.orientation == CloudOrientation::global && !normals.viewpoint;
+  RowMatrixX3d start;
+  JetNormals jets;
+  if (deferred) {
+    CloudNormalOptions by_tree = normals;
+    by_tree.orientation = CloudOrientation::mst;
+    jets = detail::cloud_jets(V, out.neighbours, by_tree, copy_of, &start);
+  } else {
+    jets = fit_jets();
+  }
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
   if (out.noise > kNoisyPositions) {
     out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
     out.neighbours = nearest(out.k, out.outlier);
     normals.jet_degree = 2;
+    start = RowMatrixX3d();
     jets = fit_jets();
+  } else if (deferred) {
+    detail::orient_jets_globally(V, out.neighbours, normals, std::move(start), jets, copy_of);
   }
   // Without jets (CloudNormalMethod::pca) there is no noise to judge by: the file's are kept.
   // 1e-9 rad: exact normals of an exactly fitted cloud (noise 0) still agree.

@@ -23,12 +23,30 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
                        int threads, const CloudCopy* copy_of = nullptr, bool global = false,
                        bool* decided = nullptr);
 
+/// orient_normals_mst's `global` step alone on N oriented by the tree: each point's area from
+/// its list in `neighbours`, the winding number on the cloud in its own order. `copy_of` and
+/// `decided` as orient_normals_mst.
+void orient_after_tree(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                       int threads, const CloudCopy* copy_of = nullptr, bool* decided = nullptr);
+
 /// cloud_normals, with the jets' residuals and degrees (empty for CloudNormalMethod::pca).
 /// `copy_of` as orient_normals_mst; each jet's points are then summed in the cloud's order
-/// (jet_normals_from), as they are on the cloud itself.
+/// (jet_normals_from), as they are on the cloud itself. `start` (when not null, and for
+/// CloudNormalMethod::jet): set to the oriented PCA normals the jets started from.
 /// \throw as cloud_normals.
 JetNormals cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                      const CloudNormalOptions& options, const CloudCopy* copy_of = nullptr);
+                      const CloudNormalOptions& options, const CloudCopy* copy_of = nullptr,
+                      RowMatrixX3d* start = nullptr);
+
+/// Turns jets = cloud_jets(V, neighbours, mst, copy_of, &start), for `options` but with the
+/// orientation CloudOrientation::mst, into those of cloud_jets(V, neighbours, options, copy_of)
+/// with CloudOrientation::global: the global step on the tree's start normals, then the jets'
+/// sides by its field where it decided (a jet's line does not depend on its start's sign, bit
+/// for bit, as cloud_jets_sided says; the field's jump sets every side). For a plan that may
+/// only need the jets' residuals: the winding number runs only on the fit that is kept.
+void orient_jets_globally(PositionsRef V, const Neighbourhoods& neighbours,
+                          const CloudNormalOptions& options, RowMatrixX3d start, JetNormals& jets,
+                          const CloudCopy* copy_of = nullptr);
 
 /// cloud_jets with each starting (PCA) normal turned to the side of its row of `side` instead
 /// of oriented by orient_normals_mst (serial, the plan's one serial step), for a plan that may

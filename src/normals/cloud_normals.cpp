@@ -307,17 +307,14 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
                                int threads, const CloudCopy* copy_of, bool global, bool* decided) {
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
-  // The areas from the lists as given (sorted by distance), before N is taken anywhere.
-  const Eigen::VectorXd area =
-      global ? detail::patch_areas(V, neighbours, N, threads) : Eigen::VectorXd();
   if (!copy_of) {
     const int components = orient_over_graph(V, symmetric(neighbours, threads), N);
-    if (global) tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads), decided);
+    if (global) orient_after_tree(V, neighbours, N, threads, nullptr, decided);
     return components;
   }
   // The tree over the cloud in its own order, whose ties it breaks by row: the graph renamed
   // from the copy's lists, N taken back (and the copy's N let go meanwhile), the cloud's own
-  // positions. The winding number's segments read the copy's lists renamed (the graph let go).
+  // positions.
   const RowPermutation& p = copy_of->permutation;
   RowMatrixX3d own;
   int components = 0;
@@ -327,13 +324,28 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
     N = RowMatrixX3d();
     components = orient_over_graph(copy_of->cloud, graph, own);
   }
-  if (global) {
-    tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
-                                   detail::rows_from(area, p.position, threads), own, threads),
-         decided);
-  }
   N = detail::rows_from(own, p.order, threads);
+  if (global) orient_after_tree(V, neighbours, N, threads, copy_of, decided);
   return components;
+}
+
+void detail::orient_after_tree(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
+                               int threads, const CloudCopy* copy_of, bool* decided) {
+  // The areas from the lists as given (sorted by distance); a normal's sign does not enter them.
+  const Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, threads);
+  if (!copy_of) {
+    tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads), decided);
+    return;
+  }
+  // On the cloud in its own order, as the tree: the winding number's segments read the copy's
+  // lists renamed.
+  const RowPermutation& p = copy_of->permutation;
+  RowMatrixX3d own = detail::rows_from(N, p.position, threads);
+  N = RowMatrixX3d();
+  tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
+                                 detail::rows_from(area, p.position, threads), own, threads),
+       decided);
+  N = detail::rows_from(own, p.order, threads);
 }
 
 int orient_normals_global(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N) {
@@ -420,15 +432,31 @@ JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
 }  // namespace
 
 JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
-                              const CloudNormalOptions& options, const CloudCopy* copy_of) {
+                              const CloudNormalOptions& options, const CloudCopy* copy_of,
+                              RowMatrixX3d* start) {
   check_jet_options(V, neighbours, options);
   RowMatrixX3d N = pca_normals(V, neighbours);
-  if (!orient(V, neighbours, options, N, copy_of) || options.method == CloudNormalMethod::pca) {
+  const bool decided = orient(V, neighbours, options, N, copy_of);
+  if (start && options.method == CloudNormalMethod::jet) *start = N;
+  if (!decided || options.method == CloudNormalMethod::pca) {
     return jets_from_start(V, neighbours, options, std::move(N), copy_of);
   }
   JetNormals jets = jets_from_start(V, neighbours, options, N, copy_of);
   side_jets(V, neighbours, N, jets.N, copy_of);
   return jets;
+}
+
+void detail::orient_jets_globally(PositionsRef V, const Neighbourhoods& neighbours,
+                                  const CloudNormalOptions& options, RowMatrixX3d start,
+                                  JetNormals& jets, const CloudCopy* copy_of) {
+  if (options.method == CloudNormalMethod::pca) {
+    orient_after_tree(V, neighbours, jets.N, 0, copy_of, nullptr);
+    return;
+  }
+  bool decided = false;
+  orient_after_tree(V, neighbours, start, 0, copy_of, &decided);
+  // Not decided: the tree's signs stay, and so do the jets fitted from them.
+  if (decided) side_jets(V, neighbours, start, jets.N, copy_of);
 }
 
 JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,

@@ -150,23 +150,49 @@ RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
 /// Rounds of per-point turns: each point takes the side that the field's jump across it says
 /// (positive: its signed normal points out), all at once, until a round turns none. The jump
 /// leaves the point's own dipole out, so a point alone in a consistent sheet follows the sheet,
-/// and across a thin part or a contact the nearer sheet's jump outweighs the other's. Returns
-/// the turns made.
-int turn_by_jumps(const WindingTree& tree, const Eigen::VectorXd& length, const RowMatrixX3d& A,
-                  const WindingOrientationOptions& options, Eigen::VectorXd& s, int threads) {
+/// and across a thin part or a contact the nearer sheet's jump outweighs the other's. After the
+/// first round a jump is evaluated again only at the points turned and their neighbours in
+/// `graph` (renamed as in `segments`): a sign turned at distance r changes the jump across a
+/// point by about its dipole's gradient times the offset, which falls as 1 / r^3. Returns the
+/// turns made.
+int turn_by_jumps(const WindingTree& tree, const Neighbourhoods& graph,
+                  const std::vector<int>* rename, const Eigen::VectorXd& length,
+                  const RowMatrixX3d& A, const WindingOrientationOptions& options,
+                  Eigen::VectorXd& s, int threads) {
+  const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
   const Eigen::Index n = A.rows();
   const RowMatrixX3d E = offsets(A, length, A);
+  RowMatrixX3d again;  // the offsets of the points evaluated again, zero elsewhere
+  std::vector<char> turned(static_cast<std::size_t>(n), 0);
+  Eigen::VectorXd J;
   int total = 0;
   for (int round = 0; round < options.jump_rounds; ++round) {
-    const Eigen::VectorXd J = tree.jump(E, A, s, threads);
-    int turned = 0;
+    if (round == 0) {
+      J = tree.jump(E, A, s, threads);
+    } else {
+      again = RowMatrixX3d::Zero(n, 3);
+      for (int row = 0; row < graph.vertex_count(); ++row) {
+        const int i = name(row);
+        bool near = turned[static_cast<std::size_t>(i)] != 0;
+        for (const int* jr = graph.begin(row); !near && jr != graph.end(row); ++jr)
+          near = turned[static_cast<std::size_t>(name(*jr))] != 0;
+        if (near) again.row(i) = E.row(i);
+      }
+      const Eigen::VectorXd update = tree.jump(again, A, s, threads);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (!again.row(i).isZero()) J[i] = update[i];
+      }
+    }
+    int count = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
+      turned[static_cast<std::size_t>(i)] = 0;
       if (A.row(i).isZero() || s[i] * J[i] >= 0.0) continue;
       s[i] = -s[i];
-      ++turned;
+      turned[static_cast<std::size_t>(i)] = 1;
+      ++count;
     }
-    total += turned;
-    if (turned == 0) break;
+    total += count;
+    if (count == 0) break;
   }
   return total;
 }
@@ -268,9 +294,10 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
   // order: sum_S s_k (K^T (K s - b))_k > sum_S |K e_k|^2 (its points' own terms; left out for
   // the segments joined across, whose sides' terms largely cancel). All such turn at once; a
   // sweep that does not lower the residual is undone, and two such in a row end the sweeps.
+  // r = K s - b for the signs s (kept through the sweeps).
+  Eigen::VectorXd r = K(s) - b;
   if (options.sweeps > 0) {
     const Eigen::VectorXd column = tree.near_column_norms(A, threads);
-    Eigen::VectorXd r = K(s) - b;
     double energy = dot(r, r);
     bool failed = false;  // the last sweep turned nothing
     for (int sweep = 0; sweep < options.sweeps; ++sweep) {
@@ -308,16 +335,16 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
       energy = e_next;
     }
   }
-  const Eigen::VectorXd after = b - K(s);
-  report.residual_after = std::sqrt(dot(after, after)) / norm_b;
+  report.residual_after = std::sqrt(dot(r, r)) / norm_b;
   // The field's own verdict on whether it decides: a closed surface sampled with consistent
   // normals has w near 1/2 at every sample; an open one (a scan from one side) or one noisy
   // beyond its spacing does not, whatever the signs, and then the tree's signs stay.
   report.decided = report.residual_after <= options.closed_residual &&
                    report.residual_after <= options.closed_gain * report.residual_before;
   if (!report.decided) return report;
-  report.jump_turned = turn_by_jumps(tree, contact_lengths(V, graph, rename, area, N, options), A,
-                                     options, s, threads);
+  report.jump_turned =
+      turn_by_jumps(tree, graph, rename, contact_lengths(V, graph, rename, area, N, options), A,
+                    options, s, threads);
   for (Eigen::Index i = 0; i < n; ++i) {
     if (s[i] > 0.0) continue;
     N.row(i) *= -1.0;

@@ -21,6 +21,7 @@
 // runs over the cells in the tree's fixed order, one point per parallel task: the same bits for any
 // thread count.
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "focal/core/mesh.h"
@@ -68,14 +69,17 @@ class WindingTree {
     int begin = 0, end = 0;  ///< its points: order_[begin, end)
     int first_child = -1;    ///< children first_child ... first_child + children - 1; -1: leaf
     int children = 0;
-    double s2 = 0.0;  ///< the mean of its points' half squared smoothing lengths
+    double s2 = 0.0;     ///< the mean of its points' half squared smoothing lengths
+    double open2 = 0.0;  ///< beta^2 radius^2: taken as a whole beyond this squared distance
   };
   /// The dipoles in tree order (rows times their sign, zero where not finite) and their
   /// moments about each node's centre.
   struct Moments {
-    RowMatrixX3d M;
-    std::vector<Eigen::Vector3d> sum;     ///< sum m_j
-    std::vector<Eigen::Matrix3d> second;  ///< sum m_j (p_j - c)^T
+    Eigen::MatrixX3d M;  ///< column-major: each coordinate contiguous for the near sums' lanes
+    /// Per node, the far term's coefficients: sum m_j (x, y, z), the trace of
+    /// T = sum m_j (p_j - c)^T, and the six of x^T T x for any x: T_xx, T_yy, T_zz, T_xy + T_yx,
+    /// T_xz + T_zx, T_yz + T_zy.
+    std::vector<std::array<double, 10>> far;
   };
   [[nodiscard]] Moments moments(const RowMatrixX3d& M, const Eigen::VectorXd& sign) const;
   /// 4 pi w at q, smoothed by `own` (half its squared smoothing length), of the dipoles `d`.
@@ -90,7 +94,7 @@ class WindingTree {
   template <class Out>
   void each_field(const Eigen::VectorXd& q, int threads, Out&& out) const;
 
-  RowMatrixX3d P_;           ///< the finite points in tree order
+  Eigen::MatrixX3d P_;       ///< the finite points in tree order (column-major, as Moments::M)
   Eigen::VectorXd s2_;       ///< half their squared smoothing lengths, in tree order
   std::vector<int> order_;   ///< tree position -> row of V
   std::vector<Node> nodes_;  ///< nodes_[0] the root; children after their parent
