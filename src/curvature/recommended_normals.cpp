@@ -114,12 +114,14 @@ constexpr double kDoubtfulRoughness = 3.0;
 /// the positions, such vertices are isolated bad normals; elsewhere the exact normals stay exact
 /// (replacing them where two truncation-level residuals happen to differ by 2x cost up to 0.5%
 /// of H error on clean irregular meshes). Only a normal in doubt by its own 1-ring fit (rougher
-/// than kDoubtfulRoughness times the file's median, or none) is compared with its jet normal, and
-/// the jets are computed there (and at the 1-rings of the outliers, whose roughness reads them):
+/// than kDoubtfulRoughness times the file's median `median_roughness`, a mesh-wide choice so
+/// that a tile screens as the whole mesh; or none) is compared with its jet normal, and the jets
+/// are computed there (and at the 1-rings of the outliers, whose roughness reads them):
 /// elsewhere the file's normal is kept whatever they are.
-RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, double side, double limit) {
+RowMatrixX3d replace_outliers(const Context& c, NormalsRef file, double side, double limit,
+                              double median_roughness) {
   const Eigen::VectorXd file_roughness = roughness_of(c, file);
-  const double doubtful = kDoubtfulRoughness * finite_median(file_roughness);
+  const double doubtful = kDoubtfulRoughness * median_roughness;
   RowMatrixX3d out(file.rows(), 3);
   std::vector<char> doubt(static_cast<std::size_t>(file.rows()));
   detail::parallel_for(file.rows(), 0, [&](std::int64_t i) {
@@ -383,7 +385,8 @@ RecommendedMeshWide choose_normals(const Context& c, RecommendedResult& out) {
                                                             c.options.file_agreement);
   if (out.file_normals_used) {
     // The file's normals, except outliers where the positions' choice is clearly smoother.
-    out.N = replace_outliers(c, *file, side, c.options.outlier_disagreement * out.plan.noise);
+    out.N = replace_outliers(c, *file, side, c.options.outlier_disagreement * out.plan.noise,
+                             mesh_wide.file_roughness);
   } else {
     if (out.plan.rings > 1) {
       // Noisy positions: normals from wider, lower-degree jets that average the noise.

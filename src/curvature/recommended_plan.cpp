@@ -121,15 +121,21 @@ Eigen::VectorXd angles_between(NormalsRef A, NormalsRef B, double side, int thre
   return angle;
 }
 
-/// The per-mesh choices from their medians over the whole mesh (length units; radians) and the
-/// side: measured on one mesh (measure_mesh_wide) or over its parts (recommended_mesh_wide_from).
-RecommendedMeshWide mesh_wide_of(double jet_residual, double sample_noise, double file_angle,
-                                 double side, double edge_length) {
+/// The medians of the file's normals over the sample (radians; slope units) and their side.
+struct FileMedians {
+  double angle = NAN, roughness = NAN, side = 1.0;
+};
+
+/// The per-mesh choices from their medians over the whole mesh (length units) and the file's:
+/// measured on one mesh (measure_mesh_wide) or over its parts (recommended_mesh_wide_from).
+RecommendedMeshWide mesh_wide_of(double jet_residual, double sample_noise, const FileMedians& file,
+                                 double edge_length) {
   RecommendedMeshWide m;
   m.noise = jet_residual / edge_length;
   m.position_noise = sample_noise / edge_length;
-  m.file_disagreement = file_angle;
-  m.side = side;
+  m.file_disagreement = file.angle;
+  m.side = file.side;
+  m.file_roughness = file.roughness;
   return m;
 }
 
@@ -166,17 +172,18 @@ RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals* all) {
   } else {
     jets = detail::jet_normals_at(c.mesh.V(), *c.one_ring, c.max, jet_options(2, 3), sample);
   }
-  double side = 1.0, file_angle = NAN;
+  FileMedians medians;
   if (const std::optional<NormalsRef> file = c.mesh.normals()) {
     // The file's normals decide the side (the sign of the curvature), as in estimate_curvature;
     // normals from the positions take the side of the faces until turned.
     const RowMatrixX3d file_rows = rows_of(*file, sample);
-    side = majority_side(file_rows, jets.N);
-    file_angle = finite_median(angles_between(file_rows, jets.N, side, 0));
+    medians.side = majority_side(file_rows, jets.N);
+    medians.angle = finite_median(angles_between(file_rows, jets.N, medians.side, 0));
+    medians.roughness = finite_median(roughness_at(c, *file, sample));
   }
   const auto [noise_sample, r2] = with_finite_residual(sample, jets.residual);
   return mesh_wide_of(finite_median(jets.residual), finite_median(noise_at(c, r2, noise_sample)),
-                      file_angle, side, c.edge_length);
+                      medians, c.edge_length);
 }
 
 }  // namespace focal::detail::recommended
@@ -258,11 +265,13 @@ RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std
   if (const std::optional<NormalsRef> file = part.normals()) {
     const RowMatrixX3d file_rows = rows_of(*file, sampled);
     std::tie(out.along, out.against) = sides(file_rows, jets.N);
-    out.angle_along = out.angle_against = Eigen::VectorXd::Constant(m, NAN);
+    const Eigen::VectorXd roughness = roughness_at(c, *file, sampled);
+    out.angle_along = out.angle_against = out.file_roughness = Eigen::VectorXd::Constant(m, NAN);
     for (std::size_t s = 0; s < sampled.size(); ++s) {
       const auto k = static_cast<Eigen::Index>(s);
       out.angle_along[listed[s]] = angle_between(file_rows, jets.N, 1.0, k);
       out.angle_against[listed[s]] = angle_between(file_rows, jets.N, -1.0, k);
+      out.file_roughness[listed[s]] = roughness[k];
     }
   }
   return out;
@@ -270,11 +279,14 @@ RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std
 
 RecommendedMeshWide recommended_mesh_wide_from(const RecommendedMedians& whole,
                                                double mean_edge_length) {
-  const double side = side_of(whole.along, whole.against);
-  const double file_angle =
-      whole.has_normals ? (side < 0.0 ? whole.angle_against : whole.angle_along) : NAN;
-  return mesh_wide_of(whole.jet_residual, finite_median(whole.sample_noise), file_angle,
-                      whole.has_normals ? side : 1.0, mean_edge_length);
+  FileMedians file;
+  if (whole.has_normals) {
+    file.side = side_of(whole.along, whole.against);
+    file.angle = file.side < 0.0 ? whole.angle_against : whole.angle_along;
+    file.roughness = whole.file_roughness;
+  }
+  return mesh_wide_of(whole.jet_residual, finite_median(whole.sample_noise), file,
+                      mean_edge_length);
 }
 
 int recommended_reach(const RecommendedPlan& plan) {

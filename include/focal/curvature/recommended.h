@@ -53,6 +53,11 @@ struct RecommendedMeshWide {
   /// +1, or -1 when most file normals point against the jet normals (the positions' normals are
   /// then turned to the file's side).
   double side = 1.0;
+  /// Median roughness of the file's normals (the RMS misfit of the rays of a vertex's 1-ring
+  /// two-slit fit with them, slope units; NaN: no normals): a used file normal much rougher than
+  /// this is in doubt and compared with the positions' normals (docs/METHOD.md, step 3). NaN
+  /// with normals puts every file normal in doubt.
+  double file_roughness = NAN;
 };
 
 /// Options of the recommended estimator. The defaults are the measured choices of
@@ -144,6 +149,9 @@ struct RecommendedStatistics {
   Eigen::VectorXd angle_along, angle_against;
   /// Listed vertices of the sample whose normal points along / against the jet normal.
   std::int64_t along = 0, against = 0;
+  /// Per listed vertex, with mesh normals (else empty): the roughness of its normal (that of
+  /// RecommendedMeshWide::file_roughness); NaN where its fit is unusable.
+  Eigen::VectorXd file_roughness;
   /// Whole-mesh ids of the listed vertices in the position noise's sample (recommended_plan) ...
   std::vector<int> sample;
   Eigen::VectorXd sample_noise;  ///< ... and their position noise (length units)
@@ -167,6 +175,7 @@ struct RecommendedMedians {
   Eigen::VectorXd sample_noise;  ///< every part's sample_noise (any order)
   std::int64_t along = 0, against = 0;            ///< summed over the parts
   double angle_along = NAN, angle_against = NAN;  ///< medians of the finite angles
+  double file_roughness = NAN;                    ///< median of the finite file_roughness
   bool has_normals = false;                       ///< whether the mesh has normals
 };
 
