@@ -202,7 +202,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
   const Tiling tiling = partition_mesh(m.V, m.F, halo, {.tile_vertices = tile_vertices});
   RecommendedMedians whole;
   whole.has_normals = true;
-  std::vector<double> residual, along, against;
+  std::vector<double> residual, along, against, roughness;
   std::vector<std::pair<int, double>> sample;
   for (const Tile& tile : tiling.tiles) {
     const RecommendedStatistics s =
@@ -212,6 +212,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
     residual.insert(residual.end(), s.jet_residual.begin(), s.jet_residual.end());
     along.insert(along.end(), s.angle_along.begin(), s.angle_along.end());
     against.insert(against.end(), s.angle_against.begin(), s.angle_against.end());
+    roughness.insert(roughness.end(), s.file_roughness.begin(), s.file_roughness.end());
     whole.along += s.along;
     whole.against += s.against;
     for (std::size_t k = 0; k < s.sample.size(); ++k) {
@@ -224,6 +225,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
   whole.jet_residual = median_of(residual);
   whole.angle_along = median_of(along);
   whole.angle_against = median_of(against);
+  whole.file_roughness = median_of(roughness);
   whole.sample_noise =
       Eigen::Map<const Eigen::VectorXd>(sample_noise->data(), std::ssize(*sample_noise));
   return recommended_mesh_wide_from(whole, mean_edge);
@@ -262,8 +264,10 @@ TEST(Tiles, TheTilesStatisticsGiveTheWholeMeshsRecommendedChoices) {
           << what << ": " << got.position_noise << " vs " << expected.position_noise;
       EXPECT_TRUE(same_bits(got.file_disagreement, expected.file_disagreement)) << what;
       EXPECT_EQ(got.side, expected.side) << what;
+      EXPECT_TRUE(same_bits(got.file_roughness, expected.file_roughness)) << what;
     }
     EXPECT_TRUE(std::isfinite(expected.file_disagreement)) << name;
+    EXPECT_TRUE(std::isfinite(expected.file_roughness)) << name;
     EXPECT_EQ(expected.side, name == "inward" ? -1.0 : 1.0) << name;
     const int rings = recommended_plan_for_noise(expected.position_noise).rings;
     EXPECT_EQ(rings, name == "noise 5%" ? 2 : name == "noise 10%" ? 3 : 1) << name;

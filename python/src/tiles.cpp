@@ -30,6 +30,7 @@ nb::dict choices_dict(const focal::MeshWideChoices& c) {
     d["position_noise"] = c.recommended->position_noise;
     d["file_disagreement"] = c.recommended->file_disagreement;
     d["side"] = c.recommended->side;
+    d["file_roughness"] = c.recommended->file_roughness;
   }
   return d;
 }
@@ -42,7 +43,8 @@ focal::MeshWideChoices choices_from(const nb::dict& d) {
         focal::RecommendedMeshWide{.noise = nb::cast<double>(d["noise"]),
                                    .position_noise = nb::cast<double>(d["position_noise"]),
                                    .file_disagreement = nb::cast<double>(d["file_disagreement"]),
-                                   .side = nb::cast<double>(d["side"])};
+                                   .side = nb::cast<double>(d["side"]),
+                                   .file_roughness = nb::cast<double>(d["file_roughness"])};
   }
   return c;
 }
@@ -137,6 +139,7 @@ nb::dict tile_statistics(const DoubleRows& V, const IntRows& F, const std::optio
   d["jet_residual"] = to_numpy(std::move(r.jet_residual));
   d["angle_along"] = to_numpy(std::move(r.angle_along));
   d["angle_against"] = to_numpy(std::move(r.angle_against));
+  d["file_roughness"] = to_numpy(std::move(r.file_roughness));
   d["along"] = r.along;
   d["against"] = r.against;
   d["sample"] = ids_to_numpy(r.sample);
@@ -155,6 +158,7 @@ nb::dict recommended_choices(const nb::dict& medians, double mean_edge_length) {
   m.against = nb::cast<std::int64_t>(medians["against"]);
   m.angle_along = nb::cast<double>(medians["angle_along"]);
   m.angle_against = nb::cast<double>(medians["angle_against"]);
+  m.file_roughness = nb::cast<double>(medians["file_roughness"]);
   m.has_normals = nb::cast<bool>(medians["has_normals"]);
   focal::MeshWideChoices c;
   c.mean_edge_length = mean_edge_length;

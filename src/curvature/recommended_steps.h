@@ -85,18 +85,14 @@ RecommendedPlan plan_for(const RecommendedMeshWide& m, const RecommendedOptions&
 /// replacement at all; the factor matters for files with isolated bad normals.)
 bool file_normals_agree(double median_angle, double noise, double agreement);
 
-/// The file's normals compared with the jet normals: the side they point to, and per vertex the
-/// angle between the two (empty without file normals).
-struct FileComparison {
-  double side = 1.0;
-  Eigen::VectorXd disagreement;
-};
+/// Angle (radians) between a and b: NaN where either is zero or not finite.
+double normal_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 
-FileComparison compare_file_normals(const Context& c, const JetNormals& jets);
-
-/// The per-mesh choices measured on the context's mesh: medians over all its vertices.
-RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals& jets,
-                                      const FileComparison& file);
+/// The per-mesh choices measured on the context's mesh: medians (and the file normals' majority
+/// side) over a sample of about 4,096 of its vertices, every (n / 4,096)-th by index, from their
+/// 2-ring cubic jets (the sample's rows of `all`, local_jets(c, 2, 3) of every vertex, when
+/// given: the same bits).
+RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals* all = nullptr);
 
 /// Vertices within `rings` rings of a flagged one (not flagged themselves).
 std::vector<int> near_flagged(const Context& c, const std::vector<char>& flagged, int rings);

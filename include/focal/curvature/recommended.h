@@ -41,18 +41,23 @@ inline constexpr double kNoiseForRefittedJets = 0.1;
 /// gives no fit (never NaN where a wider fit is possible).
 inline constexpr int kMaxExtraRings = 2;
 
-/// The choices of steps 1 to 3 that are made once per mesh, from all its vertices (medians and
-/// a majority): given in RecommendedOptions::mesh_wide instead of measured, they let a part of a
-/// mesh (a tile with its halo, focal/tiles/tiles.h) be estimated exactly as in the whole mesh.
+/// The choices of steps 1 to 3 that are made once per mesh, from a sample of about 4,096 of its
+/// vertices chosen by index (medians and a majority): given in RecommendedOptions::mesh_wide
+/// instead of measured, they let a part of a mesh (a tile with its halo, focal/tiles/tiles.h) be
+/// estimated exactly as in the whole mesh.
 struct RecommendedMeshWide {
   double noise = NAN;  ///< RecommendedPlan::noise: judges the file's normals
-  /// RecommendedPlan::position_noise: decides the plan (measured on a sample of the vertices
-  /// chosen by index, so a tile could not measure it alone).
+  /// RecommendedPlan::position_noise: decides the plan (a tile could not measure it alone).
   double position_noise = NAN;
   double file_disagreement = NAN;  ///< RecommendedResult::file_disagreement (NaN: no normals)
   /// +1, or -1 when most file normals point against the jet normals (the positions' normals are
   /// then turned to the file's side).
   double side = 1.0;
+  /// Median roughness of the file's normals (the RMS misfit of the rays of a vertex's 1-ring
+  /// two-slit fit with them, slope units; NaN: no normals): a used file normal much rougher than
+  /// this is in doubt and compared with the positions' normals (docs/METHOD.md, step 3). NaN
+  /// with normals puts every file normal in doubt.
+  double file_roughness = NAN;
 };
 
 /// Options of the recommended estimator. The defaults are the measured choices of
@@ -85,7 +90,9 @@ struct RecommendedOptions {
 
 /// What the recommended estimator does for a mesh, decided from its positions alone.
 struct RecommendedPlan {
-  double noise = NAN;  ///< median cubic-jet residual over the mean edge length; NaN: none
+  /// median cubic-jet residual (over the sample of RecommendedMeshWide) over the mean edge
+  /// length; NaN: none
+  double noise = NAN;
   /// The part of it that is position noise, the jets' truncation error taken out (see
   /// recommended_plan): what decides the rings. Equals `noise` from recommended_plan_for_noise.
   double position_noise = NAN;
@@ -116,7 +123,8 @@ struct RecommendedPlan {
                                                const RecommendedOptions& options = {});
 
 /// The per-mesh choices of the recommended estimator on `mesh` (its normals as the file's, as
-/// estimate_curvature_recommended takes them): cubic jets over the 2-ring of every vertex.
+/// estimate_curvature_recommended takes them): cubic jets over the 2-ring of every
+/// (n / 4,096)-th vertex by index.
 /// \throw InvalidInput when an option is out of range.
 [[nodiscard]] RecommendedMeshWide recommended_mesh_wide(const PreparedMesh& mesh,
                                                         const RecommendedOptions& options = {});
@@ -129,8 +137,9 @@ inline constexpr int kRecommendedStatisticsReach = 3;
 
 /// A part's share of what recommended_mesh_wide measures over a whole mesh, for a mesh that no
 /// process holds whole (streamed tile by tile, python/focal/stream.py): per listed vertex the
-/// values the medians run over, and the counts of the majority. The whole mesh's choices are
-/// then recommended_mesh_wide_from the medians over all parts.
+/// values the medians run over (NaN at a vertex outside the whole mesh's sample, whose whole-mesh
+/// id is not a multiple of max(1, whole_vertex_count / 4096)), and the counts of the majority. The
+/// whole mesh's choices are then recommended_mesh_wide_from the medians over all parts.
 struct RecommendedStatistics {
   /// Per listed vertex: the residual of its 2-ring cubic jet (length units; NaN: no fit).
   Eigen::VectorXd jet_residual;
@@ -138,8 +147,11 @@ struct RecommendedStatistics {
   /// and the jet normal (along), and the jet normal turned round (against); NaN where either is
   /// unusable.
   Eigen::VectorXd angle_along, angle_against;
-  /// Listed vertices whose normal points along / against the jet normal.
+  /// Listed vertices of the sample whose normal points along / against the jet normal.
   std::int64_t along = 0, against = 0;
+  /// Per listed vertex, with mesh normals (else empty): the roughness of its normal (that of
+  /// RecommendedMeshWide::file_roughness); NaN where its fit is unusable.
+  Eigen::VectorXd file_roughness;
   /// Whole-mesh ids of the listed vertices in the position noise's sample (recommended_plan) ...
   std::vector<int> sample;
   Eigen::VectorXd sample_noise;  ///< ... and their position noise (length units)
@@ -156,12 +168,14 @@ struct RecommendedStatistics {
                                                            Eigen::Index whole_vertex_count,
                                                            const RecommendedOptions& options = {});
 
-/// The medians and counts of recommended_statistics over every vertex of a whole mesh.
+/// The medians and counts of recommended_statistics over every vertex of a whole mesh (its
+/// sample's values: the others are NaN).
 struct RecommendedMedians {
   double jet_residual = NAN;     ///< median of the finite jet_residual (nth_element at size / 2)
   Eigen::VectorXd sample_noise;  ///< every part's sample_noise (any order)
   std::int64_t along = 0, against = 0;            ///< summed over the parts
   double angle_along = NAN, angle_against = NAN;  ///< medians of the finite angles
+  double file_roughness = NAN;                    ///< median of the finite file_roughness
   bool has_normals = false;                       ///< whether the mesh has normals
 };
 
@@ -191,7 +205,8 @@ struct RecommendedResult {
   CurvatureResult curvature;
   RowMatrixX3d N;  ///< #V x 3 unit normals the two-slit fit used (NaN rows where there is none)
   RecommendedPlan plan;
-  /// Median angle (radians) between the file's normals and the jet normals; NaN without normals.
+  /// Median angle (radians) between the file's normals and the jet normals over the sample of
+  /// RecommendedMeshWide; NaN without normals.
   double file_disagreement = NAN;
   /// Whether the file's normals were used: they agree with the positions (file_disagreement at
   /// most file_agreement times the noise). Otherwise they are ignored as a whole, except for
