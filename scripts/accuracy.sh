@@ -487,11 +487,12 @@ HEAD
 
 ## By category
 
-- **Clean meshes.** Exact on spheres and cylinders whatever the triangulation. On irregular
-  meshes focal is the lowest, with the file's normals (the corrected measures of those normals
-  on irregular 1-rings) and without them (jet normals from the positions). On clean regular
-  grids the cotangent formula (MDSB03, libigl, VTK) is second order with a smaller constant and
-  is ahead.
+- **Clean meshes.** Exact on spheres and cylinders whatever the triangulation. With the file's
+  normals focal is the lowest on regular, irregular, strip and graded meshes: it fits a quartic
+  to each 1-ring's heights and the slopes its normals give (third order in the edge length).
+  Without normals it is the lowest on irregular meshes (jet normals from the positions); on
+  clean regular grids the cotangent formula (MDSB03, libigl, VTK) is second order with a
+  smaller constant and is ahead there.
 - **Vertex noise.** focal measures the noise and widens its fit (2 or 3 Gaussian-weighted rings,
   rays far off the fit rejected): lowest on most noisy cases, with LRTC20 on the file's normals
   close and ahead on a few (helix tube, pear, where the whole-mesh ring count is wide for the
@@ -500,8 +501,8 @@ HEAD
 - **Normal noise.** focal judges the file's normals as a whole and ignores noisy ones, so it
   gives what it gives without normals; methods that trust the normals (LRTC20 on the file's
   normals) take the noise in.
-- **Hard cases.** Lowest or tied in most categories. On strips across the curvature the
-  cotangent formula and the mid-edge operator (GGRZ06) are ahead. Outlier normals and spikes
+- **Hard cases.** Lowest or tied in most categories. Without normals, on strips across the
+  curvature the cotangent formula and the mid-edge operator (GGRZ06) are ahead. Outlier normals and spikes
   are found and undone with the file's normals; without normals spikes are found from the
   positions (each vertex against a quadric fitted to its neighbours without it) and moved back.
   Creases (the capped cylinder) are flagged on clean positions and not fitted across.

@@ -1,6 +1,7 @@
 #include "curvature/hermite_fit.h"
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -113,15 +114,18 @@ constexpr auto kNormalEntries = normal_entries();
 /// by 1 / d^4 plus moments of degree 2 to 6 weighted by 1 / d^2, and A^T b is made of 30 more:
 /// 90 sums a point instead of three rank-one updates of a 12 x 12 matrix.
 ///
-/// With `free_height`, the height at the vertex is an unknown too (its position is known to
-/// third order only, as a repaired spike's), eliminated from the normal equations (its Schur
-/// complement): its column, the height rows' 1 / d^2, is summed from the rows themselves (the
-/// case is rare).
+/// Free terms: the height at the vertex (`free_height`: its position is known to third order
+/// only, as a repaired spike's) and the gradient there (`free_gradient`: its normal is, as one
+/// estimated from the positions) become unknowns too, eliminated from the normal equations
+/// (their Schur complement). Their columns are 1 / d^2, u / d^2, v / d^2 in the height row and
+/// 1 / d in the slope rows of the gradient's own component; their blocks are summed from the
+/// rows themselves (few vertices need them).
 struct System {
-  bool free_height = false;
-  double free_free = 0.0;   ///< the free column's square
-  Terms free_terms{};       ///< its products with the terms' columns
-  double free_right = 0.0;  ///< its product with b
+  bool free_height = false, free_gradient = false;
+  Eigen::Matrix3d free_free = Eigen::Matrix3d::Zero();  ///< F^T F, terms (1, u, v)
+  Eigen::Matrix<double, 3, kTerms> free_terms =
+      Eigen::Matrix<double, 3, kTerms>::Zero();          ///< F^T A
+  Eigen::Vector3d free_right = Eigen::Vector3d::Zero();  ///< F^T b
   std::array<double, kHeightMoments.size()> heights{};
   std::array<double, kSlopeMoments.size()> slopes{};
   std::array<double, kHeightRight.size()> height_right{};
@@ -130,8 +134,10 @@ struct System {
   int rows = 0;
 
   /// A point at scaled offset (u, v), height z, slopes (zu, zv).
-  void add_point(double u, double v, double z, double zu, double zv) {
+  void add_point(double u, double v, double z, double zu, double zv, bool slopes_known) {
     const double g = 1.0 / (u * u + v * v), h = g * g;
+    // A point whose normal is not known to full order gives its height row only.
+    const double gs = slopes_known ? g : 0.0;
     std::array<double, 9> pu, pv;
     pu[0] = pv[0] = 1.0;
     for (std::size_t k = 1; k < 9; ++k) {
@@ -142,23 +148,57 @@ struct System {
       constexpr std::array<int, 2> e = decltype(table)::value[k];
       return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
     };
-    const double hz = h * z, gu = g * zu, gv = g * zv;
+    const double hz = h * z, gu = gs * zu, gv = gs * zv;
     unroll<kHeightMoments.size()>([&](auto k) { heights[k] += h * at(HeightMoments{}, k); });
-    unroll<kSlopeMoments.size()>([&](auto k) { slopes[k] += g * at(SlopeMoments{}, k); });
+    unroll<kSlopeMoments.size()>([&](auto k) { slopes[k] += gs * at(SlopeMoments{}, k); });
     unroll<kTerms>([&](auto k) { height_right[k] += hz * at(HeightRight{}, k); });
     unroll<kSlopeRight.size()>([&](auto k) {
       const double m = at(SlopeRight{}, k);
       u_right[k] += gu * m;
       v_right[k] += gv * m;
     });
-    if (free_height) {
-      // The free column is 1 / d^2 in the height row, 0 in the slope rows.
-      free_free += h;
-      unroll<kTerms>([&](auto k) { free_terms[k] += h * at(HeightRight{}, k); });
-      free_right += hz;
+    if (free_height || free_gradient) add_free(pu, pv, g, slopes_known, z, zu, zv);
+    btb += hz * z + gs * (zu * zu + zv * zv);
+    rows += slopes_known ? 3 : 1;
+  }
+
+  /// The free terms' blocks of a point's three rows (g = 1 / d^2).
+  void add_free(const std::array<double, 9>& pu, const std::array<double, 9>& pv, double g,
+                bool slopes_known, double z, double zu, double zv) {
+    const double w = slopes_known ? std::sqrt(g) : 0.0, on = free_gradient ? 1.0 : 0.0;
+    const Eigen::Vector3d height(free_height ? g : 0.0, on * g * pu[1], on * g * pv[1]);
+    const Eigen::Vector3d du(0.0, on * w, 0.0), dv(0.0, 0.0, on * w);
+    Eigen::Matrix<double, kTerms, 1> m, mu, mv;
+    for (std::size_t i = 0; i < kTerms; ++i) {
+      const auto a = static_cast<std::size_t>(kHeightRight[i][0]);
+      const auto b = static_cast<std::size_t>(kHeightRight[i][1]);
+      const auto k = static_cast<Eigen::Index>(i);
+      m[k] = g * pu[a] * pv[b];
+      mu[k] = a > 0 ? w * static_cast<double>(a) * pu[a - 1] * pv[b] : 0.0;
+      mv[k] = b > 0 ? w * static_cast<double>(b) * pu[a] * pv[b - 1] : 0.0;
     }
-    btb += hz * z + g * (zu * zu + zv * zv);
-    rows += 3;
+    free_free += height * height.transpose() + du * du.transpose() + dv * dv.transpose();
+    free_terms += height * m.transpose() + du * mu.transpose() + dv * mv.transpose();
+    free_right += height * (g * z) + du * (w * zu) + dv * (w * zv);
+  }
+
+  [[nodiscard]] bool any_free() const { return free_height || free_gradient; }
+
+  /// The inverse of the free terms' block on the free terms (zero rows and columns elsewhere).
+  [[nodiscard]] Eigen::Matrix3d free_inverse() const {
+    Eigen::Matrix3d out = Eigen::Matrix3d::Zero();
+    if (free_height && free_gradient) return free_free.inverse();
+    if (free_height) out(0, 0) = 1.0 / free_free(0, 0);
+    if (free_gradient)
+      out.bottomRightCorner<2, 2>() = free_free.bottomRightCorner<2, 2>().inverse();
+    return out;
+  }
+
+  /// The free gradient at the solution c of the other terms: F^T F e = F^T (b - A c).
+  [[nodiscard]] Eigen::Vector2d free_gradient_at(const Terms& c) const {
+    const Eigen::Map<const Eigen::Matrix<double, kTerms, 1>> terms(c.data());
+    const Eigen::Vector3d e = free_inverse() * (free_right - free_terms * terms);
+    return e.tail<2>();
   }
 
   /// A^T A from the moments.
@@ -172,10 +212,13 @@ struct System {
       out[static_cast<std::size_t>(e.i)][static_cast<std::size_t>(e.j)] = x;
       out[static_cast<std::size_t>(e.j)][static_cast<std::size_t>(e.i)] = x;
     });
-    if (free_height) {
+    if (any_free()) {
+      const Eigen::Matrix<double, kTerms, kTerms> schur =
+          free_terms.transpose() * free_inverse() * free_terms;
       for (std::size_t i = 0; i < kTerms; ++i) {
-        for (std::size_t j = 0; j < kTerms; ++j)
-          out[i][j] -= free_terms[i] * free_terms[j] / free_free;
+        for (std::size_t j = 0; j < kTerms; ++j) {
+          out[i][j] -= schur(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+        }
       }
     }
     return out;
@@ -192,8 +235,10 @@ struct System {
       if constexpr (b > 0) x += b * v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
       out[i] = x;
     });
-    if (free_height) {
-      for (std::size_t i = 0; i < kTerms; ++i) out[i] -= free_terms[i] * free_right / free_free;
+    if (any_free()) {
+      const Eigen::Matrix<double, kTerms, 1> schur =
+          free_terms.transpose() * (free_inverse() * free_right);
+      for (std::size_t i = 0; i < kTerms; ++i) out[i] -= schur[static_cast<Eigen::Index>(i)];
     }
     return out;
   }
@@ -241,10 +286,23 @@ struct System {
     const Terms atb = right_side();
     double ctb = 0.0;
     for (std::size_t i = 0; i < kTerms; ++i) ctb += c[i] * atb[i];
-    const double bb = free_height ? btb - free_right * free_right / free_free : btb;
+    const double bb = any_free() ? btb - free_right.dot(free_inverse() * free_right) : btb;
     return std::sqrt(std::max(0.0, bb - ctb) / rows);
   }
 };
+
+/// The shape operator [a b; b c] of a graph with Hessian `hessian` and gradient p at the
+/// point, symmetrised in the metric G = I + p p^T: G^(-1/2) II G^(-1/2) with
+/// II = -hessian / sqrt(1 + |p|^2). Its eigenvalues are the principal curvatures; its
+/// eigenvectors are the directions in the plane to first order in p.
+Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eigen::Vector2d& p) {
+  const double q = p.squaredNorm();
+  const double root = std::sqrt(1.0 + q);
+  Eigen::Matrix2d half = Eigen::Matrix2d::Identity();  // G^(-1/2)
+  if (q > 0.0) half += (1.0 / root - 1.0) * p * p.transpose() / q;
+  const Eigen::Matrix2d S = half * (-hessian / root) * half;
+  return {S(0, 0), 0.5 * (S(0, 1) + S(1, 0)), S(1, 1)};
+}
 
 /// Why a stencil gave no operator: too few rows to fix the quartic (a wider stencil may), or
 /// rows it does not fit (a wider one would not help).
@@ -255,8 +313,9 @@ enum class Refusal { none, underdetermined, unfit };
 std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX3d& N,
                                                 const std::vector<char>& ok,
                                                 const std::vector<int>& stencil, int v,
+                                                const std::vector<char>& guessed,
                                                 const TangentFrame& frame, bool free_height,
-                                                Refusal& refusal) {
+                                                bool free_gradient, Refusal& refusal) {
   refusal = Refusal::underdetermined;
   if (stencil.size() < 5 || stencil.size() > kMaxPoints) return std::nullopt;
   refusal = Refusal::unfit;
@@ -281,10 +340,12 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
   if (!(s > 0.0)) return std::nullopt;
   System sys;
   sys.free_height = free_height;
+  sys.free_gradient = free_gradient;
   for (std::size_t j = 0; j < stencil.size(); ++j) {
     const double u = local[j].x() / s, w = local[j].y() / s;
     if (!(u * u + w * w > 0.0)) return std::nullopt;
-    sys.add_point(u, w, local[j].z() / s, slope[j].x(), slope[j].y());
+    sys.add_point(u, w, local[j].z() / s, slope[j].x(), slope[j].y(),
+                  guessed.empty() || !guessed[static_cast<std::size_t>(stencil[j])]);
   }
   const std::optional<Terms> c = sys.solve();
   if (!c) {
@@ -296,14 +357,17 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
     return std::nullopt;
   }
   refusal = Refusal::none;
-  // h(x, y) = s h~(x / s, y / s): second derivatives are h~'s over s.
-  return Eigen::Vector3d(-2.0 * k[0] / s, -k[1] / s, -2.0 * k[2] / s);
+  // h(x, y) = s h~(x / s, y / s): second derivatives are h~'s over s, first ones h~'s.
+  const Eigen::Matrix2d hessian =
+      (Eigen::Matrix2d() << 2.0 * k[0], k[1], k[1], 2.0 * k[2]).finished() / s;
+  return free_gradient ? graph_operator(hessian, sys.free_gradient_at(k))
+                       : Eigen::Vector3d(-hessian(0, 0), -hessian(0, 1), -hessian(1, 1));
 }
 
-/// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` and `guessed`
-/// vertices, into `out`.
+/// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` vertices, into
+/// `out`.
 void stencil_of(const Neighbourhoods& one_ring, int v, bool wide, const std::vector<char>& moved,
-                const std::vector<char>& guessed, std::vector<int>& out) {
+                std::vector<int>& out) {
   out.assign(one_ring.begin(v), one_ring.end(v));
   if (wide) {
     const std::size_t first = out.size();
@@ -315,11 +379,9 @@ void stencil_of(const Neighbourhoods& one_ring, int v, bool wide, const std::vec
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
-  const auto left_out = [&](int j) {
-    const auto k = static_cast<std::size_t>(j);
-    return (!moved.empty() && moved[k]) || (!guessed.empty() && guessed[k]);
-  };
-  if (!moved.empty() || !guessed.empty()) std::erase_if(out, left_out);
+  if (!moved.empty()) {
+    std::erase_if(out, [&](int j) { return moved[static_cast<std::size_t>(j)] != 0; });
+  }
 }
 
 }  // namespace
@@ -336,18 +398,16 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
     for (std::int64_t i = begin; i < end; ++i) {
       const auto v = static_cast<std::size_t>(i);
       const int vi = static_cast<int>(i);
-      if (!ok[v] || (!keep.empty() && keep[v]) || (!guessed.empty() && guessed[v]) ||
-          fit.residual[i] <= exact_residual) {
-        continue;
-      }
+      if (!ok[v] || (!keep.empty() && keep[v]) || fit.residual[i] <= exact_residual) continue;
       if (incidence.size(i) != static_cast<int>(one_ring.end(vi) - one_ring.begin(vi))) continue;
       const TangentFrame frame = tangent_frame(N.row(i).transpose());
       Refusal refusal = Refusal::none;
       std::optional<Eigen::Vector3d> op;
       // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
       for (const bool wide : {false, true}) {
-        stencil_of(one_ring, vi, wide, moved, guessed, stencil);
-        op = hermite_operator(V, N, ok, stencil, vi, frame, !moved.empty() && moved[v], refusal);
+        stencil_of(one_ring, vi, wide, moved, stencil);
+        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, !moved.empty() && moved[v],
+                              !guessed.empty() && guessed[v], refusal);
         if (refusal != Refusal::underdetermined) break;
       }
       if (!op) continue;

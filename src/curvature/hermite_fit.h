@@ -40,16 +40,17 @@ constexpr double kHermiteMaxMisfit = 0.005;
 /// and second), on irregular, strip and graded meshes alike.
 ///
 /// Writes the rows of `fit` at vertices with `ok` normals whose 1-ring is closed (as many
-/// faces as neighbours in `incidence`), where neither `keep` nor `guessed` (below) is set and the
+/// faces as neighbours in `incidence`), where `keep` (empty or #V flags) is not set and the
 /// row's residual is above `exact_residual` (the two-slit fit is exact there already). The
 /// stencil is the 1-ring, or the 2-ring where the 1-ring does not fix the quartic
-/// (kHermiteMinPivot; a vertex of valence 4), less the `moved` and `guessed` vertices (each
-/// empty or #V flags: positions known to third order only, such as repaired spikes; normals
-/// estimated from the positions, such as a file normal replaced as an outlier; a moved vertex's
-/// own fit takes the height at it as one more unknown): at least 5 and at most 96
-/// points, all with `ok` normals within kHermiteMaxTurnCosine of the vertex's, whose quartic
-/// meets its rows (kHermiteMaxMisfit). The row keeps its residual. Returns, per vertex,
-/// whether its row was written.
+/// (kHermiteMinPivot; a vertex of valence 4): at least 5 and at most 96 points, all with `ok`
+/// normals within kHermiteMaxTurnCosine of the vertex's, whose quartic meets its rows
+/// (kHermiteMaxMisfit). Two kinds of vertices know less (each empty or #V flags): `moved`
+/// positions are known to third order only (repaired spikes): they are in no other stencil,
+/// and their own fits take the height at the vertex as one more unknown; `guessed` normals are
+/// estimated from the positions (file normals replaced as outliers): they give their height
+/// rows only, and their own fits take the gradient at the vertex as two more unknowns. The row
+/// keeps its residual. Returns, per vertex, whether its row was written.
 std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const std::vector<char>& ok, const Neighbourhoods& one_ring,
                                      const VertexFaces& incidence, const std::vector<char>& keep,
