@@ -68,13 +68,19 @@ struct Centre {
   bool written;
   CurvatureResult fit;
 };
-Centre fit_centre(const Mesh& m) {
+/// `moved` / `guessed`: the centre's position / normal flagged as known to low order only.
+Centre fit_centre(const Mesh& m, bool moved = false, bool guessed = false) {
   const PreparedMesh mesh(m.V, m.F, m.N);
   CurvatureResult fit = detail::undefined_result(m.V.rows());
   fit.residual.setConstant(1.0);  // no row exact
-  const std::vector<char> ok(static_cast<std::size_t>(m.V.rows()), 1), keep;
-  const std::vector<char> written = detail::prefer_hermite_fit(
-      m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep, keep, keep, 1e-9, {}, fit);
+  const auto n = static_cast<std::size_t>(m.V.rows());
+  const std::vector<char> ok(n, 1), keep;
+  std::vector<char> moved_flags(n, 0), guessed_flags(n, 0);
+  moved_flags[0] = moved ? 1 : 0;
+  guessed_flags[0] = guessed ? 1 : 0;
+  const std::vector<char> written =
+      detail::prefer_hermite_fit(m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep,
+                                 moved_flags, guessed_flags, 1e-9, {}, fit);
   return {written[0] != 0, std::move(fit)};
 }
 
@@ -92,6 +98,38 @@ TEST(HermiteFit, ExactOnQuarticGraphs) {
     EXPECT_NEAR(r.fit.K[0], K, 1e-10) << valence;
     EXPECT_NEAR(r.fit.k1[0] - r.fit.k2[0], 2.0 * std::sqrt(H * H - K), 1e-10) << valence;
   }
+}
+
+// A centre whose position is off the surface (moved: its height is an unknown) or whose normal
+// is not the surface's (guessed: the gradient is), on a graph with a tilt: the surface's
+// curvature all the same, from the graph's operator with the fitted gradient.
+TEST(HermiteFit, FreeHeightAndGradient) {
+  Quartic f;
+  const Centre plain = fit_centre(fan(f, 7, 0.3));
+  Mesh moved = fan(f, 7, 0.3);
+  moved.V(0, 2) += 0.05;  // the centre above the surface; neighbours exact
+  const Centre off = fit_centre(moved, true, false);
+  ASSERT_TRUE(off.written);
+  EXPECT_NEAR(off.fit.H[0], plain.fit.H[0], 1e-10);
+  EXPECT_NEAR(off.fit.K[0], plain.fit.K[0], 1e-10);
+  // z = p x + q y + the quartic, its normal at 0 left as (0, 0, 1): the frame is tilted.
+  const double p = 0.2, q = -0.1;
+  Mesh tilted = fan(f, 7, 0.3);
+  for (Eigen::Index i = 1; i < tilted.V.rows(); ++i) {
+    tilted.V(i, 2) += p * tilted.V(i, 0) + q * tilted.V(i, 1);
+    const Eigen::Vector3d n = tilted.N.row(i).transpose();
+    tilted.N.row(i) = Eigen::Vector3d(n.x() / n.z() - p, n.y() / n.z() - q, 1.0).normalized();
+  }
+  const Centre graph = fit_centre(tilted, false, true);
+  ASSERT_TRUE(graph.written);
+  // Monge patch: r, s, t the second derivatives, w = 1 + p^2 + q^2; the outward normal's H
+  // and K (the sign of the operator, minus the Hessian).
+  const double r = 2 * f.a20, sxy = f.a11, t = 2 * f.a02, w = 1 + p * p + q * q;
+  const double K = (r * t - sxy * sxy) / (w * w);
+  const double H = -((1 + q * q) * r - 2 * p * q * sxy + (1 + p * p) * t) / (2 * std::pow(w, 1.5));
+  EXPECT_NEAR(graph.fit.H[0], H, 1e-10);
+  EXPECT_NEAR(graph.fit.K[0], K, 1e-10);
+  EXPECT_FALSE(fit_centre(tilted).written);  // without the free gradient the rows do not fit
 }
 
 // Four points give 12 rows for 12 unknowns (a fan of valence 4, whose 2-ring is its 1-ring):
