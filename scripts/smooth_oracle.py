@@ -60,6 +60,20 @@ def best_peer(V, F, sd, crease, V0, h):
     return best
 
 
+def chosen_cases(args):
+    """The cases of smooth_eval.py on args.surfaces (all if none), each with its noisy inputs:
+    (surface, noise label, clean V, F, signed distance, crease distance, mean edge, a generator
+    of (seed, noisy V) over args.seeds)."""
+    for name, V0, F, sd, crease in se.cases():
+        if args.surfaces and name not in args.surfaces:
+            continue
+        h = se.edge_length(V0, F)
+        for label, how, level in se.NOISES:
+            inputs = ((seed, se.noisy(V0, F, how, level, h, np.random.default_rng(seed)))
+                      for seed in args.seeds)
+            yield name, label, V0, F, sd, crease, h, inputs
+
+
 def sweep(args):
     out = open(args.settings, "w") if args.settings else None
     if out:
@@ -67,46 +81,40 @@ def sweep(args):
     print("| surface | noise | input | focal default (passes) | focal oracle (rings, passes, "
           "robust) | signed | best peer | 0.6 x peer | oracle / peer |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for name, V0, F, sd, crease in se.cases():
-        if args.surfaces and name not in args.surfaces:
-            continue
-        h = se.edge_length(V0, F)
+    for name, label, V0, F, sd, crease, h, inputs in chosen_cases(args):
         creases = crease is not None
-        for label, how, level in se.NOISES:
-            rows = []
-            for seed in args.seeds:
-                rng = np.random.default_rng(seed)
-                V = se.noisy(V0, F, how, level, h, rng)
-                inp = math.sqrt(np.mean((sd(V) / h) ** 2))
-                d = focal.smooth(V, F, keep_creases=creases, threads=args.threads)
-                default = se.metrics(d.V, d.N, sd, crease, V0, h)[0]
-                best = None
-                for rings, it in settings(args.rings):
-                    for robust in (True, False) if rings <= 6 else (True,):
-                        r = focal.smooth(V, F, iterations=it, rings=rings, robust=robust,
-                                         keep_creases=creases, threads=args.threads)
-                        m = se.metrics(r.V, r.N, sd, crease, V0, h)
-                        if out:
-                            out.write(f"{name},{label},{seed},{int(creases)},{rings},{it},"
-                                      f"{int(robust)},{m[0]:.5f},{m[2]:+.5f}\n")
-                        if best is None or m[0] < best[0]:
-                            best = (m[0], m[2], f"{rings}, {it}, {'on' if robust else 'off'}")
-                peer = best_peer(V, F, sd, crease, V0, h)
-                rows.append((inp, default, d.iterations, best, peer))
-            inp = np.mean([r[0] for r in rows])
-            default = np.mean([r[1] for r in rows])
-            oracle = np.mean([r[3][0] for r in rows])
-            signed = np.mean([r[3][1] for r in rows])
-            peer = np.mean([r[4][0] for r in rows])
-            passes = "/".join(str(r[2]) for r in rows)
-            which = " / ".join(r[3][2] for r in rows)
-            peers = " / ".join(r[4][1] for r in rows)
-            print(f"| {name} | {label} | {inp:.3f} | {default:.3f} ({passes}) | {oracle:.3f} "
-                  f"({which}) | {signed:+.3f} | {peer:.3f} {peers} | {0.6 * peer:.3f} | "
-                  f"{oracle / peer:.2f} |")
-            sys.stdout.flush()
-            if out:
-                out.flush()
+        rows = []
+        for seed, V in inputs:
+            inp = math.sqrt(np.mean((sd(V) / h) ** 2))
+            d = focal.smooth(V, F, keep_creases=creases, threads=args.threads)
+            default = se.metrics(d.V, d.N, sd, crease, V0, h)[0]
+            best = None
+            for rings, it in settings(args.rings):
+                for robust in (True, False) if rings <= 6 else (True,):
+                    r = focal.smooth(V, F, iterations=it, rings=rings, robust=robust,
+                                     keep_creases=creases, threads=args.threads)
+                    m = se.metrics(r.V, r.N, sd, crease, V0, h)
+                    if out:
+                        out.write(f"{name},{label},{seed},{int(creases)},{rings},{it},"
+                                  f"{int(robust)},{m[0]:.5f},{m[2]:+.5f}\n")
+                    if best is None or m[0] < best[0]:
+                        best = (m[0], m[2], f"{rings}, {it}, {'on' if robust else 'off'}")
+            peer = best_peer(V, F, sd, crease, V0, h)
+            rows.append((inp, default, d.iterations, best, peer))
+        inp = np.mean([r[0] for r in rows])
+        default = np.mean([r[1] for r in rows])
+        oracle = np.mean([r[3][0] for r in rows])
+        signed = np.mean([r[3][1] for r in rows])
+        peer = np.mean([r[4][0] for r in rows])
+        passes = "/".join(str(r[2]) for r in rows)
+        which = " / ".join(r[3][2] for r in rows)
+        peers = " / ".join(r[4][1] for r in rows)
+        print(f"| {name} | {label} | {inp:.3f} | {default:.3f} ({passes}) | {oracle:.3f} "
+              f"({which}) | {signed:+.3f} | {peer:.3f} {peers} | {0.6 * peer:.3f} | "
+              f"{oracle / peer:.2f} |")
+        sys.stdout.flush()
+        if out:
+            out.flush()
 
 
 def rule(args):
@@ -115,31 +123,26 @@ def rule(args):
     print("| surface | noise | default (rings; passes) | RMS | signed | normal | wider (rings; "
           "passes) | RMS | signed | normal |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for name, V0, F, sd, crease in se.cases():
-        if args.surfaces and name not in args.surfaces:
-            continue
-        h = se.edge_length(V0, F)
+    for name, label, V0, F, sd, crease, h, inputs in chosen_cases(args):
         creases = crease is not None
-        for label, how, level in se.NOISES:
-            cols = {"default": [], "wider": []}
-            for seed in args.seeds:
-                V = se.noisy(V0, F, how, level, h, np.random.default_rng(seed))
-                d = focal.smooth(V, F, keep_creases=creases, threads=args.threads)
-                w = d
-                if d.rings >= args.from_rings:
-                    w = focal.smooth(V, F, rings=d.rings + args.wider, keep_creases=creases,
-                                     threads=args.threads)
-                for key, r in (("default", d), ("wider", w)):
-                    cols[key].append(se.metrics(r.V, r.N, sd, crease, V0, h) +
-                                     (f"{r.rings}; {r.iterations}",))
-            cells = []
-            for key in ("default", "wider"):
-                a = cols[key]
-                cells.append(f"{'/'.join(c[4] for c in a)} | {np.mean([c[0] for c in a]):.4f} | "
-                             f"{np.mean([c[2] for c in a]):+.4f} | "
-                             f"{np.mean([c[3] for c in a]):.2f}")
-            print(f"| {name} | {label} | {' | '.join(cells)} |")
-            sys.stdout.flush()
+        cols = {"default": [], "wider": []}
+        for _, V in inputs:
+            d = focal.smooth(V, F, keep_creases=creases, threads=args.threads)
+            w = d
+            if d.rings >= args.from_rings:
+                w = focal.smooth(V, F, rings=d.rings + args.wider, keep_creases=creases,
+                                 threads=args.threads)
+            for key, r in (("default", d), ("wider", w)):
+                cols[key].append(se.metrics(r.V, r.N, sd, crease, V0, h) +
+                                 (f"{r.rings}; {r.iterations}",))
+        cells = []
+        for key in ("default", "wider"):
+            a = cols[key]
+            cells.append(f"{'/'.join(c[4] for c in a)} | {np.mean([c[0] for c in a]):.4f} | "
+                         f"{np.mean([c[2] for c in a]):+.4f} | "
+                         f"{np.mean([c[3] for c in a]):.2f}")
+        print(f"| {name} | {label} | {' | '.join(cells)} |")
+        sys.stdout.flush()
 
 
 # --- the linear model ------------------------------------------------------------------------
