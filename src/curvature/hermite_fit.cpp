@@ -404,11 +404,25 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
       Refusal refusal = Refusal::none;
       std::optional<Eigen::Vector3d> op;
       // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
+      const bool free_gradient = !guessed.empty() && guessed[v];
+      const bool free_height = !moved.empty() && moved[v];
+      bool on_one_ring = true;
       for (const bool wide : {false, true}) {
+        on_one_ring = !wide;
         stencil_of(one_ring, vi, wide, moved, stencil);
-        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, !moved.empty() && moved[v],
-                              !guessed.empty() && guessed[v], refusal);
+        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
+                              refusal);
         if (refusal != Refusal::underdetermined) break;
+      }
+      // A free gradient leaves a 1-ring's misfit too few rows (14 unknowns) to tell a spike
+      // or a wild normal in it: the 1-ring's operator stands only where the 2-ring's agrees.
+      if (op.has_value() && free_gradient && on_one_ring) {
+        const Eigen::Vector3d ring_operator = *op;
+        stencil_of(one_ring, vi, true, moved, stencil);
+        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, true, refusal);
+        if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
+          op = ring_operator;
+        }
       }
       if (!op) continue;
       store_vertex(fit, i, frame, principal_from_symmetric((*op)[0], (*op)[1], (*op)[2]),

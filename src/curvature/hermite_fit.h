@@ -30,6 +30,13 @@ constexpr double kHermiteMinPivot = 1e-12;
 /// shows as 0.01 to 0.6, and the per-triangle pass there stays.
 constexpr double kHermiteMaxMisfit = 0.005;
 
+/// Largest difference, relative to the 2-ring's, between the operators of a vertex's 1-ring
+/// and 2-ring fits for the 1-ring's to stand where the gradient is free (a guessed normal): on
+/// clean meshes the two differ by their truncation, a few percent; a spike or a wild normal in
+/// the 1-ring, which its few spare rows cannot show, by far more (the spiked helix tube with
+/// outlier normals: 5 times H).
+constexpr double kHermiteAgreement = 0.1;
+
 /// The quartic Hermite fit of a vertex's closed 1-ring: the height h(x, y) over the tangent
 /// plane of the vertex's unit normal, h = sum of the 12 monomials of degree 2 to 4 (h and its
 /// gradient vanish at the vertex: the normal is the plane's), fitted in least squares to each
