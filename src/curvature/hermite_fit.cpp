@@ -315,7 +315,7 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
                                                 const std::vector<int>& stencil, int v,
                                                 const std::vector<char>& guessed,
                                                 const TangentFrame& frame, bool free_height,
-                                                bool free_gradient, Refusal& refusal) {
+                                                bool free_gradient, Refusal& refusal, int& spare) {
   refusal = Refusal::underdetermined;
   if (stencil.size() < 5 || stencil.size() > kMaxPoints) return std::nullopt;
   refusal = Refusal::unfit;
@@ -346,6 +346,11 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
     if (!(u * u + w * w > 0.0)) return std::nullopt;
     sys.add_point(u, w, local[j].z() / s, slope[j].x(), slope[j].y(),
                   guessed.empty() || !guessed[static_cast<std::size_t>(stencil[j])]);
+  }
+  spare = sys.rows - (kTerms + (free_height ? 1 : 0) + (free_gradient ? 2 : 0));
+  if (spare < 1) {
+    refusal = Refusal::underdetermined;
+    return std::nullopt;
   }
   const std::optional<Terms> c = sys.solve();
   if (!c) {
@@ -407,19 +412,22 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
       const bool free_gradient = !guessed.empty() && guessed[v];
       const bool free_height = !moved.empty() && moved[v];
       bool on_one_ring = true;
+      int spare = 0;
       for (const bool wide : {false, true}) {
         on_one_ring = !wide;
         stencil_of(one_ring, vi, wide, moved, stencil);
         op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
-                              refusal);
+                              refusal, spare);
         if (refusal != Refusal::underdetermined) break;
       }
-      // A free gradient leaves a 1-ring's misfit too few rows (14 unknowns) to tell a spike
-      // or a wild normal in it: the 1-ring's operator stands only where the 2-ring's agrees.
-      if (op.has_value() && free_gradient && on_one_ring) {
+      // A 1-ring fit with few rows to spare (a free gradient, guessed neighbours' single rows)
+      // cannot show a spike or a wild normal in its misfit: it stands only where the 2-ring's
+      // agrees.
+      if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
         const Eigen::Vector3d ring_operator = *op;
         stencil_of(one_ring, vi, true, moved, stencil);
-        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, true, refusal);
+        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
+                              refusal, spare);
         if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
           op = ring_operator;
         }

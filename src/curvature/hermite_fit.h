@@ -30,8 +30,15 @@ constexpr double kHermiteMinPivot = 1e-12;
 /// shows as 0.01 to 0.6, and the per-triangle pass there stays.
 constexpr double kHermiteMaxMisfit = 0.005;
 
+/// Rows a 1-ring fit has beyond its unknowns (a 1-ring of 5 neighbours: 15 rows for 12) for its
+/// misfit alone to judge it; with fewer (a neighbour whose normal is guessed gives one row,
+/// not three; a free height or gradient adds unknowns) it must agree with the 2-ring's
+/// (kHermiteAgreement).
+constexpr int kHermiteSpareRows = 3;
+
 /// Largest difference, relative to the 2-ring's, between the operators of a vertex's 1-ring
-/// and 2-ring fits for the 1-ring's to stand where the gradient is free (a guessed normal): on
+/// and 2-ring fits for the 1-ring's to stand where the gradient is free (a guessed normal) or
+/// rows are few (kHermiteSpareRows): on
 /// clean meshes the two differ by their truncation, a few percent; a spike or a wild normal in
 /// the 1-ring, which its few spare rows cannot show, by far more (the spiked helix tube with
 /// outlier normals: 5 times H).
