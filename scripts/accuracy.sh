@@ -502,9 +502,10 @@ HEAD
   gives what it gives without normals; methods that trust the normals (LRTC20 on the file's
   normals) take the noise in.
 - **Hard cases.** Lowest or tied in most categories. Without normals, on strips across the
-  curvature the cotangent formula and the mid-edge operator (GGRZ06) are ahead. Outlier normals and spikes
-  are found and undone with the file's normals; without normals spikes are found from the
-  positions (each vertex against a quadric fitted to its neighbours without it) and moved back.
+  curvature the cotangent formula and the mid-edge operator (GGRZ06) are ahead. Outlier
+  normals and spikes are found and undone with the file's normals; without normals spikes are
+  found from the positions (each vertex against a quadric fitted to its neighbours without it)
+  and moved back.
   Creases (the capped cylinder) are flagged on clean positions and not fitted across.
 - **Principal directions.** The angle of d1 to the exact direction: focal's default is ahead
   of every peer that gives directions on most cases; pymeshlab's normal cycles win where a
