@@ -14,20 +14,9 @@
 namespace focal::detail {
 namespace {
 
-/// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4.
+/// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4
+/// (kHeightRight below lists them).
 constexpr int kTerms = 12;
-constexpr std::array<std::array<int, 2>, kTerms> kPowers{{{2, 0},
-                                                          {1, 1},
-                                                          {0, 2},
-                                                          {3, 0},
-                                                          {2, 1},
-                                                          {1, 2},
-                                                          {0, 3},
-                                                          {4, 0},
-                                                          {3, 1},
-                                                          {2, 2},
-                                                          {1, 3},
-                                                          {0, 4}}};
 
 /// Points a fit takes at most (a 1-ring, or a 2-ring where the 1-ring is too small); more: no
 /// fit.
@@ -243,9 +232,15 @@ struct System {
     return out;
   }
 
-  /// The least-squares coefficients (Cholesky of A^T A), or nothing where a pivot is below
+  /// The least-squares coefficients and the rows' RMS misfit there.
+  struct Solution {
+    Terms c;
+    double misfit;
+  };
+
+  /// The least-squares solution (Cholesky of A^T A), or nothing where a pivot is below
   /// kHermiteMinPivot times the largest.
-  [[nodiscard]] std::optional<Terms> solve() const {
+  [[nodiscard]] std::optional<Solution> solve() const {
     std::array<Terms, kTerms> l = normal_matrix();
     double largest = 0.0, smallest = INFINITY;
     bool positive = true;
@@ -277,17 +272,11 @@ struct System {
       unroll<kTerms - 1 - i>([&](auto k) { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
       c[i] /= l[i][i];
     });
-    return c;
-  }
-
-  /// The RMS misfit of the rows at coefficients c: r^T r = b^T b - c^T A^T b at the
-  /// least-squares solution.
-  [[nodiscard]] double misfit(const Terms& c) const {
-    const Terms atb = right_side();
+    // r^T r = b^T b - c^T A^T b at the least-squares solution (less the free terms' part).
     double ctb = 0.0;
     for (std::size_t i = 0; i < kTerms; ++i) ctb += c[i] * atb[i];
     const double bb = any_free() ? btb - free_right.dot(free_inverse() * free_right) : btb;
-    return std::sqrt(std::max(0.0, bb - ctb) / rows);
+    return Solution{c, std::sqrt(std::max(0.0, bb - ctb) / rows)};
   }
 };
 
@@ -352,13 +341,13 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
     refusal = Refusal::underdetermined;
     return std::nullopt;
   }
-  const std::optional<Terms> c = sys.solve();
-  if (!c) {
+  const std::optional<System::Solution> solution = sys.solve();
+  if (!solution) {
     refusal = Refusal::underdetermined;
     return std::nullopt;
   }
-  const Terms& k = *c;
-  if (!std::isfinite(k[0] + k[1] + k[2]) || !(sys.misfit(k) <= kHermiteMaxMisfit)) {
+  const Terms& k = solution->c;
+  if (!std::isfinite(k[0] + k[1] + k[2]) || !(solution->misfit <= kHermiteMaxMisfit)) {
     return std::nullopt;
   }
   refusal = Refusal::none;

@@ -40,8 +40,8 @@ using detail::kExactFitResidual;
 
 /// On clean positions, the per-triangle characteristic equation averaged to the vertices
 /// (Method::triangle) is more accurate than the 1-ring fit on irregular meshes (measured 1.3 to
-/// 1.8 times lower H error, docs/notes/estimator-log.md), but only second-order exact where the fit is
-/// exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
+/// 1.8 times lower H error, docs/notes/estimator-log.md), but only second-order exact where the fit
+/// is exact: `fit` keeps its rows where its residual says the rays fit exactly, or where the
 /// triangles give no estimate, and takes the triangles' elsewhere, except where `replaced` (if
 /// not empty) is set: the corrected step writes those rows, so the pass runs on the faces of the
 /// other vertices only (a vertex's row reads its own faces, in the same order: the same bits).
@@ -153,11 +153,12 @@ std::vector<char> near_creases(const Context& c, const VectorXu8& crease) {
 }
 
 /// Trusted file normals on clean positions: the quartic Hermite fit (curvature/hermite_fit.h)
-/// where the two-slit fit is not exact, except near creases, with the `repaired` spikes'
-/// positions (exact to third order only) and the normals that are not the file's in no other
-/// vertex's fit; returns the rows it wrote.
-std::vector<char> hermite(const Context& c, const PreparedMesh& fitted, const VectorXu8& crease,
-                          const std::vector<int>& repaired, CurvatureResult& fit) {
+/// where the two-slit fit is not exact, except `near_crease` (near_creases), with the
+/// `repaired` spikes and the normals that are not the file's (outliers replaced) as the fit's
+/// moved and guessed vertices; returns the rows it wrote.
+std::vector<char> hermite(const Context& c, const PreparedMesh& fitted,
+                          const std::vector<char>& near_crease, const std::vector<int>& repaired,
+                          CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   const detail::UnitNormals& unit = detail::unit_normals(fitted);
   const auto count = static_cast<std::size_t>(c.mesh.vertex_count());
@@ -173,21 +174,19 @@ std::vector<char> hermite(const Context& c, const PreparedMesh& fitted, const Ve
     const Eigen::RowVector3d n = file.row(v);
     guessed[static_cast<std::size_t>(v)] = !(unit.N.row(v).dot(n) >= (1.0 - 1e-12) * n.norm());
   });
-  return detail::prefer_hermite_fit(fitted.V(), unit.N, unit.ok, *c.one_ring,
-                                    *detail::incidence(c.mesh), near_creases(c, crease), moved,
-                                    guessed, kExactFitResidual,
-                                    detail::class_tolerances(paper_options(c), c.edge_length), fit);
+  return detail::prefer_hermite_fit(
+      fitted.V(), unit.N, unit.ok, *c.one_ring, *detail::incidence(c.mesh), near_crease, moved,
+      guessed, kExactFitResidual, detail::class_tolerances(paper_options(c), c.edge_length), fit);
 }
 
 /// Trusted file normals on clean positions: the corrected curvature measures
-/// (curvature/corrected_step.h) where the fit is not exact, except near creases and where
-/// `written` (the Hermite fit's rows) is set; no measure, and no stencil asymmetry, where no
+/// (curvature/corrected_step.h) where the fit is not exact, except where `keep` (near_creases)
+/// or `written` (the Hermite fit's rows) is set; no measure, and no stencil asymmetry, where no
 /// vertex is left (a clean mesh the Hermite fit covers).
 detail::CorrectedRows corrected(const Context& c, const PreparedMesh& fitted,
-                                const VectorXu8& crease, const std::vector<char>& written,
+                                std::vector<char> keep, const std::vector<char>& written,
                                 const CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
-  std::vector<char> keep = near_creases(c, crease);
   // A vertex of one face keeps that face's operator (its spread, the residual, is 0: the
   // per-triangle pass's row counts as exact, as it did when the pass ran first).
   keep.resize(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
@@ -275,8 +274,10 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
     // freed) before the pass runs.
     std::vector<char> replaced;
     if (out.file_normals_used) {
-      replaced = hermite(c, fitted, out.crease, repaired, out.curvature);
-      detail::CorrectedRows measures = corrected(c, fitted, out.crease, replaced, out.curvature);
+      std::vector<char> near_crease = near_creases(c, out.crease);
+      replaced = hermite(c, fitted, near_crease, repaired, out.curvature);
+      detail::CorrectedRows measures =
+          corrected(c, fitted, std::move(near_crease), replaced, out.curvature);
       detail::apply_corrected_rows(measures, 0, out.curvature);
       for (std::size_t v = 0; v < replaced.size(); ++v) replaced[v] |= measures.replace[v];
     }
