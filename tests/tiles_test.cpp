@@ -202,7 +202,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
   const Tiling tiling = partition_mesh(m.V, m.F, halo, {.tile_vertices = tile_vertices});
   RecommendedMedians whole;
   whole.has_normals = true;
-  std::vector<double> residual, along, against, roughness;
+  std::vector<double> residual, along, against, roughness, share;
   std::vector<std::pair<int, double>> sample;
   for (const Tile& tile : tiling.tiles) {
     const RecommendedStatistics s =
@@ -213,6 +213,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
     along.insert(along.end(), s.angle_along.begin(), s.angle_along.end());
     against.insert(against.end(), s.angle_against.begin(), s.angle_against.end());
     roughness.insert(roughness.end(), s.file_roughness.begin(), s.file_roughness.end());
+    share.insert(share.end(), s.height_share.begin(), s.height_share.end());
     whole.along += s.along;
     whole.against += s.against;
     for (std::size_t k = 0; k < s.sample.size(); ++k) {
@@ -226,6 +227,7 @@ RecommendedMeshWide mesh_wide_of_tiles(const Mesh& m, int halo, int tile_vertice
   whole.angle_along = median_of(along);
   whole.angle_against = median_of(against);
   whole.file_roughness = median_of(roughness);
+  whole.height_share = median_of(share);
   whole.sample_noise =
       Eigen::Map<const Eigen::VectorXd>(sample_noise->data(), std::ssize(*sample_noise));
   return recommended_mesh_wide_from(whole, mean_edge);
@@ -265,6 +267,9 @@ TEST(Tiles, TheTilesStatisticsGiveTheWholeMeshsRecommendedChoices) {
       EXPECT_TRUE(same_bits(got.file_disagreement, expected.file_disagreement)) << what;
       EXPECT_EQ(got.side, expected.side) << what;
       EXPECT_TRUE(same_bits(got.file_roughness, expected.file_roughness)) << what;
+      if (std::isfinite(expected.height_share)) {
+        EXPECT_TRUE(same_bits(got.height_share, expected.height_share)) << what;
+      }
     }
     EXPECT_TRUE(std::isfinite(expected.file_disagreement)) << name;
     EXPECT_TRUE(std::isfinite(expected.file_roughness)) << name;

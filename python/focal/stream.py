@@ -167,7 +167,7 @@ def _write_plan(p: dict) -> None:
 
 
 #: Columns of a tile's statistics file (float64, one row per owned vertex).
-STATISTICS = ("jet_residual", "angle_along", "angle_against", "file_roughness")
+STATISTICS = ("jet_residual", "angle_along", "angle_against", "file_roughness", "height_share")
 
 
 def tile_statistics(p: dict, t: int) -> dict:
@@ -198,7 +198,7 @@ def choose(p: dict, statistics: list) -> dict:
     medians = {
         "jet_residual": _median(files, 0),
         "angle_along": _median(files, 1), "angle_against": _median(files, 2),
-        "file_roughness": _median(files, 3),
+        "file_roughness": _median(files, 3), "height_share": _median(files, 4),
         "along": sum(r["along"] for r in statistics),
         "against": sum(r["against"] for r in statistics),
         "sample_noise": [x for _, x in sample], "has_normals": True,

@@ -31,6 +31,7 @@ nb::dict choices_dict(const focal::MeshWideChoices& c) {
     d["file_disagreement"] = c.recommended->file_disagreement;
     d["side"] = c.recommended->side;
     d["file_roughness"] = c.recommended->file_roughness;
+    d["height_share"] = c.recommended->height_share;
   }
   return d;
 }
@@ -44,7 +45,8 @@ focal::MeshWideChoices choices_from(const nb::dict& d) {
                                    .position_noise = nb::cast<double>(d["position_noise"]),
                                    .file_disagreement = nb::cast<double>(d["file_disagreement"]),
                                    .side = nb::cast<double>(d["side"]),
-                                   .file_roughness = nb::cast<double>(d["file_roughness"])};
+                                   .file_roughness = nb::cast<double>(d["file_roughness"]),
+                                   .height_share = nb::cast<double>(d["height_share"])};
   }
   return c;
 }
@@ -140,6 +142,7 @@ nb::dict tile_statistics(const DoubleRows& V, const IntRows& F, const std::optio
   d["angle_along"] = to_numpy(std::move(r.angle_along));
   d["angle_against"] = to_numpy(std::move(r.angle_against));
   d["file_roughness"] = to_numpy(std::move(r.file_roughness));
+  d["height_share"] = to_numpy(std::move(r.height_share));
   d["along"] = r.along;
   d["against"] = r.against;
   d["sample"] = ids_to_numpy(r.sample);
@@ -159,6 +162,7 @@ nb::dict recommended_choices(const nb::dict& medians, double mean_edge_length) {
   m.angle_along = nb::cast<double>(medians["angle_along"]);
   m.angle_against = nb::cast<double>(medians["angle_against"]);
   m.file_roughness = nb::cast<double>(medians["file_roughness"]);
+  m.height_share = nb::cast<double>(medians["height_share"]);
   m.has_normals = nb::cast<bool>(medians["has_normals"]);
   focal::MeshWideChoices c;
   c.mean_edge_length = mean_edge_length;

@@ -10,9 +10,15 @@
 #include <utility>
 
 #include "core/parallel.h"
+#include "curvature/polynomial_fit_detail.h"
 
 namespace focal::detail {
 namespace {
+
+using polynomial::monomial_index;
+using polynomial::monomials;
+using polynomial::Table;
+using polynomial::unroll;
 
 /// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4
 /// (kHeightRight below lists them).
@@ -22,34 +28,7 @@ constexpr int kTerms = 12;
 /// fit.
 constexpr std::size_t kMaxPoints = 96;
 
-using Terms = std::array<double, kTerms>;
-
-/// f(integral_constant<0>), ..., f(integral_constant<N - 1>): loops over the fit's fixed sizes
-/// unrolled, with every index a constant.
-template <std::size_t N, class F>
-void unroll(F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
-    (f(std::integral_constant<std::size_t, I>{}), ...);
-  }
-  (std::make_index_sequence<N>{});
-}
-
-/// Exponents (a, b) of the monomials u^a v^b with lo <= a + b <= hi, by degree.
-template <int lo, int hi>
-constexpr auto monomials() {
-  std::array<std::array<int, 2>, ((hi + 1) * (hi + 2) - lo * (lo + 1)) / 2> out{};
-  std::size_t k = 0;
-  for (int n = lo; n <= hi; ++n) {
-    for (int a = n; a >= 0; --a) out[k++] = {a, n - a};
-  }
-  return out;
-}
-
-/// Index of u^a v^b in monomials<lo, hi>().
-constexpr int monomial_index(int lo, int a, int b) {
-  const int n = a + b;
-  return (n * (n + 1) - lo * (lo + 1)) / 2 + (n - a);
-}
+using Terms = polynomial::Vector<kTerms>;
 
 /// The moments the normal matrix needs: heights' of degree 4 to 8 (weight 1 / d^4), slopes' of
 /// degree 2 to 6 (weight 1 / d^2); the right side's: z u^a v^b of degree 2 to 4 (1 / d^4), the
@@ -60,11 +39,6 @@ constexpr auto kHeightRight = monomials<2, 4>();
 constexpr auto kSlopeRight = monomials<1, 3>();
 static_assert(kHeightRight.size() == kTerms);
 
-/// The tables as types, for unroll's constant indices.
-template <const auto& table>
-struct Table {
-  static constexpr const auto& value = table;
-};
 using HeightMoments = Table<kHeightMoments>;
 using SlopeMoments = Table<kSlopeMoments>;
 using HeightRight = Table<kHeightRight>;
@@ -134,8 +108,7 @@ struct System {
       pv[k] = pv[k - 1] * v;
     }
     const auto at = [&](auto table, auto k) {
-      constexpr std::array<int, 2> e = decltype(table)::value[k];
-      return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
+      return polynomial::monomial_at<decltype(table)>(pu, pv, k);
     };
     const double hz = h * z, gu = gs * zu, gv = gs * zv;
     unroll<kHeightMoments.size()>([&](auto k) { heights[k] += h * at(HeightMoments{}, k); });
@@ -191,8 +164,8 @@ struct System {
   }
 
   /// A^T A from the moments.
-  [[nodiscard]] std::array<Terms, kTerms> normal_matrix() const {
-    std::array<Terms, kTerms> out;
+  [[nodiscard]] polynomial::Matrix<kTerms> normal_matrix() const {
+    polynomial::Matrix<kTerms> out;
     unroll<kNormalEntries.size()>([&](auto k) {
       constexpr NormalEntry e = kNormalEntries[k];
       double x = heights[static_cast<std::size_t>(e.height)];
@@ -241,57 +214,15 @@ struct System {
   /// The least-squares solution (Cholesky of A^T A), or nothing where a pivot is below
   /// kHermiteMinPivot times the largest.
   [[nodiscard]] std::optional<Solution> solve() const {
-    std::array<Terms, kTerms> l = normal_matrix();
-    double largest = 0.0, smallest = INFINITY;
-    bool positive = true;
-    unroll<kTerms>([&](auto k) {
-      double pivot = l[k][k];
-      unroll<k>([&](auto j) { pivot -= l[k][j] * l[k][j]; });
-      positive = positive && pivot > 0.0;
-      largest = std::max(largest, pivot);
-      smallest = std::min(smallest, pivot);
-      l[k][k] = std::sqrt(pivot);
-      const double inverse = 1.0 / l[k][k];
-      unroll<kTerms - k - 1>([&](auto r) {
-        constexpr std::size_t i = k + 1 + r;
-        double v = l[i][k];
-        unroll<k>([&](auto j) { v -= l[i][j] * l[k][j]; });
-        l[i][k] = v * inverse;
-      });
-    });
-    if (!positive) return std::nullopt;
-    if (!(smallest >= kHermiteMinPivot * largest)) return std::nullopt;
     const Terms atb = right_side();
-    Terms c = atb;
-    unroll<kTerms>([&](auto i) {  // L y = A^T b
-      unroll<i>([&](auto j) { c[i] -= l[i][j] * c[j]; });
-      c[i] /= l[i][i];
-    });
-    unroll<kTerms>([&](auto r) {  // L^T c = y
-      constexpr std::size_t i = kTerms - 1 - r;
-      unroll<kTerms - 1 - i>([&](auto k) { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
-      c[i] /= l[i][i];
-    });
-    // r^T r = b^T b - c^T A^T b at the least-squares solution (less the free terms' part).
-    double ctb = 0.0;
-    for (std::size_t i = 0; i < kTerms; ++i) ctb += c[i] * atb[i];
+    const std::optional<Terms> c =
+        polynomial::cholesky_solve<kTerms>(normal_matrix(), atb, kHermiteMinPivot);
+    if (!c) return std::nullopt;
+    // Less the free terms' part of b^T b.
     const double bb = any_free() ? btb - free_right.dot(free_inverse() * free_right) : btb;
-    return Solution{c, std::sqrt(std::max(0.0, bb - ctb) / rows)};
+    return Solution{*c, polynomial::rms_misfit(bb, *c, atb, rows)};
   }
 };
-
-/// The shape operator [a b; b c] of a graph with Hessian `hessian` and gradient p at the
-/// point, symmetrised in the metric G = I + p p^T: G^(-1/2) II G^(-1/2) with
-/// II = -hessian / sqrt(1 + |p|^2). Its eigenvalues are the principal curvatures; its
-/// eigenvectors are the directions in the plane to first order in p.
-Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eigen::Vector2d& p) {
-  const double q = p.squaredNorm();
-  const double root = std::sqrt(1.0 + q);
-  Eigen::Matrix2d half = Eigen::Matrix2d::Identity();  // G^(-1/2)
-  if (q > 0.0) half += (1.0 / root - 1.0) * p * p.transpose() / q;
-  const Eigen::Matrix2d S = half * (-hessian / root) * half;
-  return {S(0, 0), 0.5 * (S(0, 1) + S(1, 0)), S(1, 1)};
-}
 
 /// Why a stencil gave no operator: too few rows to fix the quartic (a wider stencil may), or
 /// rows it does not fit (a wider one would not help).
@@ -354,28 +285,8 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
   // h(x, y) = s h~(x / s, y / s): second derivatives are h~'s over s, first ones h~'s.
   const Eigen::Matrix2d hessian =
       (Eigen::Matrix2d() << 2.0 * k[0], k[1], k[1], 2.0 * k[2]).finished() / s;
-  return free_gradient ? graph_operator(hessian, sys.free_gradient_at(k))
+  return free_gradient ? polynomial::graph_operator(hessian, sys.free_gradient_at(k))
                        : Eigen::Vector3d(-hessian(0, 0), -hessian(0, 1), -hessian(1, 1));
-}
-
-/// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` vertices, into
-/// `out`.
-void stencil_of(const Neighbourhoods& one_ring, int v, bool wide, const std::vector<char>& moved,
-                std::vector<int>& out) {
-  out.assign(one_ring.begin(v), one_ring.end(v));
-  if (wide) {
-    const std::size_t first = out.size();
-    for (std::size_t k = 0; k < first; ++k) {
-      for (const int* j = one_ring.begin(out[k]); j != one_ring.end(out[k]); ++j) {
-        if (*j != v) out.push_back(*j);
-      }
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-  }
-  if (!moved.empty()) {
-    std::erase_if(out, [&](int j) { return moved[static_cast<std::size_t>(j)] != 0; });
-  }
 }
 
 }  // namespace
@@ -404,7 +315,7 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
       int spare = 0;
       for (const bool wide : {false, true}) {
         on_one_ring = !wide;
-        stencil_of(one_ring, vi, wide, moved, stencil);
+        polynomial::ring_stencil(one_ring, vi, wide, moved, stencil);
         op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
                               refusal, spare);
         if (refusal != Refusal::underdetermined) break;
@@ -414,7 +325,7 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
       // agrees.
       if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
         const Eigen::Vector3d ring_operator = *op;
-        stencil_of(one_ring, vi, true, moved, stencil);
+        polynomial::ring_stencil(one_ring, vi, true, moved, stencil);
         op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
                               refusal, spare);
         if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {

@@ -14,6 +14,7 @@
 #include "core/parallel.h"
 #include "core/result_rows.h"
 #include "curvature/corrected_step.h"
+#include "curvature/height_fit.h"
 #include "curvature/hermite_fit.h"
 #include "curvature/recommended_steps.h"
 #include "curvature/robust_fit.h"
@@ -179,6 +180,25 @@ std::vector<char> hermite(const Context& c, const PreparedMesh& fitted,
       guessed, kExactFitResidual, detail::class_tolerances(paper_options(c), c.edge_length), fit);
 }
 
+/// Clean positions without trusted normals: the quartic height fit of the positions
+/// (curvature/height_fit.h) where the two-slit fit is not exact, except `near_crease`
+/// (near_creases), with the `repaired` spikes as the fit's moved vertices; returns the rows it
+/// wrote.
+std::vector<char> heights(const Context& c, const PreparedMesh& fitted,
+                          const std::vector<char>& near_crease, const std::vector<int>& repaired,
+                          CurvatureResult& fit) {
+  if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
+  const detail::UnitNormals& unit = detail::unit_normals(fitted);
+  std::vector<char> moved;
+  if (!repaired.empty()) {
+    moved.assign(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+    for (const int v : repaired) moved[static_cast<std::size_t>(v)] = 1;
+  }
+  return detail::prefer_height_fit(
+      fitted.V(), unit.N, unit.ok, *c.one_ring, *detail::incidence(c.mesh), near_crease, moved,
+      kExactFitResidual, detail::class_tolerances(paper_options(c), c.edge_length), fit);
+}
+
 /// Trusted file normals on clean positions: the corrected curvature measures
 /// (curvature/corrected_step.h) where the fit is not exact, except where `keep` (near_creases)
 /// or `written` (the Hermite fit's rows) is set; no measure, and no stencil asymmetry, where no
@@ -280,6 +300,8 @@ RecommendedResult estimate(const PreparedMesh& mesh, const RecommendedOptions& o
           corrected(c, fitted, std::move(near_crease), replaced, out.curvature);
       detail::apply_corrected_rows(measures, 0, out.curvature);
       for (std::size_t v = 0; v < replaced.size(); ++v) replaced[v] |= measures.replace[v];
+    } else if (mesh_wide.height_share <= detail::kHeightMaxMedianShare) {
+      replaced = heights(c, fitted, near_creases(c, out.crease), repaired, out.curvature);
     }
     // The 1-ring's memory is the per-triangle pass's (later steps rebuild it if they need it).
     c.one_ring.reset();

@@ -12,6 +12,7 @@
 
 #include "core/parallel.h"
 #include "curvature/corrected_step.h"
+#include "curvature/height_fit.h"
 #include "curvature/recommended_steps.h"
 #include "curvature/spike_repair.h"
 #include "focal/core/error.h"
@@ -129,14 +130,34 @@ struct FileMedians {
 /// The per-mesh choices from their medians over the whole mesh (length units) and the file's:
 /// measured on one mesh (measure_mesh_wide) or over its parts (recommended_mesh_wide_from).
 RecommendedMeshWide mesh_wide_of(double jet_residual, double sample_noise, const FileMedians& file,
-                                 double edge_length) {
+                                 double height_share, double edge_length) {
   RecommendedMeshWide m;
+  m.height_share = height_share;
   m.noise = jet_residual / edge_length;
   m.position_noise = sample_noise / edge_length;
   m.file_disagreement = file.angle;
   m.side = file.side;
   m.file_roughness = file.roughness;
   return m;
+}
+
+/// The height fit's truncation shares (curvature/height_fit.h) at the listed vertices, in the
+/// frames of their jet normals (rows of `jet_normals`), its turn guard on Max's normals.
+Eigen::VectorXd height_shares(const Context& c, const std::vector<int>& vertices,
+                              const RowMatrixX3d& jet_normals) {
+  std::vector<char> ok(static_cast<std::size_t>(c.max.rows()));
+  for (Eigen::Index v = 0; v < c.max.rows(); ++v) {
+    ok[static_cast<std::size_t>(v)] = c.max.row(v).allFinite() ? 1 : 0;
+  }
+  const auto incidence = detail::incidence(c.mesh);
+  Eigen::VectorXd out(std::ssize(vertices));
+  detail::parallel_for(out.size(), 0, [&](std::int64_t k) {
+    const Eigen::Vector3d n = jet_normals.row(k).transpose();
+    out[k] = n.allFinite() ? detail::height_truncation_share(c.mesh.V(), c.max, ok, *c.one_ring,
+                                                             *incidence, vertices[k], n)
+                           : NAN;
+  });
+  return out;
 }
 
 }  // namespace
@@ -182,8 +203,14 @@ RecommendedMeshWide measure_mesh_wide(const Context& c, const JetNormals* all) {
     medians.roughness = finite_median(roughness_at(c, *file, sample));
   }
   const auto [noise_sample, r2] = with_finite_residual(sample, jets.residual);
-  return mesh_wide_of(finite_median(jets.residual), finite_median(noise_at(c, r2, noise_sample)),
-                      medians, c.edge_length);
+  const double jet_residual = finite_median(jets.residual);
+  // The height fit runs only where the file's normals are not used.
+  const bool file_used =
+      c.mesh.normals().has_value() &&
+      file_normals_agree(medians.angle, jet_residual / c.edge_length, c.options.file_agreement);
+  const double share = file_used ? NAN : finite_median(height_shares(c, sample, jets.N));
+  return mesh_wide_of(jet_residual, finite_median(noise_at(c, r2, noise_sample)), medians, share,
+                      c.edge_length);
 }
 
 }  // namespace focal::detail::recommended
@@ -262,6 +289,11 @@ RecommendedStatistics recommended_statistics(const PreparedMesh& part, const std
   const auto [noise_sample, r2] = with_finite_residual(sampled, jets.residual);
   for (const int r : noise_sample) out.sample.push_back(ids[static_cast<std::size_t>(r)]);
   out.sample_noise = noise_at(c, r2, noise_sample);
+  const Eigen::VectorXd shares = height_shares(c, sampled, jets.N);
+  out.height_share = Eigen::VectorXd::Constant(m, NAN);
+  for (std::size_t s = 0; s < sampled.size(); ++s) {
+    out.height_share[listed[s]] = shares[static_cast<Eigen::Index>(s)];
+  }
   if (const std::optional<NormalsRef> file = part.normals()) {
     const RowMatrixX3d file_rows = rows_of(*file, sampled);
     std::tie(out.along, out.against) = sides(file_rows, jets.N);
@@ -286,7 +318,7 @@ RecommendedMeshWide recommended_mesh_wide_from(const RecommendedMedians& whole,
     file.roughness = whole.file_roughness;
   }
   return mesh_wide_of(whole.jet_residual, finite_median(whole.sample_noise), file,
-                      mean_edge_length);
+                      whole.height_share, mean_edge_length);
 }
 
 int recommended_reach(const RecommendedPlan& plan) {

@@ -58,6 +58,13 @@ struct RecommendedMeshWide {
   /// this is in doubt and compared with the positions' normals (docs/METHOD.md, step 3). NaN
   /// with normals puts every file normal in doubt.
   double file_roughness = NAN;
+  /// Median over the sample of how much of a quartic height fit's misfit remains of the cubic's
+  /// over the same 2-ring of positions (docs/METHOD.md, step 5): small where the positions are
+  /// exact to the fits' truncation, near 1 where noise, however small, dominates. The quartic
+  /// fit of positions alone runs only on meshes where it is at most 0.15. NaN: no such fit at
+  /// the sample (the fit does not run), or the file's normals are used (not measured on a whole
+  /// mesh then; a part's statistics measure it all the same, and the estimate does not read it).
+  double height_share = NAN;
 };
 
 /// Options of the recommended estimator. The defaults are the measured choices of
@@ -152,6 +159,9 @@ struct RecommendedStatistics {
   /// Per listed vertex, with mesh normals (else empty): the roughness of its normal (that of
   /// RecommendedMeshWide::file_roughness); NaN where its fit is unusable.
   Eigen::VectorXd file_roughness;
+  /// Per listed vertex: its share of RecommendedMeshWide::height_share; NaN where the fit is
+  /// refused.
+  Eigen::VectorXd height_share;
   /// Whole-mesh ids of the listed vertices in the position noise's sample (recommended_plan) ...
   std::vector<int> sample;
   Eigen::VectorXd sample_noise;  ///< ... and their position noise (length units)
@@ -176,6 +186,7 @@ struct RecommendedMedians {
   std::int64_t along = 0, against = 0;            ///< summed over the parts
   double angle_along = NAN, angle_against = NAN;  ///< medians of the finite angles
   double file_roughness = NAN;                    ///< median of the finite file_roughness
+  double height_share = NAN;                      ///< median of the finite height_share
   bool has_normals = false;                       ///< whether the mesh has normals
 };
 

@@ -1,0 +1,142 @@
+#pragma once
+// Internal to curvature/: what the polynomial height fits (hermite_fit.cpp, height_fit.cpp)
+// share: their monomial tables, loops unrolled over the fits' fixed sizes, the Cholesky solve
+// of their normal equations, the shape operator of a fitted graph and the rings they fit.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "focal/mesh/neighbourhood.h"
+
+namespace focal::detail::polynomial {
+
+/// f(integral_constant<0>), ..., f(integral_constant<N - 1>): loops over the fit's fixed sizes
+/// unrolled, with every index a constant.
+template <std::size_t N, class F>
+void unroll(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (f(std::integral_constant<std::size_t, I>{}), ...);
+  }
+  (std::make_index_sequence<N>{});
+}
+
+/// Exponents (a, b) of the monomials u^a v^b with lo <= a + b <= hi, by degree.
+template <int lo, int hi>
+constexpr auto monomials() {
+  std::array<std::array<int, 2>, ((hi + 1) * (hi + 2) - lo * (lo + 1)) / 2> out{};
+  std::size_t k = 0;
+  for (int n = lo; n <= hi; ++n) {
+    for (int a = n; a >= 0; --a) out[k++] = {a, n - a};
+  }
+  return out;
+}
+
+/// Index of u^a v^b in monomials<lo, hi>().
+constexpr int monomial_index(int lo, int a, int b) {
+  const int n = a + b;
+  return (n * (n + 1) - lo * (lo + 1)) / 2 + (n - a);
+}
+
+/// A table as a type, for unroll's constant indices.
+template <const auto& table>
+struct Table {
+  static constexpr const auto& value = table;
+};
+
+/// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
+template <class table, class K, std::size_t P>
+double monomial_at(const std::array<double, P>& pu, const std::array<double, P>& pv, K k) {
+  constexpr std::array<int, 2> e = table::value[k];
+  return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
+}
+
+template <std::size_t N>
+using Vector = std::array<double, N>;
+template <std::size_t N>
+using Matrix = std::array<Vector<N>, N>;
+
+/// The solution of `normal` c = `right` (symmetric, only the lower triangle read) by Cholesky,
+/// or nothing where a pivot is not positive or below `min_pivot` times the largest (the
+/// stencil does not fix the polynomial).
+template <std::size_t N>
+std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right, double min_pivot) {
+  double largest = 0.0, smallest = INFINITY;
+  bool positive = true;
+  unroll<N>([&](auto k) {
+    double pivot = l[k][k];
+    unroll<k>([&](auto j) { pivot -= l[k][j] * l[k][j]; });
+    positive = positive && pivot > 0.0;
+    largest = std::max(largest, pivot);
+    smallest = std::min(smallest, pivot);
+    l[k][k] = std::sqrt(pivot);
+    const double inverse = 1.0 / l[k][k];
+    unroll<N - k - 1>([&](auto r) {
+      constexpr std::size_t i = k + 1 + r;
+      double v = l[i][k];
+      unroll<k>([&](auto j) { v -= l[i][j] * l[k][j]; });
+      l[i][k] = v * inverse;
+    });
+  });
+  if (!positive || !(smallest >= min_pivot * largest)) return std::nullopt;
+  Vector<N> c = right;
+  unroll<N>([&](auto i) {  // L y = right
+    unroll<i>([&](auto j) { c[i] -= l[i][j] * c[j]; });
+    c[i] /= l[i][i];
+  });
+  unroll<N>([&](auto r) {  // L^T c = y
+    constexpr std::size_t i = N - 1 - r;
+    unroll<N - 1 - i>([&](auto k) { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
+    c[i] /= l[i][i];
+  });
+  return c;
+}
+
+/// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
+template <std::size_t N>
+double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb, int rows) {
+  double ctb = 0.0;
+  for (std::size_t i = 0; i < N; ++i) ctb += c[i] * atb[i];
+  return std::sqrt(std::max(0.0, btb - ctb) / rows);
+}
+
+/// The shape operator [a b; b c] of a graph with Hessian `hessian` and gradient p at the
+/// point, symmetrised in the metric G = I + p p^T: G^(-1/2) II G^(-1/2) with
+/// II = -hessian / sqrt(1 + |p|^2). Its eigenvalues are the principal curvatures; its
+/// eigenvectors are the directions in the plane to first order in p.
+inline Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eigen::Vector2d& p) {
+  const double q = p.squaredNorm();
+  const double root = std::sqrt(1.0 + q);
+  Eigen::Matrix2d half = Eigen::Matrix2d::Identity();  // G^(-1/2)
+  if (q > 0.0) half += (1.0 / root - 1.0) * p * p.transpose() / q;
+  const Eigen::Matrix2d S = half * (-hessian / root) * half;
+  return {S(0, 0), 0.5 * (S(0, 1) + S(1, 0)), S(1, 1)};
+}
+
+/// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` vertices (empty or
+/// #V flags), into `out` (the 1-ring in its order, the 2-ring ascending).
+inline void ring_stencil(const Neighbourhoods& one_ring, int v, bool wide,
+                         const std::vector<char>& moved, std::vector<int>& out) {
+  out.assign(one_ring.begin(v), one_ring.end(v));
+  if (wide) {
+    const std::size_t first = out.size();
+    for (std::size_t k = 0; k < first; ++k) {
+      for (const int* j = one_ring.begin(out[k]); j != one_ring.end(out[k]); ++j) {
+        if (*j != v) out.push_back(*j);
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  if (!moved.empty()) {
+    std::erase_if(out, [&](int j) { return moved[static_cast<std::size_t>(j)] != 0; });
+  }
+}
+
+}  // namespace focal::detail::polynomial
