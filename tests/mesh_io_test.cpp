@@ -288,6 +288,34 @@ TEST_F(MeshIo, PlyBinaryRoundTripIsExact) {
   }
 }
 
+TEST_F(MeshIo, FilesBelowAndAboveTheMappedSizeReadTheSame) {
+  // The readers map a file of 1 MiB or more and read a smaller one into a buffer: a binary PLY
+  // with normals (48 bytes a vertex, 13 a face, and the header) on each side of 1 MiB, an OBJ
+  // above it, all exact; a truncated mapped file is an IoError, not a read past its end.
+  for (const int n : {15000, 25000}) {
+    SCOPED_TRACE("vertices " + std::to_string(n));
+    Mesh m;
+    m.V.resize(n, 3);
+    m.N.resize(n, 3);
+    m.F.resize(n, 3);
+    for (int i = 0; i < n; ++i) {
+      m.V.row(i) << 0.001 * i, std::sin(0.37 * i), 1.0 / (i + 1);
+      m.N.row(i) << 0.0, std::cos(0.37 * i), i % 7 == 0 ? -0.0 : 1e-300 * i;
+      m.F.row(i) << i, (i + 1) % n, (i + 2) % n;
+    }
+    m.face_source = Eigen::VectorXi::LinSpaced(n, 0, n - 1);  // each triangle its own polygon
+    const fs::path ply = file("m.ply");
+    focal::write_ply(ply, m);
+    EXPECT_EQ(fs::file_size(ply) >= (1u << 20), n == 25000);
+    expect_same_mesh(m, focal::read_mesh(ply));
+    const fs::path obj = file("m.obj");
+    focal::write_obj(obj, m);
+    expect_same_mesh(m, focal::read_mesh(obj));
+    fs::resize_file(ply, fs::file_size(ply) - 7);
+    EXPECT_THROW((void)focal::read_mesh(ply), focal::IoError);
+  }
+}
+
 TEST_F(MeshIo, TextWritersGiveTheSameBytesOnAnyThreadCount) {
   // 40,000 vertices and faces: more lines than one batch of the parallel blocks (32,768), so
   // blocks, batches and the header before them all meet.

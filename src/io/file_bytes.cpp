@@ -7,6 +7,10 @@
 #include <memory>
 #include <system_error>
 
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/mman.h>
+#endif
+
 #include "core/memory.h"
 #include "focal/core/error.h"
 
@@ -24,6 +28,33 @@ void fail_at_offset(const std::filesystem::path& path, std::size_t offset,
                     const std::string& what) {
   throw IoError(path.string() + ": byte offset " + std::to_string(offset) + ": " + what);
 }
+
+namespace {
+
+/// Files from this size on are mapped: below it a read costs less than the mapping's setup.
+constexpr std::uintmax_t kMapFrom = std::uintmax_t{1} << 20;
+
+/// The first `size` bytes of `file` mapped read-only and faulted in at once, or nullptr where
+/// mapping is not available or fails (the caller reads instead).
+std::shared_ptr<const char> mapped(std::FILE* file, std::uintmax_t size) {
+#if defined(__unix__) || defined(__APPLE__)
+  int flags = MAP_PRIVATE;
+#if defined(MAP_POPULATE)
+  flags |= MAP_POPULATE;
+#endif
+  void* p = mmap(nullptr, static_cast<std::size_t>(size), PROT_READ, flags, fileno(file), 0);
+  if (p == MAP_FAILED) return nullptr;
+  const auto bytes = static_cast<std::size_t>(size);
+  return {static_cast<const char*>(p), [bytes](const char* q) {
+            munmap(const_cast<char*>(q), bytes);  // NOLINT: munmap takes void*
+          }};
+#else
+  (void)file, (void)size;
+  return nullptr;
+#endif
+}
+
+}  // namespace
 
 FileBytes read_whole_file(const std::filesystem::path& path) {
   std::error_code ec;
@@ -46,6 +77,12 @@ FileBytes read_whole_file(const std::filesystem::path& path) {
   // Read into a buffer one byte larger than the reported size, so that a file that grew (or a
   // size query that is wrong, as for pipes) is noticed and the buffer extended.
   const auto size_hint = std::filesystem::file_size(path, ec);
+  if (!ec && size_hint >= kMapFrom) {
+    if (auto bytes = mapped(file, size_hint)) {
+      std::fclose(file);  // the mapping stays valid without the descriptor
+      return {std::move(bytes), static_cast<std::size_t>(size_hint)};
+    }
+  }
   std::size_t capacity = ec ? std::size_t{1} << 20 : static_cast<std::size_t>(size_hint) + 1;
   auto data = std::make_unique_for_overwrite<char[]>(capacity);
   std::size_t used = 0;

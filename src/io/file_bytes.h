@@ -23,20 +23,28 @@ namespace focal::io_detail {
 [[noreturn]] void fail_at_offset(const std::filesystem::path& path, std::size_t offset,
                                  const std::string& what);
 
-/// A file's bytes in memory. The buffer is not zero-filled before the read writes it (a
-/// std::string was: a pass over the whole file of its own, ~80 MB for a 1M-vertex PLY).
+/// A file's bytes in memory: a buffer the file was read into, or the file mapped read-only.
+/// A buffer is not zero-filled before the read writes it (a std::string was: a pass over the
+/// whole file of its own, ~80 MB for a 1M-vertex PLY).
 class FileBytes {
  public:
-  FileBytes(std::unique_ptr<char[]> data, std::size_t size) : data_(std::move(data)), size_(size) {}
+  FileBytes(std::unique_ptr<char[]> data, std::size_t size)
+      : data_(data.release(), std::default_delete<char[]>()), size_(size) {}
+  /// Bytes owned by `owner` (a mapping, released with it).
+  FileBytes(std::shared_ptr<const char> owner, std::size_t size)
+      : data_(std::move(owner)), size_(size) {}
   [[nodiscard]] std::string_view view() const { return {data_.get(), size_}; }
   operator std::string_view() const { return view(); }  // NOLINT: parsers take string_view
 
  private:
-  std::unique_ptr<char[]> data_;
+  std::shared_ptr<const char> data_;
   std::size_t size_;
 };
 
-/// The whole file in memory (one read, so that parsers work on a contiguous buffer).
+/// The whole file in memory, contiguous for the parsers: a regular file of 1 MiB or more mapped
+/// (its pages are the page cache's: neither copied nor first-touched in a buffer of our own),
+/// a smaller one, or one that cannot be mapped, read in one read. A mapped file must not be
+/// shortened while it is parsed (as for any reader of a file another process rewrites).
 /// \throw IoError when the path is missing, a directory or unreadable.
 [[nodiscard]] FileBytes read_whole_file(const std::filesystem::path& path);
 
