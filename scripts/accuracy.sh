@@ -229,11 +229,10 @@ normal noise costs a method that trusts normals.
 
 Why focal default still loses where it does (the tables above; measured, see docs/notes/estimator-log.md):
 
-- **Regular grids, normal noise**: the default finds the file's normals noisy and ignores them,
-  so it works from clean positions only, on a regular grid. There the cotangent formula of
-  MDSB03 (and VTK's, the same) is second order with a smaller constant on symmetric stencils;
-  focal's jet normals and per-triangle step are second order too, with a larger constant. On
-  irregular meshes the cotangent formula does not converge, and focal wins every such case.
+- **Normal noise**: the default finds the file's normals noisy and ignores them, so it works
+  from the clean positions: a quartic fitted to each 2-ring's heights (third order), ahead of
+  the cotangent formula of MDSB03 and VTK on regular grids and of every method on irregular
+  ones, except on the helix tube, whose 2-rings turn too far for the quartic (GGRZ06 ahead).
 - (Vertex noise without normals on the regular sphere and pear, lost to libigl's 5-ring quadric
   fit before issue 16, is won since normals from the positions are turned with their 1-ring:
   a few jets fitted in frames of folded faces pointed inward and emptied their neighbours' fits;
@@ -289,16 +288,11 @@ HARD
 
 Where focal default loses on these cases (measured, docs/notes/estimator-log.md):
 
-- **Strips across the curvature** (saddle 20:1, helix tube 1:5): the cotangent formula (MDSB03)
-  is exact for the symmetric stencils of a strip grid in the long direction; the two-slit fit and
-  the per-triangle pass see neighbours at very different distances, and their first-order terms
-  do not cancel. Closing it needs anisotropy-aware weights; not built.
-- **Coarse pear and graded pear with file normals**: 2% to 6% behind the per-triangle pass or
-  LRTC20 at one mean edge length on the same normals: the corrected step's ball (one local edge
-  length) is not the best one for every vertex of these meshes.
-  **Coarse helix tube and torus without normals**: behind LRTC20 on Max's normals (the torus
-  within half a percent); **torus strips without normals**: behind the per-triangle pass on
-  Max's normals; the default's per-vertex roughness test keeps the jets' normals there.
+- **Coarse helix tube and torus without normals** (850 vertices): the tube's 1- and 2-rings
+  turn by more than 30 degrees, where neither quartic fit is used, and LRTC20 on Max's normals
+  is ahead (the torus within half a percent on some seeds).
+- **Near a boundary on the helix tube without normals**: within 2 rings of the boundary the
+  2-ring two-slit fit on Max's normals is ahead on some seeds (by about 10%).
 - (**Spikes**, 0.5% of the vertices 2 edges off, are no longer lost: with the file's normals
   the spike repair and without them the spike step from positions alone move them back;
   docs/METHOD.md, "Spikes".)
@@ -490,9 +484,11 @@ HEAD
 - **Clean meshes.** Exact on spheres and cylinders whatever the triangulation. With the file's
   normals focal is the lowest on regular, irregular, strip and graded meshes: it fits a quartic
   to each 1-ring's heights and the slopes its normals give (third order in the edge length).
-  Without normals it is the lowest on irregular meshes (jet normals from the positions); on
-  clean regular grids the cotangent formula (MDSB03, libigl, VTK) is second order with a
-  smaller constant and is ahead there.
+  Without normals it fits a quartic to each 2-ring's heights where the positions are exact to
+  that fit's truncation (it measures this over the mesh): the lowest on regular and irregular
+  clean meshes alike, except the helix tube (a thin tube: GGRZ06 ahead). Positions with even a
+  little noise (a thousandth of an edge, any scan) keep the jet normals and the per-triangle
+  pass.
 - **Vertex noise.** focal measures the noise and widens its fit (2 or 3 Gaussian-weighted rings,
   rays far off the fit rejected): lowest on most noisy cases, with LRTC20 on the file's normals
   close and ahead on a few (helix tube, pear, where the whole-mesh ring count is wide for the
