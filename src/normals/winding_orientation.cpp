@@ -274,6 +274,8 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
       const Eigen::VectorXd q = K(p);
       const double alpha = gamma / (dot(q, q) + lambda * dot(p, p));
       d += alpha * p;
+      // The last step's gradient would only set a next direction: its product is not taken.
+      if (it + 1 == options.iterations) break;
       r -= alpha * q;
       g = Kt(r) - lambda * d;
       const double next = dot(g, g);
@@ -300,9 +302,10 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     const Eigen::VectorXd column = tree.near_column_norms(A, threads);
     double energy = dot(r, r);
     bool failed = false;  // the last sweep turned nothing
+    Eigen::VectorXd g;    // K^T r, kept while a sweep that turned nothing leaves r as it was
     for (int sweep = 0; sweep < options.sweeps; ++sweep) {
       const std::vector<int> label = segments(V, graph, rename, N, s, sweep % 2 == 1);
-      const Eigen::VectorXd g = Kt(r);
+      if (!failed) g = Kt(r);
       std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
       for (Eigen::Index i = 0; i < n; ++i) {
         if (A.row(i).isZero()) continue;

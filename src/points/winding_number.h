@@ -22,6 +22,7 @@
 // thread count.
 #include <Eigen/Core>
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "focal/core/mesh.h"
@@ -82,6 +83,9 @@ class WindingTree {
     std::vector<std::array<double, 10>> far;
   };
   [[nodiscard]] Moments moments(const RowMatrixX3d& M, const Eigen::VectorXd& sign) const;
+  /// Sets d.far of node k and those below it from d.M; returns the node's sum of m_j and
+  /// sum m_j (p_j - c)^T about its centre c.
+  std::pair<Eigen::Vector3d, Eigen::Matrix3d> far_moments(int k, Moments& d) const;
   /// 4 pi w at q, smoothed by `own` (half its squared smoothing length), of the dipoles `d`.
   [[nodiscard]] double winding_sum(const Eigen::Vector3d& q, double own, const Moments& d) const;
   /// Splits `node` (its rows in order_, its cube's corner `low` and side `size`) into octants.
