@@ -50,15 +50,18 @@ class SymmetricGraph {
       : lists_(lists), p_(p) {
     const int n = lists.vertex_count();
     // Per list entry r -> e: whether the edge comes back (r in e's list); each list's own
-    // entries (in parallel), a list's scan branch-free (they are short).
+    // entries (in parallel), e's list counted through without a branch (they are short: the
+    // count runs in vector lanes).
     std::vector<char> back(static_cast<std::size_t>(lists.indices.size()), 0);
     detail::parallel_for(n, threads, [&](std::int64_t r64) {
       const int r = static_cast<int>(r64);
       for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k) {
         const int e = lists.indices[k];
-        bool found = false;
-        for (const int* j = lists.begin(e); j != lists.end(e); ++j) found |= *j == r;
-        back[static_cast<std::size_t>(k)] = found ? 1 : 0;
+        const int* list = lists.begin(e);
+        const int size = lists.size(e);
+        int hits = 0;
+        for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
+        back[static_cast<std::size_t>(k)] = hits > 0 ? 1 : 0;
       }
     });
     // The one-way edges' far ends collect their near ends, in list order (serial: the same
