@@ -270,12 +270,22 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     Eigen::VectorXd g = Kt(r);
     Eigen::VectorXd p = g;
     double gamma = dot(g, g);
+    // Only the signs of s + d are taken: once a step turns none of them against the step
+    // before, the iteration stops (on a plate the first step turns a whole side and the next
+    // four none; on thin parts with contacts they move at every step).
+    std::vector<char> turns(static_cast<std::size_t>(n), 0);
     for (int it = 0; it < options.iterations && gamma > 0.0; ++it) {
       const Eigen::VectorXd q = K(p);
       const double alpha = gamma / (dot(q, q) + lambda * dot(p, p));
       d += alpha * p;
+      bool moved = false;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const char t = (s[i] + d[i]) * s[i] < 0.0 ? 1 : 0;
+        moved = moved || t != turns[static_cast<std::size_t>(i)];
+        turns[static_cast<std::size_t>(i)] = t;
+      }
       // The last step's gradient would only set a next direction: its product is not taken.
-      if (it + 1 == options.iterations) break;
+      if (it + 1 == options.iterations || (it > 0 && !moved)) break;
       r -= alpha * q;
       g = Kt(r) - lambda * d;
       const double next = dot(g, g);
