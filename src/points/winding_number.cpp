@@ -255,12 +255,31 @@ Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorX
 Eigen::VectorXd WindingTree::jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
                                   const Eigen::VectorXd& sign, int threads) const {
   if (E.rows() != rows_) throw InvalidInput("WindingTree::jump: E does not have #V rows");
+  return jumps(M, sign, threads, [&](int row) -> Eigen::Vector3d { return E.row(row).transpose(); });
+}
+
+Eigen::VectorXd WindingTree::jump_along(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
+                                        const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                        int threads) const {
+  if (lines.rows() != rows_ || length.size() != rows_) {
+    throw InvalidInput("WindingTree::jump_along: lines or length do not have #V rows");
+  }
+  return jumps(M, sign, threads, [&](int row) -> Eigen::Vector3d {
+    const double l = lines.row(row).norm();
+    if (M.row(row).isZero() || !(l > 0.0) || !std::isfinite(l)) return Eigen::Vector3d::Zero();
+    return (length[row] / l * lines.row(row)).transpose();
+  });
+}
+
+template <class Offset>
+Eigen::VectorXd WindingTree::jumps(const RowMatrixX3d& M, const Eigen::VectorXd& sign, int threads,
+                                   Offset&& offset) const {
   const Moments d = moments(M, sign);
   const auto n = static_cast<Eigen::Index>(order_.size());
   Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
   parallel_for(n, threads, [&](std::int64_t t) {
     const int row = order_[static_cast<std::size_t>(t)];
-    const Eigen::Vector3d e = E.row(row).transpose();
+    const Eigen::Vector3d e = offset(row);
     if (!e.allFinite() || e.isZero()) return;
     const Eigen::Vector3d p = P_.row(t).transpose(), m = d.M.row(t).transpose();
     const double own = s2_[t];
