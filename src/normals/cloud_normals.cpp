@@ -50,19 +50,12 @@ class SymmetricGraph {
       : lists_(lists), p_(p) {
     const int n = lists.vertex_count();
     // Per list entry r -> e: whether the edge comes back (r in e's list); each list's own
-    // entries (in parallel), e's list counted through without a branch (they are short: the
-    // count runs in vector lanes).
+    // entries (in parallel).
     std::vector<char> back(static_cast<std::size_t>(lists.indices.size()), 0);
     detail::parallel_for(n, threads, [&](std::int64_t r64) {
       const int r = static_cast<int>(r64);
-      for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k) {
-        const int e = lists.indices[k];
-        const int* list = lists.begin(e);
-        const int size = lists.size(e);
-        int hits = 0;
-        for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
-        back[static_cast<std::size_t>(k)] = hits > 0 ? 1 : 0;
-      }
+      for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k)
+        back[static_cast<std::size_t>(k)] = lists_back(lists, r, k - lists.offsets[r]) ? 1 : 0;
     });
     // The one-way edges' far ends collect their near ends, in list order (serial: the same
     // graph for any thread count).
@@ -82,6 +75,22 @@ class SymmetricGraph {
       }
     }
   }
+
+  /// Whether r is in the list of e, entry `at` of r's list. Sorted by distance, two mutual
+  /// neighbours mostly stand at about the same place in each other's lists: looked for near
+  /// `at` first, then counted through the whole list without a branch (it runs in vector lanes).
+  static bool lists_back(const Neighbourhoods& lists, int r, int at) {
+    const int e = lists.indices[lists.offsets[r] + at];
+    const int* list = lists.begin(e);
+    const int size = lists.size(e);
+    for (int m = std::max(0, at - kNearPlace); m < std::min(size, at + kNearPlace + 1); ++m) {
+      if (list[m] == r) return true;
+    }
+    int hits = 0;
+    for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
+    return hits > 0;
+  }
+  static constexpr int kNearPlace = 3;
 
   /// Calls f(j) for each neighbour j of the cloud's row i.
   template <class F>
