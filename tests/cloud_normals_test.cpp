@@ -119,7 +119,8 @@ Neighbourhoods lists_of(const std::vector<std::vector<int>>& lists) {
     all.insert(all.end(), lists[i].begin(), lists[i].end());
     out.offsets[static_cast<Eigen::Index>(i) + 1] = static_cast<int>(all.size());
   }
-  out.indices = Eigen::Map<const Eigen::VectorXi>(all.data(), static_cast<Eigen::Index>(all.size()));
+  out.indices =
+      Eigen::Map<const Eigen::VectorXi>(all.data(), static_cast<Eigen::Index>(all.size()));
   return out;
 }
 

@@ -38,12 +38,12 @@ void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* w
 
 /// The neighbour graph made symmetric (j in i's list or i in j's) without a second copy of the
 /// lists: each point's own list, and beside it the points that list it but are not in its list
-/// (kNN lists are mostly mutual, so these are few; the graph held as both directions of every
-/// edge, sorted, cost about 1 KB a point with 64 neighbours, the plan's peak of memory). A
-/// point's neighbours come in another order than sorted, and twice where a list repeats an
-/// entry: the tree takes each point's best offer, the same whatever the order or repeats of the
-/// offers. `p`: null, or the lists are a permuted copy's (copy row j is the cloud's row
-/// p->order[j]) and the graph is over the cloud's own rows.
+/// (kNN lists are mostly mutual, so these are few; both directions of every edge held as a
+/// second, sorted copy would cost about 1 KB a point with 64 neighbours). A point's neighbours
+/// come in another order than sorted, and twice where a list repeats an entry: the tree takes
+/// each point's best offer, the same whatever the order or repeats of the offers. `p`: null,
+/// or the lists are a permuted copy's (copy row j is the cloud's row p->order[j]) and the graph
+/// is over the cloud's own rows.
 class SymmetricGraph {
  public:
   SymmetricGraph(const Neighbourhoods& lists, const detail::RowPermutation* p, int threads)
@@ -57,8 +57,40 @@ class SymmetricGraph {
       for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k)
         back[static_cast<std::size_t>(k)] = lists_back(lists, r, k - lists.offsets[r]) ? 1 : 0;
     });
-    // The one-way edges' far ends collect their near ends, in list order (serial: the same
-    // graph for any thread count).
+    collect_one_way(back);
+  }
+
+  /// Calls f(j) for each neighbour j of the cloud's row i.
+  template <class F>
+  void each(int i, F&& f) const {
+    const int r = p_ ? p_->position[static_cast<std::size_t>(i)] : i;
+    for (const int* j = lists_.begin(r); j != lists_.end(r); ++j) f(own(*j));
+    for (int k = extra_offsets_[i]; k < extra_offsets_[i + 1]; ++k)
+      f(extra_[static_cast<std::size_t>(k)]);
+  }
+
+ private:
+  /// Whether r is in the list of e, entry `at` of r's list. Sorted by distance, two mutual
+  /// neighbours mostly stand at about the same place in each other's lists: looked for near
+  /// `at` first, then counted through the whole list without a branch (it runs in vector lanes).
+  static bool lists_back(const Neighbourhoods& lists, int r, int at) {
+    const int e = lists.indices[lists.offsets[r] + at];
+    const int* list = lists.begin(e);
+    const int size = lists.size(e);
+    for (int m = std::max(0, at - kNearPlace); m < std::min(size, at + kNearPlace + 1); ++m) {
+      if (list[m] == r) return true;
+    }
+    int hits = 0;
+    for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
+    return hits > 0;
+  }
+  static constexpr int kNearPlace = 3;
+
+  /// The one-way edges (`back` 0) listed at their far ends, in list order (serial: the same
+  /// graph for any thread count).
+  void collect_one_way(const std::vector<char>& back) {
+    const Neighbourhoods& lists = lists_;
+    const int n = lists.vertex_count();
     extra_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
     for (int r = 0; r < n; ++r) {
       for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k) {
@@ -76,39 +108,13 @@ class SymmetricGraph {
     }
   }
 
-  /// Whether r is in the list of e, entry `at` of r's list. Sorted by distance, two mutual
-  /// neighbours mostly stand at about the same place in each other's lists: looked for near
-  /// `at` first, then counted through the whole list without a branch (it runs in vector lanes).
-  static bool lists_back(const Neighbourhoods& lists, int r, int at) {
-    const int e = lists.indices[lists.offsets[r] + at];
-    const int* list = lists.begin(e);
-    const int size = lists.size(e);
-    for (int m = std::max(0, at - kNearPlace); m < std::min(size, at + kNearPlace + 1); ++m) {
-      if (list[m] == r) return true;
-    }
-    int hits = 0;
-    for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
-    return hits > 0;
-  }
-  static constexpr int kNearPlace = 3;
-
-  /// Calls f(j) for each neighbour j of the cloud's row i.
-  template <class F>
-  void each(int i, F&& f) const {
-    const int r = p_ ? p_->position[static_cast<std::size_t>(i)] : i;
-    for (const int* j = lists_.begin(r); j != lists_.end(r); ++j) f(own(*j));
-    for (int k = extra_offsets_[i]; k < extra_offsets_[i + 1]; ++k)
-      f(extra_[static_cast<std::size_t>(k)]);
-  }
-
- private:
   /// The cloud's row of the lists' row r.
   int own(int r) const { return p_ ? p_->order[static_cast<std::size_t>(r)] : r; }
 
   const Neighbourhoods& lists_;
   const detail::RowPermutation* p_;
   std::vector<int> extra_offsets_;  ///< per cloud row, into extra_
-  std::vector<int> extra_;                   ///< the one-way edges' near ends, cloud rows
+  std::vector<int> extra_;          ///< the one-way edges' near ends, cloud rows
 };
 
 /// Prim's frontier: the points offered an edge to the tree and not in it yet, smallest
@@ -426,8 +432,8 @@ bool orient(PositionsRef V, const Neighbourhoods& neighbours, const CloudNormalO
 /// Where the global orientation decided: the jets' sides by the field of the oriented PCA
 /// normals N (detail::side_by_jumps), on the cloud in its own order as the orientation was; each
 /// field let go once its copy in that order is made (this is the global plan's peak of memory).
-void side_jets(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d N,
-               RowMatrixX3d& jets, const detail::CloudCopy* copy_of) {
+void side_jets(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d N, RowMatrixX3d& jets,
+               const detail::CloudCopy* copy_of) {
   Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, 0);
   if (!copy_of) {
     detail::side_by_jumps(V, area, N, jets, 0);

@@ -189,9 +189,9 @@ int turn_by_jumps(const WindingTree& tree, const Neighbourhoods& graph,
 int side_by_jumps(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, RowMatrixX3d& L,
                   int threads, const WindingOrientationOptions& options) {
   const RowMatrixX3d A = dipoles(V, area, N);
-  const Eigen::VectorXd J = tree_of(V, area, N, options)
-                                .jump_along(L, jump_lengths(area, options), A,
-                                            Eigen::VectorXd(), threads);
+  const Eigen::VectorXd J =
+      tree_of(V, area, N, options)
+          .jump_along(L, jump_lengths(area, options), A, Eigen::VectorXd(), threads);
   int turned = 0;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (J[i] >= 0.0) continue;

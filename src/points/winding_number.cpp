@@ -255,7 +255,8 @@ Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorX
 Eigen::VectorXd WindingTree::jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
                                   const Eigen::VectorXd& sign, int threads) const {
   if (E.rows() != rows_) throw InvalidInput("WindingTree::jump: E does not have #V rows");
-  return jumps(M, sign, threads, [&](int row) -> Eigen::Vector3d { return E.row(row).transpose(); });
+  return jumps(M, sign, threads,
+               [&](int row) -> Eigen::Vector3d { return E.row(row).transpose(); });
 }
 
 Eigen::VectorXd WindingTree::jump_along(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
