@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "focal/core/error.h"
 #include "focal/points/neighbours.h"
@@ -105,6 +107,66 @@ TEST(OrientNormals, RandomlyFlippedExactNormalsAreRestoredPerComponent) {
   }
   EXPECT_EQ(orient_normals_mst(V, nearest_neighbours(V, 12), N), 2);
   EXPECT_EQ(N, exact);
+}
+
+/// Lists as CSR.
+Neighbourhoods lists_of(const std::vector<std::vector<int>>& lists) {
+  Neighbourhoods out;
+  out.offsets.resize(static_cast<Eigen::Index>(lists.size()) + 1);
+  out.offsets[0] = 0;
+  std::vector<int> all;
+  for (std::size_t i = 0; i < lists.size(); ++i) {
+    all.insert(all.end(), lists[i].begin(), lists[i].end());
+    out.offsets[static_cast<Eigen::Index>(i) + 1] = static_cast<int>(all.size());
+  }
+  out.indices =
+      Eigen::Map<const Eigen::VectorXi>(all.data(), static_cast<Eigen::Index>(all.size()));
+  return out;
+}
+
+// The tree runs over the lists made symmetric (j in i's list or i in j's): the same bits from
+// the kNN lists, from their symmetric closure (sorted, each edge once per direction) and from
+// that closure shuffled with repeated entries, where PCA's signs leave the tree real choices
+// (a noisy torus, 8 neighbours: lists far from mutual), and one point far below that no list
+// holds: reached only by its own list's edges, one way, it is no component of its own.
+TEST(OrientNormals, TheTreeIsThatOfTheSymmetricGraph) {
+  const AnalyticSurface a = test::cloud_of(SurfaceKind::torus, 3000);
+  RowMatrixX3d V(a.mesh.V.rows() + 1, 3);
+  const double extent = (a.mesh.V.colwise().maxCoeff() - a.mesh.V.colwise().minCoeff()).maxCoeff();
+  V << a.mesh.V, Eigen::RowVector3d(0.0, 0.0, a.mesh.V.col(2).minCoeff() - extent);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, 0.02);
+  for (Eigen::Index i = 0; i < V.size(); ++i) V.data()[i] += g(rng);
+  const Neighbourhoods knn = nearest_neighbours(V, 8);
+  const int n = knn.vertex_count();
+  std::vector<std::vector<int>> closure(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    for (const int* j = knn.begin(i); j != knn.end(i); ++j) {
+      closure[static_cast<std::size_t>(i)].push_back(*j);
+      closure[static_cast<std::size_t>(*j)].push_back(i);
+    }
+  }
+  int one_way = 0;
+  for (auto& l : closure) {
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+    one_way += static_cast<int>(l.size()) - 8;
+  }
+  EXPECT_GT(one_way, n / 10);  // the closure adds edges: the one-way ones are exercised
+  std::vector<std::vector<int>> shuffled = closure;
+  for (auto& l : shuffled) {
+    l.push_back(l.front());
+    std::shuffle(l.begin(), l.end(), rng);
+  }
+  const RowMatrixX3d pca = pca_normals(V, knn);
+  RowMatrixX3d N1 = pca, N2 = pca, N3 = pca;
+  const int c1 = orient_normals_mst(V, knn, N1);
+  EXPECT_EQ(c1, 1);
+  EXPECT_EQ(orient_normals_mst(V, lists_of(closure), N2), c1);
+  EXPECT_EQ(orient_normals_mst(V, lists_of(shuffled), N3), c1);
+  EXPECT_EQ(N1, N2);
+  EXPECT_EQ(N1, N3);
+  EXPECT_NE(N1, pca);
 }
 
 TEST(OrientNormals, TowardsAViewpoint) {

@@ -36,52 +36,86 @@ void check_sizes(PositionsRef V, const Neighbourhoods& neighbours, const char* w
   }
 }
 
-/// The neighbour graph made symmetric (j in i's list or i in j's), as CSR, each edge once per
-/// direction, lists sorted. Built in place in one flat array (a vector per point cost 200 bytes
-/// per point more at 1M points); the lists sorted on `threads`. `rename`: null, or the graph of
-/// the lists with every row and entry r renamed (*rename)[r] (a permuted copy's lists, the
-/// graph of the cloud in its own order, without its own lists held beside the copy's).
-Neighbourhoods symmetric(const Neighbourhoods& nb, int threads,
-                         const std::vector<int>* rename = nullptr) {
-  const int n = nb.vertex_count();
-  const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
-  std::vector<std::int64_t> start(static_cast<std::size_t>(n) + 1, 0);
-  for (int r = 0; r < n; ++r) {
-    for (const int* j = nb.begin(r); j != nb.end(r); ++j)
-      ++start[name(r) + 1], ++start[name(*j) + 1];
+/// The neighbour graph made symmetric (j in i's list or i in j's) without a second copy of the
+/// lists: each point's own list, and beside it the points that list it but are not in its list
+/// (kNN lists are mostly mutual, so these are few; both directions of every edge held as a
+/// second, sorted copy would cost about 1 KB a point with 64 neighbours). A point's neighbours
+/// come in another order than sorted, and twice where a list repeats an entry: the tree takes
+/// each point's best offer, the same whatever the order or repeats of the offers. `p`: null,
+/// or the lists are a permuted copy's (copy row j is the cloud's row p->order[j]) and the graph
+/// is over the cloud's own rows.
+class SymmetricGraph {
+ public:
+  SymmetricGraph(const Neighbourhoods& lists, const detail::RowPermutation* p, int threads)
+      : lists_(lists), p_(p) {
+    const int n = lists.vertex_count();
+    // Per list entry r -> e: whether the edge comes back (r in e's list); each list's own
+    // entries (in parallel).
+    std::vector<char> back(static_cast<std::size_t>(lists.indices.size()), 0);
+    detail::parallel_for(n, threads, [&](std::int64_t r64) {
+      const int r = static_cast<int>(r64);
+      for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k)
+        back[static_cast<std::size_t>(k)] = lists_back(lists, r, k - lists.offsets[r]) ? 1 : 0;
+    });
+    collect_one_way(back);
   }
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> both(static_cast<std::size_t>(start[n]));
-  std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
-  for (int r = 0; r < n; ++r) {
-    const int i = name(r);
-    for (const int* j = nb.begin(r); j != nb.end(r); ++j) {
-      const int k = name(*j);
-      both[static_cast<std::size_t>(fill[i]++)] = k;
-      both[static_cast<std::size_t>(fill[k]++)] = i;
+
+  /// Calls f(j) for each neighbour j of the cloud's row i.
+  template <class F>
+  void each(int i, F&& f) const {
+    const int r = p_ ? p_->position[static_cast<std::size_t>(i)] : i;
+    for (const int* j = lists_.begin(r); j != lists_.end(r); ++j) f(own(*j));
+    for (int k = extra_offsets_[i]; k < extra_offsets_[i + 1]; ++k)
+      f(extra_[static_cast<std::size_t>(k)]);
+  }
+
+ private:
+  /// Whether r is in the list of e, entry `at` of r's list. Sorted by distance, two mutual
+  /// neighbours mostly stand at about the same place in each other's lists: looked for near
+  /// `at` first, then counted through the whole list without a branch (it runs in vector lanes).
+  static bool lists_back(const Neighbourhoods& lists, int r, int at) {
+    const int e = lists.indices[lists.offsets[r] + at];
+    const int* list = lists.begin(e);
+    const int size = lists.size(e);
+    for (int m = std::max(0, at - kNearPlace); m < std::min(size, at + kNearPlace + 1); ++m) {
+      if (list[m] == r) return true;
+    }
+    int hits = 0;
+    for (int m = 0; m < size; ++m) hits += list[m] == r ? 1 : 0;
+    return hits > 0;
+  }
+  static constexpr int kNearPlace = 3;
+
+  /// The one-way edges (`back` 0) listed at their far ends, in list order (serial: the same
+  /// graph for any thread count).
+  void collect_one_way(const std::vector<char>& back) {
+    const Neighbourhoods& lists = lists_;
+    const int n = lists.vertex_count();
+    extra_offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (int r = 0; r < n; ++r) {
+      for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k) {
+        if (!back[static_cast<std::size_t>(k)]) ++extra_offsets_[own(lists.indices[k]) + 1];
+      }
+    }
+    for (int i = 0; i < n; ++i) extra_offsets_[i + 1] += extra_offsets_[i];
+    extra_.resize(static_cast<std::size_t>(extra_offsets_[n]));
+    std::vector<int> fill(extra_offsets_.begin(), extra_offsets_.end() - 1);
+    for (int r = 0; r < n; ++r) {
+      for (int k = lists.offsets[r]; k < lists.offsets[r + 1]; ++k) {
+        if (!back[static_cast<std::size_t>(k)])
+          extra_[static_cast<std::size_t>(fill[own(lists.indices[k])]++)] = own(r);
+      }
     }
   }
-  Neighbourhoods out;
-  out.offsets.resize(n + 1);
-  out.offsets[0] = 0;
-  // Each list sorted and made unique where it lies (the lists are disjoint: in parallel), its
-  // length kept in offsets[i + 1] until the lists are packed.
-  detail::parallel_for(n, threads, [&](std::int64_t i) {
-    const auto first = both.begin() + start[i], last = both.begin() + start[i + 1];
-    std::sort(first, last);
-    out.offsets[i + 1] = static_cast<int>(std::unique(first, last) - first);
-  });
-  std::int64_t kept = 0;
-  for (int i = 0; i < n; ++i) {
-    const auto first = both.begin() + start[i];
-    // Leftwards: the destination starts at or before first.
-    std::copy(first, first + out.offsets[i + 1], both.begin() + kept);
-    kept += out.offsets[i + 1];
-    out.offsets[i + 1] = static_cast<int>(kept);
-  }
-  out.indices = Eigen::Map<const Eigen::VectorXi>(both.data(), static_cast<Eigen::Index>(kept));
-  return out;
-}
+
+  /// The cloud's row of the lists' row r.
+  int own(int r) const { return p_ ? p_->order[static_cast<std::size_t>(r)] : r; }
+
+  const Neighbourhoods& lists_;
+  const detail::RowPermutation* p_;
+  std::vector<int> extra_offsets_;  ///< per cloud row, into extra_
+  std::vector<int> extra_;          ///< the one-way edges' near ends, cloud rows
+};
 
 /// Prim's frontier: the points offered an edge to the tree and not in it yet, smallest
 /// (weight, point) first, with the best (weight, parent) offered to each. An indexed binary heap
@@ -229,7 +263,7 @@ int orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours, RowMatr
 namespace {
 
 /// orient_normals_mst over the symmetric neighbour graph `graph` of V.
-int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d& N) {
+int orient_over_graph(PositionsRef V, const SymmetricGraph& graph, RowMatrixX3d& N) {
   const auto n = static_cast<int>(V.rows());
   std::vector<char> usable(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) usable[i] = N.row(i).allFinite() && V.row(i).allFinite();
@@ -252,10 +286,10 @@ int orient_over_graph(PositionsRef V, const Neighbourhoods& graph, RowMatrixX3d&
       done[static_cast<std::size_t>(i)] = 1;
       component[static_cast<std::size_t>(i)] = label;
       if (N.row(i).dot(N.row(parent)) < 0.0) N.row(i) *= -1.0;
-      for (const int* j = graph.begin(i); j != graph.end(i); ++j) {
-        if (done[static_cast<std::size_t>(*j)] || !usable[*j]) continue;
-        frontier.offer(*j, 1.0 - std::abs(N.row(i).dot(N.row(*j))), i);
-      }
+      graph.each(i, [&](int j) {
+        if (done[static_cast<std::size_t>(j)] || !usable[j]) return;
+        frontier.offer(j, 1.0 - std::abs(N.row(i).dot(N.row(j))), i);
+      });
     }
   }
   // The side of each component: the seed alone (its highest point) may be an outlier or a
@@ -308,7 +342,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   check_sizes(V, neighbours, "orient_normals_mst");
   if (N.rows() != V.rows()) throw InvalidInput("orient_normals_mst: N does not have #V rows");
   if (!copy_of) {
-    const int components = orient_over_graph(V, symmetric(neighbours, threads), N);
+    const int components = orient_over_graph(V, SymmetricGraph(neighbours, nullptr, threads), N);
     if (global) orient_after_tree(V, neighbours, N, threads, nullptr, decided);
     return components;
   }
@@ -319,7 +353,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
   RowMatrixX3d own;
   int components = 0;
   {
-    const Neighbourhoods graph = symmetric(neighbours, threads, &p.order);
+    const SymmetricGraph graph(neighbours, &p, threads);
     own = detail::rows_from(N, p.position, threads);
     N = RowMatrixX3d();
     components = orient_over_graph(copy_of->cloud, graph, own);
@@ -332,7 +366,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
 void detail::orient_after_tree(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d& N,
                                int threads, const CloudCopy* copy_of, bool* decided) {
   // The areas from the lists as given (sorted by distance); a normal's sign does not enter them.
-  const Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, threads);
+  Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, threads);
   if (!copy_of) {
     tell(detail::orient_by_winding(V, neighbours, nullptr, area, N, threads), decided);
     return;
@@ -340,10 +374,10 @@ void detail::orient_after_tree(PositionsRef V, const Neighbourhoods& neighbours,
   // On the cloud in its own order, as the tree: the winding number's segments read the copy's
   // lists renamed.
   const RowPermutation& p = copy_of->permutation;
+  area = detail::rows_from(area, p.position, threads);
   RowMatrixX3d own = detail::rows_from(N, p.position, threads);
   N = RowMatrixX3d();
-  tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order,
-                                 detail::rows_from(area, p.position, threads), own, threads),
+  tell(detail::orient_by_winding(copy_of->cloud, neighbours, &p.order, area, own, threads),
        decided);
   N = detail::rows_from(own, p.order, threads);
 }
@@ -396,18 +430,22 @@ bool orient(PositionsRef V, const Neighbourhoods& neighbours, const CloudNormalO
 }
 
 /// Where the global orientation decided: the jets' sides by the field of the oriented PCA
-/// normals N (detail::side_by_jumps), on the cloud in its own order as the orientation was.
-void side_jets(PositionsRef V, const Neighbourhoods& neighbours, const RowMatrixX3d& N,
-               RowMatrixX3d& jets, const detail::CloudCopy* copy_of) {
-  const Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, 0);
+/// normals N (detail::side_by_jumps), on the cloud in its own order as the orientation was; each
+/// field let go once its copy in that order is made (this is the global plan's peak of memory).
+void side_jets(PositionsRef V, const Neighbourhoods& neighbours, RowMatrixX3d N, RowMatrixX3d& jets,
+               const detail::CloudCopy* copy_of) {
+  Eigen::VectorXd area = detail::patch_areas(V, neighbours, N, 0);
   if (!copy_of) {
     detail::side_by_jumps(V, area, N, jets, 0);
     return;
   }
   const auto& p = copy_of->permutation;
+  area = detail::rows_from(area, p.position, 0);
+  N = detail::rows_from(N, p.position, 0);
   RowMatrixX3d own = detail::rows_from(jets, p.position, 0);
-  detail::side_by_jumps(copy_of->cloud, detail::rows_from(area, p.position, 0),
-                        detail::rows_from(N, p.position, 0), own, 0);
+  jets = RowMatrixX3d();
+  detail::side_by_jumps(copy_of->cloud, area, N, own, 0);
+  N = RowMatrixX3d();
   jets = detail::rows_from(own, p.order, 0);
 }
 
@@ -416,17 +454,24 @@ bool turned_to_side(const Eigen::RowVector3d& n, NormalsRef side, Eigen::Index i
   return n.dot(side.row(i)) < 0.0;
 }
 
-/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N. `copy_of`
-/// as detail::orient_normals_mst.
-JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
-                           const CloudNormalOptions& options, RowMatrixX3d N,
-                           const detail::CloudCopy* copy_of) {
-  if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
+/// The jets (CloudNormalMethod::jet) from oriented PCA normals N. `copy_of` as
+/// detail::orient_normals_mst.
+JetNormals jets_of(PositionsRef V, const Neighbourhoods& neighbours,
+                   const CloudNormalOptions& options, NormalsRef N,
+                   const detail::CloudCopy* copy_of) {
   // The neighbourhoods play the 1-ring of a mesh (rings = 1): the jet of each point is fitted
   // to exactly its neighbours and itself, in the frame of its oriented PCA normal.
   const JetOptions jet{.rings = 1, .degree = options.jet_degree, .iterations = 2};
   return detail::jet_normals_from(V, neighbours, N, jet, detail::SimdIsa::best,
                                   copy_of ? &copy_of->permutation.order : nullptr);
+}
+
+/// The jets (or, for CloudNormalMethod::pca, nothing more) from oriented PCA normals N.
+JetNormals jets_from_start(PositionsRef V, const Neighbourhoods& neighbours,
+                           const CloudNormalOptions& options, RowMatrixX3d N,
+                           const detail::CloudCopy* copy_of) {
+  if (options.method == CloudNormalMethod::pca) return {std::move(N), {}, {}};
+  return jets_of(V, neighbours, options, N, copy_of);
 }
 
 }  // namespace
@@ -441,8 +486,8 @@ JetNormals detail::cloud_jets(PositionsRef V, const Neighbourhoods& neighbours,
   if (!decided || options.method == CloudNormalMethod::pca) {
     return jets_from_start(V, neighbours, options, std::move(N), copy_of);
   }
-  JetNormals jets = jets_from_start(V, neighbours, options, N, copy_of);
-  side_jets(V, neighbours, N, jets.N, copy_of);
+  JetNormals jets = jets_of(V, neighbours, options, N, copy_of);
+  side_jets(V, neighbours, std::move(N), jets.N, copy_of);
   return jets;
 }
 
@@ -456,7 +501,7 @@ void detail::orient_jets_globally(PositionsRef V, const Neighbourhoods& neighbou
   bool decided = false;
   orient_after_tree(V, neighbours, start, 0, copy_of, &decided);
   // Not decided: the tree's signs stay, and so do the jets fitted from them.
-  if (decided) side_jets(V, neighbours, start, jets.N, copy_of);
+  if (decided) side_jets(V, neighbours, std::move(start), jets.N, copy_of);
 }
 
 JetNormals detail::cloud_jets_sided(PositionsRef V, const Neighbourhoods& neighbours,
@@ -489,7 +534,7 @@ void detail::orient_sided_jets(PositionsRef V, const Neighbourhoods& neighbours,
     }
   });
   if (decided && options.method == CloudNormalMethod::jet)
-    side_jets(V, neighbours, mst, jets.N, copy_of);
+    side_jets(V, neighbours, std::move(mst), jets.N, copy_of);
 }
 
 RowMatrixX3d cloud_normals(PositionsRef V, const Neighbourhoods& neighbours,

@@ -135,18 +135,6 @@ Eigen::VectorXd contact_lengths(PositionsRef V, const Neighbourhoods& graph,
   return length;
 }
 
-/// The jumps' offsets (#V x 3): along each row of `lines`, its entry of `length`; zero where A
-/// has no dipole or the line is zero or not finite.
-RowMatrixX3d offsets(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
-                     const RowMatrixX3d& A) {
-  RowMatrixX3d E = RowMatrixX3d::Zero(A.rows(), 3);
-  for (Eigen::Index i = 0; i < A.rows(); ++i) {
-    const double l = lines.row(i).norm();
-    if (!A.row(i).isZero() && l > 0.0 && std::isfinite(l)) E.row(i) = length[i] / l * lines.row(i);
-  }
-  return E;
-}
-
 /// Rounds of per-point turns: each point takes the side that the field's jump across it says
 /// (positive: its signed normal points out), all at once, until a round turns none. The jump
 /// leaves the point's own dipole out, so a point alone in a consistent sheet follows the sheet,
@@ -161,26 +149,25 @@ int turn_by_jumps(const WindingTree& tree, const Neighbourhoods& graph,
                   Eigen::VectorXd& s, int threads) {
   const auto name = [rename](int r) { return rename ? (*rename)[static_cast<std::size_t>(r)] : r; };
   const Eigen::Index n = A.rows();
-  const RowMatrixX3d E = offsets(A, length, A);
-  RowMatrixX3d again;  // the offsets of the points evaluated again, zero elsewhere
+  Eigen::VectorXd again;  // the lengths of the points evaluated again, zero elsewhere
   std::vector<char> turned(static_cast<std::size_t>(n), 0);
   Eigen::VectorXd J;
   int total = 0;
   for (int round = 0; round < options.jump_rounds; ++round) {
     if (round == 0) {
-      J = tree.jump(E, A, s, threads);
+      J = tree.jump_along(A, length, A, s, threads);
     } else {
-      again = RowMatrixX3d::Zero(n, 3);
+      again = Eigen::VectorXd::Zero(n);
       for (int row = 0; row < graph.vertex_count(); ++row) {
         const int i = name(row);
         bool near = turned[static_cast<std::size_t>(i)] != 0;
         for (const int* jr = graph.begin(row); !near && jr != graph.end(row); ++jr)
           near = turned[static_cast<std::size_t>(name(*jr))] != 0;
-        if (near) again.row(i) = E.row(i);
+        if (near) again[i] = length[i];
       }
-      const Eigen::VectorXd update = tree.jump(again, A, s, threads);
+      const Eigen::VectorXd update = tree.jump_along(A, again, A, s, threads);
       for (Eigen::Index i = 0; i < n; ++i) {
-        if (!again.row(i).isZero()) J[i] = update[i];
+        if (again[i] != 0.0) J[i] = update[i];
       }
     }
     int count = 0;
@@ -202,9 +189,9 @@ int turn_by_jumps(const WindingTree& tree, const Neighbourhoods& graph,
 int side_by_jumps(PositionsRef V, const Eigen::VectorXd& area, NormalsRef N, RowMatrixX3d& L,
                   int threads, const WindingOrientationOptions& options) {
   const RowMatrixX3d A = dipoles(V, area, N);
-  const Eigen::VectorXd J = tree_of(V, area, N, options)
-                                .jump(offsets(L, jump_lengths(area, options), A), A,
-                                      Eigen::VectorXd(), threads);
+  const Eigen::VectorXd J =
+      tree_of(V, area, N, options)
+          .jump_along(L, jump_lengths(area, options), A, Eigen::VectorXd(), threads);
   int turned = 0;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (J[i] >= 0.0) continue;
@@ -270,10 +257,22 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     Eigen::VectorXd g = Kt(r);
     Eigen::VectorXd p = g;
     double gamma = dot(g, g);
+    // Only the signs of s + d are taken: once a step turns none of them against the step
+    // before, the iteration stops (on a plate the first step turns a whole side and the next
+    // four none; on thin parts with contacts they move at every step).
+    std::vector<char> turns(static_cast<std::size_t>(n), 0);
     for (int it = 0; it < options.iterations && gamma > 0.0; ++it) {
       const Eigen::VectorXd q = K(p);
       const double alpha = gamma / (dot(q, q) + lambda * dot(p, p));
       d += alpha * p;
+      bool moved = false;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const char t = (s[i] + d[i]) * s[i] < 0.0 ? 1 : 0;
+        moved = moved || t != turns[static_cast<std::size_t>(i)];
+        turns[static_cast<std::size_t>(i)] = t;
+      }
+      // The last step's gradient would only set a next direction: its product is not taken.
+      if (it + 1 == options.iterations || (it > 0 && !moved)) break;
       r -= alpha * q;
       g = Kt(r) - lambda * d;
       const double next = dot(g, g);
@@ -300,9 +299,10 @@ WindingOrientationReport orient_by_winding(PositionsRef V, const Neighbourhoods&
     const Eigen::VectorXd column = tree.near_column_norms(A, threads);
     double energy = dot(r, r);
     bool failed = false;  // the last sweep turned nothing
+    Eigen::VectorXd g;    // K^T r, kept while a sweep that turned nothing leaves r as it was
     for (int sweep = 0; sweep < options.sweeps; ++sweep) {
       const std::vector<int> label = segments(V, graph, rename, N, s, sweep % 2 == 1);
-      const Eigen::VectorXd g = Kt(r);
+      if (!failed) g = Kt(r);
       std::vector<double> gain(static_cast<std::size_t>(n), 0.0);
       for (Eigen::Index i = 0; i < n; ++i) {
         if (A.row(i).isZero()) continue;

@@ -30,9 +30,11 @@ namespace focal::detail {
 struct WindingOrientationOptions {
   double beta = 1.5;      ///< far-field criterion of the tree
   double damping = 0.05;  ///< lambda above
-  int iterations = 5;     ///< CGLS iterations per round
-  int rounds = 1;         ///< rounds, each seeded from the signs of the last
-  int sweeps = 6;         ///< sweeps over segments after the rounds, at most
+  /// CGLS iterations per round, at most: a round stops once an iteration turns no sign of its
+  /// solution against the iteration before (only those signs are taken).
+  int iterations = 5;
+  int rounds = 1;  ///< rounds, each seeded from the signs of the last
+  int sweeps = 6;  ///< sweeps over segments after the rounds, at most
   /// The signs are taken only where the field decides: the residual of the signs found at most
   /// closed_residual and at most closed_gain times the tree's. Measured (docs/notes/points-log.md,
   /// "Global orientation"): closed thin solids 0.13-0.34 and 0.10-0.33 of the tree's, CGAL's

@@ -65,6 +65,7 @@ WindingTree::WindingTree(PositionsRef V, const Eigen::VectorXd& smoothing, doubl
   nodes_[0].begin = 0;
   nodes_[0].end = static_cast<int>(n);
   build(V, 0, low, (high - low).maxCoeff(), 0);
+  nodes_.shrink_to_fit();  // the growth's spare capacity, up to as much again
   for (Eigen::Index t = 0; t < n; ++t) {
     const int i = order_[static_cast<std::size_t>(t)];
     P_.row(t) = V.row(i);
@@ -168,43 +169,42 @@ WindingTree::Moments WindingTree::moments(const RowMatrixX3d& M,
                                                   : Eigen::RowVector3d(M.row(row));
     d.M.row(t) = m.allFinite() ? m : Eigen::RowVector3d::Zero();
   }
-  // Children before parents (they come after them): the sums and second moments about each
-  // node's centre, then the far terms' coefficients.
-  const auto count = static_cast<std::size_t>(nodes_.size());
-  std::vector<Eigen::Vector3d> sum(count);
-  std::vector<Eigen::Matrix3d> second(count);
-  d.far.resize(count);
-  for (std::size_t k = count; k-- > 0;) {
-    const Node& node = nodes_[k];
-    Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
-    if (node.first_child < 0) {
-      for (int t = node.begin; t < node.end; ++t) {
-        const Eigen::Vector3d m = d.M.row(t).transpose();
-        s += m;
-        T += m * (P_.row(t).transpose() - node.centre).transpose();
-      }
-    } else {
-      for (int c = node.first_child; c < node.first_child + node.children; ++c) {
-        const auto cs = static_cast<std::size_t>(c);
-        s += sum[cs];
-        T += second[cs] + sum[cs] * (nodes_[cs].centre - node.centre).transpose();
-      }
-    }
-    sum[k] = s;
-    second[k] = T;
-    d.far[k] = {s.x(),
-                s.y(),
-                s.z(),
-                T.trace(),
-                T(0, 0),
-                T(1, 1),
-                T(2, 2),
-                T(0, 1) + T(1, 0),
-                T(0, 2) + T(2, 0),
-                T(1, 2) + T(2, 1)};
-  }
+  d.far.resize(nodes_.size());
+  if (!nodes_.empty()) far_moments(0, d);
   return d;
+}
+
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> WindingTree::far_moments(int k, Moments& d) const {
+  // Depth first, children in order: the sums and second moments of each node about its centre
+  // from its children's (no array of them beside the far terms), then its far term's
+  // coefficients.
+  const Node& node = nodes_[static_cast<std::size_t>(k)];
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d T = Eigen::Matrix3d::Zero();
+  if (node.first_child < 0) {
+    for (int t = node.begin; t < node.end; ++t) {
+      const Eigen::Vector3d m = d.M.row(t).transpose();
+      s += m;
+      T += m * (P_.row(t).transpose() - node.centre).transpose();
+    }
+  } else {
+    for (int c = node.first_child; c < node.first_child + node.children; ++c) {
+      const auto [cs, cT] = far_moments(c, d);
+      s += cs;
+      T += cT + cs * (nodes_[static_cast<std::size_t>(c)].centre - node.centre).transpose();
+    }
+  }
+  d.far[static_cast<std::size_t>(k)] = {s.x(),
+                                        s.y(),
+                                        s.z(),
+                                        T.trace(),
+                                        T(0, 0),
+                                        T(1, 1),
+                                        T(2, 2),
+                                        T(0, 1) + T(1, 0),
+                                        T(0, 2) + T(2, 0),
+                                        T(1, 2) + T(2, 1)};
+  return {s, T};
 }
 
 double WindingTree::winding_sum(const Eigen::Vector3d& q, double own, const Moments& d) const {
@@ -255,12 +255,32 @@ Eigen::VectorXd WindingTree::winding(const RowMatrixX3d& M, const Eigen::VectorX
 Eigen::VectorXd WindingTree::jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
                                   const Eigen::VectorXd& sign, int threads) const {
   if (E.rows() != rows_) throw InvalidInput("WindingTree::jump: E does not have #V rows");
+  return jumps(M, sign, threads,
+               [&](int row) -> Eigen::Vector3d { return E.row(row).transpose(); });
+}
+
+Eigen::VectorXd WindingTree::jump_along(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
+                                        const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                        int threads) const {
+  if (lines.rows() != rows_ || length.size() != rows_) {
+    throw InvalidInput("WindingTree::jump_along: lines or length do not have #V rows");
+  }
+  return jumps(M, sign, threads, [&](int row) -> Eigen::Vector3d {
+    const double l = lines.row(row).norm();
+    if (M.row(row).isZero() || !(l > 0.0) || !std::isfinite(l)) return Eigen::Vector3d::Zero();
+    return (length[row] / l * lines.row(row)).transpose();
+  });
+}
+
+template <class Offset>
+Eigen::VectorXd WindingTree::jumps(const RowMatrixX3d& M, const Eigen::VectorXd& sign, int threads,
+                                   Offset&& offset) const {
   const Moments d = moments(M, sign);
   const auto n = static_cast<Eigen::Index>(order_.size());
   Eigen::VectorXd out = Eigen::VectorXd::Zero(rows_);
   parallel_for(n, threads, [&](std::int64_t t) {
     const int row = order_[static_cast<std::size_t>(t)];
-    const Eigen::Vector3d e = E.row(row).transpose();
+    const Eigen::Vector3d e = offset(row);
     if (!e.allFinite() || e.isZero()) return;
     const Eigen::Vector3d p = P_.row(t).transpose(), m = d.M.row(t).transpose();
     const double own = s2_[t];

@@ -22,6 +22,7 @@
 // thread count.
 #include <Eigen/Core>
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "focal/core/mesh.h"
@@ -46,6 +47,13 @@ class WindingTree {
   /// dipoles, about -1 where it points in. 0 where E's row is zero or not finite.
   [[nodiscard]] Eigen::VectorXd jump(const RowMatrixX3d& E, const RowMatrixX3d& M,
                                      const Eigen::VectorXd& sign, int threads) const;
+
+  /// jump() with the offsets made in the pass instead of held: e_i = length_i / |l_i| l_i along
+  /// row i of `lines` (#V x 3; `length` #V), zero where M's row or the line is zero or the line
+  /// is not finite.
+  [[nodiscard]] Eigen::VectorXd jump_along(const RowMatrixX3d& lines, const Eigen::VectorXd& length,
+                                           const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                           int threads) const;
 
   /// g_j (#V x 3) at every point of V for charges q (#V).
   [[nodiscard]] RowMatrixX3d field(const Eigen::VectorXd& q, int threads) const;
@@ -82,6 +90,13 @@ class WindingTree {
     std::vector<std::array<double, 10>> far;
   };
   [[nodiscard]] Moments moments(const RowMatrixX3d& M, const Eigen::VectorXd& sign) const;
+  /// Sets d.far of node k and those below it from d.M; returns the node's sum of m_j and
+  /// sum m_j (p_j - c)^T about its centre c.
+  std::pair<Eigen::Vector3d, Eigen::Matrix3d> far_moments(int k, Moments& d) const;
+  /// jump() with point row's offset offset(row).
+  template <class Offset>
+  [[nodiscard]] Eigen::VectorXd jumps(const RowMatrixX3d& M, const Eigen::VectorXd& sign,
+                                      int threads, Offset&& offset) const;
   /// 4 pi w at q, smoothed by `own` (half its squared smoothing length), of the dipoles `d`.
   [[nodiscard]] double winding_sum(const Eigen::Vector3d& q, double own, const Moments& d) const;
   /// Splits `node` (its rows in order_, its cube's corner `low` and side `size`) into octants.
