@@ -288,21 +288,28 @@ TEST_F(MeshIo, PlyBinaryRoundTripIsExact) {
   }
 }
 
+/// n vertices with normals (signed zeros and subnormal-sized components among them) and n
+/// triangles over consecutive vertices: every number a writer has to keep exact.
+Mesh strip_mesh(int n) {
+  Mesh m;
+  m.V.resize(n, 3);
+  m.N.resize(n, 3);
+  m.F.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    m.V.row(i) << 0.001 * i, std::sin(0.37 * i), 1.0 / (i + 1);
+    m.N.row(i) << 0.0, std::cos(0.37 * i), i % 7 == 0 ? -0.0 : 1e-300 * i;
+    m.F.row(i) << i, (i + 1) % n, (i + 2) % n;
+  }
+  return m;
+}
+
 TEST_F(MeshIo, FilesBelowAndAboveTheMappedSizeReadTheSame) {
   // The readers map a file of 1 MiB or more and read a smaller one into a buffer: a binary PLY
   // with normals (48 bytes a vertex, 13 a face, and the header) on each side of 1 MiB, an OBJ
   // above it, all exact; a truncated mapped file is an IoError, not a read past its end.
   for (const int n : {15000, 25000}) {
     SCOPED_TRACE("vertices " + std::to_string(n));
-    Mesh m;
-    m.V.resize(n, 3);
-    m.N.resize(n, 3);
-    m.F.resize(n, 3);
-    for (int i = 0; i < n; ++i) {
-      m.V.row(i) << 0.001 * i, std::sin(0.37 * i), 1.0 / (i + 1);
-      m.N.row(i) << 0.0, std::cos(0.37 * i), i % 7 == 0 ? -0.0 : 1e-300 * i;
-      m.F.row(i) << i, (i + 1) % n, (i + 2) % n;
-    }
+    Mesh m = strip_mesh(n);
     m.face_source = Eigen::VectorXi::LinSpaced(n, 0, n - 1);  // each triangle its own polygon
     const fs::path ply = file("m.ply");
     focal::write_ply(ply, m);
@@ -319,16 +326,8 @@ TEST_F(MeshIo, FilesBelowAndAboveTheMappedSizeReadTheSame) {
 TEST_F(MeshIo, TextWritersGiveTheSameBytesOnAnyThreadCount) {
   // 40,000 vertices and faces: more lines than one batch of the parallel blocks (32,768), so
   // blocks, batches and the header before them all meet.
-  Mesh m;
   const int n = 40000;
-  m.V.resize(n, 3);
-  m.N.resize(n, 3);
-  m.F.resize(n, 3);
-  for (int i = 0; i < n; ++i) {
-    m.V.row(i) << 0.001 * i, std::sin(0.37 * i), 1.0 / (i + 1);
-    m.N.row(i) << 0.0, std::cos(0.37 * i), i % 7 == 0 ? -0.0 : 1e-300 * i;
-    m.F.row(i) << i, (i + 1) % n, (i + 2) % n;
-  }
+  const Mesh m = strip_mesh(n);
   const std::vector<focal::CsvColumn> columns{{"x", Eigen::VectorXd(m.V.col(0))},
                                               {"word", std::vector<std::string>(n, "a,b")}};
   for (const focal::Precision precision : {focal::Precision::float64, focal::Precision::float32}) {
