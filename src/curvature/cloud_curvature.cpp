@@ -260,10 +260,14 @@ CloudCurvature adaptive_plan(PositionsRef V, std::optional<NormalsRef> N,
   }
   out.noise = median_of({jets.residual.begin(), jets.residual.end()}) / out.spacing;
   if (out.noise > kNoisyPositions) {
+    // The first fit gave its noise only: its jets and start let go before the wider lists and
+    // the second fit (at 1M points their 36 B a point stood at the global orientation's peak).
+    jets = JetNormals();
+    start = RowMatrixX3d();
     out.k = kNoisyNeighbourFactor * default_cloud_neighbours;
+    out.neighbours = Neighbourhoods();
     out.neighbours = nearest(out.k, out.outlier);
     normals.jet_degree = 2;
-    start = RowMatrixX3d();
     jets = fit_jets();
   } else if (deferred) {
     detail::orient_jets_globally(V, out.neighbours, normals, std::move(start), jets, copy_of);

@@ -359,6 +359,7 @@ int detail::orient_normals_mst(PositionsRef V, const Neighbourhoods& neighbours,
     components = orient_over_graph(copy_of->cloud, graph, own);
   }
   N = detail::rows_from(own, p.order, threads);
+  own = RowMatrixX3d();  // not held through the global step, whose peak it raised by 24 B a point
   if (global) orient_after_tree(V, neighbours, N, threads, copy_of, decided);
   return components;
 }
