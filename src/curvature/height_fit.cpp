@@ -40,12 +40,8 @@ struct HeightSystem {
 
   void add_point(double u, double v, double z) {
     const double g = 1.0 / (u * u + v * v), h = g * g, hz = h * z;
-    std::array<double, 9> pu, pv;
-    pu[0] = pv[0] = 1.0;
-    for (std::size_t k = 1; k < 9; ++k) {
-      pu[k] = pu[k - 1] * u;
-      pv[k] = pv[k - 1] * v;
-    }
+    const polynomial::Powers powers(u, v);
+    const std::array<double, 9>&pu = powers.u, &pv = powers.v;
     unroll<kMoments.size()>(
         [&](auto k) { moments[k] += h * polynomial::monomial_at<Moments>(pu, pv, k); });
     unroll<N>([&](auto k) { right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k); });
@@ -136,11 +132,6 @@ std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
                    cubic ? polynomial::rms_misfit(sys.btb, *cubic, cubic_right, sys.rows) : NAN};
 }
 
-/// Whether v's 1-ring is closed (as many faces as neighbours).
-bool closed_ring(const Neighbourhoods& one_ring, const VertexFaces& incidence, int v) {
-  return incidence.size(v) == static_cast<int>(one_ring.end(v) - one_ring.begin(v));
-}
-
 }  // namespace
 
 std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
@@ -155,7 +146,7 @@ std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
       const auto v = static_cast<std::size_t>(i);
       if (!ok[v] || (!keep.empty() && keep[v]) || fit.residual[i] <= exact_residual) continue;
       const int vi = static_cast<int>(i);
-      if (!closed_ring(one_ring, incidence, vi)) continue;
+      if (!polynomial::closed_ring(one_ring, incidence, vi)) continue;
       const TangentFrame frame = tangent_frame(N.row(i).transpose());
       polynomial::ring_stencil(one_ring, vi, true, moved, stencil);
       const std::optional<HeightFit> f = !moved.empty() && moved[v]
@@ -179,7 +170,8 @@ std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
 double height_truncation_share(PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
                                const Neighbourhoods& one_ring, const VertexFaces& incidence, int v,
                                const Eigen::Vector3d& n) {
-  if (!closed_ring(one_ring, incidence, v) || !ok[static_cast<std::size_t>(v)]) return NAN;
+  if (!polynomial::closed_ring(one_ring, incidence, v) || !ok[static_cast<std::size_t>(v)])
+    return NAN;
   std::vector<int> stencil;
   polynomial::ring_stencil(one_ring, v, true, {}, stencil);
   const std::optional<HeightFit> f = height_fit<1>(V, N, ok, stencil, v, tangent_frame(n));

@@ -101,12 +101,8 @@ struct System {
     const double g = 1.0 / (u * u + v * v), h = g * g;
     // A point whose normal is not known to full order gives its height row only.
     const double gs = slopes_known ? g : 0.0;
-    std::array<double, 9> pu, pv;
-    pu[0] = pv[0] = 1.0;
-    for (std::size_t k = 1; k < 9; ++k) {
-      pu[k] = pu[k - 1] * u;
-      pv[k] = pv[k - 1] * v;
-    }
+    const polynomial::Powers powers(u, v);
+    const std::array<double, 9>&pu = powers.u, &pv = powers.v;
     const auto at = [&](auto table, auto k) {
       return polynomial::monomial_at<decltype(table)>(pu, pv, k);
     };
@@ -304,7 +300,7 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
       const auto v = static_cast<std::size_t>(i);
       const int vi = static_cast<int>(i);
       if (!ok[v] || (!keep.empty() && keep[v]) || fit.residual[i] <= exact_residual) continue;
-      if (incidence.size(i) != static_cast<int>(one_ring.end(vi) - one_ring.begin(vi))) continue;
+      if (!polynomial::closed_ring(one_ring, incidence, vi)) continue;
       const TangentFrame frame = tangent_frame(N.row(i).transpose());
       Refusal refusal = Refusal::none;
       std::optional<Eigen::Vector3d> op;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "focal/mesh/neighbourhood.h"
+#include "mesh/topology.h"
 
 namespace focal::detail::polynomial {
 
@@ -56,6 +57,18 @@ double monomial_at(const std::array<double, P>& pu, const std::array<double, P>&
   constexpr std::array<int, 2> e = table::value[k];
   return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
 }
+
+/// The powers u^0 .. u^8 and v^0 .. v^8 of a point's scaled offset (the moments' degrees).
+struct Powers {
+  std::array<double, 9> u, v;
+  Powers(double x, double y) {
+    u[0] = v[0] = 1.0;
+    for (std::size_t k = 1; k < 9; ++k) {
+      u[k] = u[k - 1] * x;
+      v[k] = v[k - 1] * y;
+    }
+  }
+};
 
 template <std::size_t N>
 using Vector = std::array<double, N>;
@@ -117,6 +130,11 @@ inline Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eige
   if (q > 0.0) half += (1.0 / root - 1.0) * p * p.transpose() / q;
   const Eigen::Matrix2d S = half * (-hessian / root) * half;
   return {S(0, 0), 0.5 * (S(0, 1) + S(1, 0)), S(1, 1)};
+}
+
+/// Whether v's 1-ring is closed: as many faces as neighbours in `incidence`.
+inline bool closed_ring(const Neighbourhoods& one_ring, const VertexFaces& incidence, int v) {
+  return incidence.size(v) == static_cast<int>(one_ring.end(v) - one_ring.begin(v));
 }
 
 /// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` vertices (empty or

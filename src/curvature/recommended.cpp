@@ -153,6 +153,16 @@ std::vector<char> near_creases(const Context& c, const VectorXu8& crease) {
   return out;
 }
 
+/// The `repaired` spikes as #V flags for the quartic fits' moved vertices (empty: none).
+std::vector<char> moved_flags(const Context& c, const std::vector<int>& repaired) {
+  std::vector<char> moved;
+  if (!repaired.empty()) {
+    moved.assign(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
+    for (const int v : repaired) moved[static_cast<std::size_t>(v)] = 1;
+  }
+  return moved;
+}
+
 /// Trusted file normals on clean positions: the quartic Hermite fit (curvature/hermite_fit.h)
 /// where the two-slit fit is not exact, except `near_crease` (near_creases), with the
 /// `repaired` spikes and the normals that are not the file's (outliers replaced) as the fit's
@@ -163,11 +173,7 @@ std::vector<char> hermite(const Context& c, const PreparedMesh& fitted,
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   const detail::UnitNormals& unit = detail::unit_normals(fitted);
   const auto count = static_cast<std::size_t>(c.mesh.vertex_count());
-  std::vector<char> moved;
-  if (!repaired.empty()) {
-    moved.assign(count, 0);
-    for (const int v : repaired) moved[static_cast<std::size_t>(v)] = 1;
-  }
+  const std::vector<char> moved = moved_flags(c, repaired);
   // The fitted normals that are not the file's (outliers replaced by the positions' normals).
   std::vector<char> guessed(count, 0);
   const NormalsRef file = *c.mesh.normals();
@@ -189,14 +195,10 @@ std::vector<char> heights(const Context& c, const PreparedMesh& fitted,
                           CurvatureResult& fit) {
   if (!c.one_ring) c.one_ring = detail::one_ring(c.mesh);
   const detail::UnitNormals& unit = detail::unit_normals(fitted);
-  std::vector<char> moved;
-  if (!repaired.empty()) {
-    moved.assign(static_cast<std::size_t>(c.mesh.vertex_count()), 0);
-    for (const int v : repaired) moved[static_cast<std::size_t>(v)] = 1;
-  }
-  return detail::prefer_height_fit(
-      fitted.V(), unit.N, unit.ok, *c.one_ring, *detail::incidence(c.mesh), near_crease, moved,
-      kExactFitResidual, detail::class_tolerances(paper_options(c), c.edge_length), fit);
+  return detail::prefer_height_fit(fitted.V(), unit.N, unit.ok, *c.one_ring,
+                                   *detail::incidence(c.mesh), near_crease,
+                                   moved_flags(c, repaired), kExactFitResidual,
+                                   detail::class_tolerances(paper_options(c), c.edge_length), fit);
 }
 
 /// Trusted file normals on clean positions: the corrected curvature measures
