@@ -282,7 +282,10 @@ int orient_over_graph(PositionsRef V, const SymmetricGraph& graph, RowMatrixX3d&
     if (N(seed, 2) < 0.0) N.row(seed) *= -1.0;
     frontier.offer(seed, 0.0, seed);
     while (!frontier.empty()) {
-      const auto [i, parent] = frontier.pop();
+      // Named variables, not a structured binding: the lambda below captures i.
+      const std::pair<int, int> popped = frontier.pop();
+      const int i = popped.first;
+      const int parent = popped.second;
       done[static_cast<std::size_t>(i)] = 1;
       component[static_cast<std::size_t>(i)] = label;
       if (N.row(i).dot(N.row(parent)) < 0.0) N.row(i) *= -1.0;
