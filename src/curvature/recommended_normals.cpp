@@ -303,13 +303,17 @@ std::vector<char> crease_vertices(const Context& c) {
   const FacesRef& F = c.mesh.F();
   const auto& incidence = *detail::incidence(c.mesh);
   const double cos_limit = std::cos(c.options.crease_angle);
-  const auto normal_of = [&](int f) {
-    const Eigen::Vector3d a = V.row(F(f, 0)).transpose(), b = V.row(F(f, 1)).transpose(),
-                          d = V.row(F(f, 2)).transpose();
-    return Eigen::Vector3d((b - a).cross(d - a).normalized());
-  };
+  // Each face's unit normal once (a face has three corners whose pairs read it).
+  RowMatrixX3d face_normal(F.rows(), 3);
+  detail::parallel_for_blocks(F.rows(), 4096, 0, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t f = begin; f < end; ++f) {
+      const Eigen::Vector3d a = V.row(F(f, 0)).transpose(), b = V.row(F(f, 1)).transpose(),
+                            d = V.row(F(f, 2)).transpose();
+      face_normal.row(f) = (b - a).cross(d - a).normalized().transpose();
+    }
+  });
   const auto at_vertex = [&](int f, int v) {
-    FaceAtVertex out{normal_of(f), {-1 - f, -1 - f}};
+    FaceAtVertex out{face_normal.row(f).transpose(), {-1 - f, -1 - f}};
     int found = 0;
     for (int x = 0; x < 3 && found < 2; ++x) {
       if (F(f, x) != v) out.other[found++] = F(f, x);
