@@ -1,12 +1,13 @@
 // The lane kernels of the closed-form fit, of the per-triangle solve, of the jets and of the
 // area- and Max-weighted vertex normals
-// (src/core/simd_lanes.h):
+// (src/core/simd_lanes.h), and the polynomial fits' builds for each instruction set:
 // the same bits for every instruction set they are compiled for and every thread count, and the
 // same values as the scalar formulas, including the lanes that the vector code handles by select
 // (invalid normals, too few rays, groups cut short at the end of a block or of the mesh).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -14,7 +15,10 @@
 #include <span>
 #include <vector>
 
+#include "core/result_rows.h"
 #include "core/simd_lanes.h"
+#include "curvature/height_fit.h"
+#include "curvature/hermite_fit.h"
 #include "curvature/triangle_fit.h"
 #include "curvature/two_slit_detail.h"
 #include "curvature/vertex_fit.h"
@@ -24,10 +28,12 @@
 #include "focal/curvature/triangle_curvature.h"
 #include "focal/curvature/two_slit_fit.h"
 #include "focal/mesh/neighbourhood.h"
+#include "focal/mesh/prepared.h"
 #include "focal/normals/vertex_normals.h"
 #include "focal/surfaces/surfaces.h"
 #include "kernels/local_shape.h"
 #include "kernels/two_slit.h"
+#include "mesh/prepared_access.h"
 #include "mesh/topology.h"
 #include "normals/jet_normals_from.h"
 #include "normals/vertex_normals_from.h"
@@ -470,6 +476,43 @@ TEST(SimdKernels, AreaAndMaxNormalsInLanesEqualTheScalarLoopVertexByVertex) {
             << " threads " << threads;
       }
     }
+  }
+}
+
+// The Hermite and height fits' blocks, compiled for AVX2 and for baseline x86-64
+// (polynomial::fit_rows_for): the same rows bit for bit, on an irregular torus where some
+// vertices' positions are flagged as moved and some normals as guessed (their free terms).
+TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
+  const Mesh m =
+      test::analytic_surface(SurfaceKind::torus, Triangulation::irregular, 3001, 0, 7).mesh;
+  const PreparedMesh mesh(m.V, m.F, m.N);
+  const auto n = static_cast<std::size_t>(m.V.rows());
+  const std::vector<char> ok(n, 1), keep;
+  std::vector<char> moved(n, 0), guessed(n, 0);
+  for (std::size_t i = 0; i < n; i += 37) moved[i] = 1;
+  for (std::size_t i = 5; i < n; i += 41) guessed[i] = 1;
+  const auto hermite = [&](SimdIsa isa) {
+    CurvatureResult fit = detail::undefined_result(m.V.rows());
+    fit.residual.setConstant(1.0);  // no row exact
+    const std::vector<char> written =
+        detail::prefer_hermite_fit(m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep,
+                                   moved, guessed, 1e-9, {}, fit, isa);
+    EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
+    return fit;
+  };
+  const auto height = [&](SimdIsa isa) {
+    CurvatureResult fit = detail::undefined_result(m.V.rows());
+    fit.residual.setConstant(1.0);
+    const std::vector<char> written = detail::prefer_height_fit(
+        m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep, moved, 1e-9, {}, fit, isa);
+    EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
+    return fit;
+  };
+  const CurvatureResult hermite_reference = hermite(SimdIsa::baseline);
+  const CurvatureResult height_reference = height(SimdIsa::baseline);
+  for (SimdIsa isa : available_isas()) {
+    EXPECT_TRUE(identical(hermite(isa), hermite_reference)) << static_cast<int>(isa);
+    EXPECT_TRUE(identical(height(isa), height_reference)) << static_cast<int>(isa);
   }
 }
 

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/parallel.h"
+#include "core/simd_lanes.h"
 #include "curvature/hermite_fit.h"
 #include "curvature/polynomial_fit_detail.h"
 
@@ -38,21 +39,24 @@ struct HeightSystem {
   double btb = 0.0;
   int rows = 0;
 
-  void add_point(double u, double v, double z) {
+  FOCAL_LANE_INLINE void add_point(double u, double v, double z) {
     const double g = 1.0 / (u * u + v * v), h = g * g, hz = h * z;
     const polynomial::Powers powers(u, v);
     const std::array<double, 9>&pu = powers.u, &pv = powers.v;
-    unroll<kMoments.size()>(
-        [&](auto k) { moments[k] += h * polynomial::monomial_at<Moments>(pu, pv, k); });
-    unroll<N>([&](auto k) { right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k); });
+    unroll<kMoments.size()>([&](auto k) FOCAL_LANE_LAMBDA {
+      moments[k] += h * polynomial::monomial_at<Moments>(pu, pv, k);
+    });
+    unroll<N>([&](auto k) FOCAL_LANE_LAMBDA {
+      right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k);
+    });
     btb += hz * z;
     ++rows;
   }
 
   [[nodiscard]] polynomial::Matrix<N> normal_matrix() const {
     polynomial::Matrix<N> out;
-    unroll<N>([&](auto i) {
-      unroll<i + 1>([&](auto j) {
+    unroll<N>([&](auto i) FOCAL_LANE_LAMBDA {
+      unroll<i + 1>([&](auto j) FOCAL_LANE_LAMBDA {
         constexpr auto ei = kTerms[i];
         constexpr auto ej = kTerms[j];
         constexpr int k = monomial_index(2 * lo, ei[0] + ej[0], ei[1] + ej[1]);
@@ -78,9 +82,10 @@ struct HeightFit {
 /// The fit of `stencil` around v in `frame`, or nothing where the stencil does not fix the
 /// quartic (too few points, or not all of them `ok` and within the turn guard of the frame).
 template <int lo>
-std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
-                                    const std::vector<char>& ok, const std::vector<int>& stencil,
-                                    int v, const TangentFrame& frame) {
+FOCAL_LANE_INLINE std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
+                                                      const std::vector<char>& ok,
+                                                      const std::vector<int>& stencil, int v,
+                                                      const TangentFrame& frame) {
   using System = HeightSystem<lo>;
   if (stencil.size() > kMaxPoints ||
       static_cast<int>(stencil.size()) < static_cast<int>(System::N) + kHeightSpareRows) {
@@ -132,37 +137,67 @@ std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
                    cubic ? polynomial::rms_misfit(sys.btb, *cubic, cubic_right, sys.rows) : NAN};
 }
 
+/// What prefer_height_fit reads (its arguments).
+struct HeightInputs {
+  PositionsRef V;
+  const RowMatrixX3d& N;
+  const std::vector<char>&ok, &keep, &moved;
+  const Neighbourhoods& one_ring;
+  const VertexFaces& incidence;
+  double exact_residual;
+  const ClassTolerances& tol;
+};
+
+/// prefer_height_fit on the vertices [begin, end).
+FOCAL_LANE_INLINE void fit_rows(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+                                CurvatureResult& fit, std::vector<char>& written) {
+  std::vector<int> stencil;
+  for (std::int64_t i = begin; i < end; ++i) {
+    const auto v = static_cast<std::size_t>(i);
+    if (!in.ok[v] || (!in.keep.empty() && in.keep[v]) || fit.residual[i] <= in.exact_residual)
+      continue;
+    const int vi = static_cast<int>(i);
+    if (!polynomial::closed_ring(in.one_ring, in.incidence, vi)) continue;
+    const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
+    polynomial::ring_stencil(in.one_ring, vi, true, in.moved, stencil);
+    const std::optional<HeightFit> f = !in.moved.empty() && in.moved[v]
+                                           ? height_fit<0>(in.V, in.N, in.ok, stencil, vi, frame)
+                                           : height_fit<1>(in.V, in.N, in.ok, stencil, vi, frame);
+    // A spike or a fold left in the stencil (kHeightMaxMisfit), or noise that dominates the
+    // fits' truncation here (kHeightMaxShare): the other steps' row stays.
+    if (!f || !(f->misfit <= kHeightMaxMisfit) ||
+        !(f->misfit <= kHeightMaxShare * f->cubic_misfit)) {
+      continue;
+    }
+    const Eigen::Vector3d& op = f->op;
+    store_vertex(fit, i, frame, principal_from_symmetric(op[0], op[1], op[2]), fit.residual[i],
+                 in.tol);
+    written[v] = 1;
+  }
+}
+
+// fit_rows for AVX2 and for baseline x86-64 (polynomial::fit_rows_for).
+FOCAL_TARGET_AVX2 void fit_rows_avx2(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+                                     CurvatureResult& fit, std::vector<char>& written) {
+  fit_rows(in, begin, end, fit, written);
+}
+void fit_rows_baseline(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+                       CurvatureResult& fit, std::vector<char>& written) {
+  fit_rows(in, begin, end, fit, written);
+}
+
 }  // namespace
 
 std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
                                     const std::vector<char>& ok, const Neighbourhoods& one_ring,
                                     const VertexFaces& incidence, const std::vector<char>& keep,
                                     const std::vector<char>& moved, double exact_residual,
-                                    const ClassTolerances& tol, CurvatureResult& fit) {
+                                    const ClassTolerances& tol, CurvatureResult& fit, SimdIsa isa) {
+  const HeightInputs in{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol};
+  const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);
   std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
   parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<int> stencil;
-    for (std::int64_t i = begin; i < end; ++i) {
-      const auto v = static_cast<std::size_t>(i);
-      if (!ok[v] || (!keep.empty() && keep[v]) || fit.residual[i] <= exact_residual) continue;
-      const int vi = static_cast<int>(i);
-      if (!polynomial::closed_ring(one_ring, incidence, vi)) continue;
-      const TangentFrame frame = tangent_frame(N.row(i).transpose());
-      polynomial::ring_stencil(one_ring, vi, true, moved, stencil);
-      const std::optional<HeightFit> f = !moved.empty() && moved[v]
-                                             ? height_fit<0>(V, N, ok, stencil, vi, frame)
-                                             : height_fit<1>(V, N, ok, stencil, vi, frame);
-      // A spike or a fold left in the stencil (kHeightMaxMisfit), or noise that dominates the
-      // fits' truncation here (kHeightMaxShare): the other steps' row stays.
-      if (!f || !(f->misfit <= kHeightMaxMisfit) ||
-          !(f->misfit <= kHeightMaxShare * f->cubic_misfit)) {
-        continue;
-      }
-      const Eigen::Vector3d& op = f->op;
-      store_vertex(fit, i, frame, principal_from_symmetric(op[0], op[1], op[2]), fit.residual[i],
-                   tol);
-      written[v] = 1;
-    }
+    rows(in, begin, end, fit, written);
   });
   return written;
 }

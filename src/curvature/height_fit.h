@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "curvature/vertex_rows.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
@@ -59,7 +60,8 @@ std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
                                     const std::vector<char>& ok, const Neighbourhoods& one_ring,
                                     const VertexFaces& incidence, const std::vector<char>& keep,
                                     const std::vector<char>& moved, double exact_residual,
-                                    const ClassTolerances& tol, CurvatureResult& fit);
+                                    const ClassTolerances& tol, CurvatureResult& fit,
+                                    SimdIsa isa = SimdIsa::best);
 
 /// The share at v of its quartic fit's misfit in the cubic's (both of its 2-ring's heights in
 /// the frame of the unit normal `n`, the turn guard on the `ok` rows of N): the sample's values

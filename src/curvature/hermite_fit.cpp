@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/parallel.h"
+#include "core/simd_lanes.h"
 #include "curvature/polynomial_fit_detail.h"
 
 namespace focal::detail {
@@ -97,20 +98,23 @@ struct System {
   int rows = 0;
 
   /// A point at scaled offset (u, v), height z, slopes (zu, zv).
-  void add_point(double u, double v, double z, double zu, double zv, bool slopes_known) {
+  FOCAL_LANE_INLINE void add_point(double u, double v, double z, double zu, double zv,
+                                   bool slopes_known) {
     const double g = 1.0 / (u * u + v * v), h = g * g;
     // A point whose normal is not known to full order gives its height row only.
     const double gs = slopes_known ? g : 0.0;
     const polynomial::Powers powers(u, v);
     const std::array<double, 9>&pu = powers.u, &pv = powers.v;
-    const auto at = [&](auto table, auto k) {
+    const auto at = [&](auto table, auto k) FOCAL_LANE_LAMBDA {
       return polynomial::monomial_at<decltype(table)>(pu, pv, k);
     };
     const double hz = h * z, gu = gs * zu, gv = gs * zv;
-    unroll<kHeightMoments.size()>([&](auto k) { heights[k] += h * at(HeightMoments{}, k); });
-    unroll<kSlopeMoments.size()>([&](auto k) { slopes[k] += gs * at(SlopeMoments{}, k); });
-    unroll<kTerms>([&](auto k) { height_right[k] += hz * at(HeightRight{}, k); });
-    unroll<kSlopeRight.size()>([&](auto k) {
+    unroll<kHeightMoments.size()>(
+        [&](auto k) FOCAL_LANE_LAMBDA { heights[k] += h * at(HeightMoments{}, k); });
+    unroll<kSlopeMoments.size()>(
+        [&](auto k) FOCAL_LANE_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
+    unroll<kTerms>([&](auto k) FOCAL_LANE_LAMBDA { height_right[k] += hz * at(HeightRight{}, k); });
+    unroll<kSlopeRight.size()>([&](auto k) FOCAL_LANE_LAMBDA {
       const double m = at(SlopeRight{}, k);
       u_right[k] += gu * m;
       v_right[k] += gv * m;
@@ -162,7 +166,7 @@ struct System {
   /// A^T A from the moments.
   [[nodiscard]] polynomial::Matrix<kTerms> normal_matrix() const {
     polynomial::Matrix<kTerms> out;
-    unroll<kNormalEntries.size()>([&](auto k) {
+    unroll<kNormalEntries.size()>([&](auto k) FOCAL_LANE_LAMBDA {
       constexpr NormalEntry e = kNormalEntries[k];
       double x = heights[static_cast<std::size_t>(e.height)];
       if constexpr (e.u_slope >= 0) x += e.u_factor * slopes[static_cast<std::size_t>(e.u_slope)];
@@ -186,7 +190,7 @@ struct System {
   /// times zu, its v-slope row (b u^a v^(b-1)) times zv.
   [[nodiscard]] Terms right_side() const {
     Terms out;
-    unroll<kTerms>([&](auto i) {
+    unroll<kTerms>([&](auto i) FOCAL_LANE_LAMBDA {
       constexpr int a = kHeightRight[i][0], b = kHeightRight[i][1];
       double x = height_right[i];
       if constexpr (a > 0) x += a * u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
@@ -209,7 +213,7 @@ struct System {
 
   /// The least-squares solution (Cholesky of A^T A), or nothing where a pivot is below
   /// kHermiteMinPivot times the largest.
-  [[nodiscard]] std::optional<Solution> solve() const {
+  [[nodiscard]] FOCAL_LANE_INLINE std::optional<Solution> solve() const {
     const Terms atb = right_side();
     const std::optional<Terms> c =
         polynomial::cholesky_solve<kTerms>(normal_matrix(), atb, kHermiteMinPivot);
@@ -226,12 +230,10 @@ enum class Refusal { none, underdetermined, unfit };
 
 /// The shape operator [a b; b c] of the fit over `stencil` in the vertex's frame; `refusal`
 /// says why there is none.
-std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX3d& N,
-                                                const std::vector<char>& ok,
-                                                const std::vector<int>& stencil, int v,
-                                                const std::vector<char>& guessed,
-                                                const TangentFrame& frame, bool free_height,
-                                                bool free_gradient, Refusal& refusal, int& spare) {
+FOCAL_LANE_INLINE std::optional<Eigen::Vector3d> hermite_operator(
+    PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
+    const std::vector<int>& stencil, int v, const std::vector<char>& guessed,
+    const TangentFrame& frame, bool free_height, bool free_gradient, Refusal& refusal, int& spare) {
   refusal = Refusal::underdetermined;
   if (stencil.size() < 5 || stencil.size() > kMaxPoints) return std::nullopt;
   refusal = Refusal::unfit;
@@ -285,6 +287,72 @@ std::optional<Eigen::Vector3d> hermite_operator(PositionsRef V, const RowMatrixX
                        : Eigen::Vector3d(-hessian(0, 0), -hessian(0, 1), -hessian(1, 1));
 }
 
+/// What prefer_hermite_fit reads (its arguments).
+struct HermiteInputs {
+  PositionsRef V;
+  const RowMatrixX3d& N;
+  const std::vector<char>&ok, &keep, &moved, &guessed;
+  const Neighbourhoods& one_ring;
+  const VertexFaces& incidence;
+  double exact_residual;
+  const ClassTolerances& tol;
+};
+
+/// prefer_hermite_fit on the vertices [begin, end).
+FOCAL_LANE_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
+                                CurvatureResult& fit, std::vector<char>& written) {
+  std::vector<int> stencil;
+  for (std::int64_t i = begin; i < end; ++i) {
+    const auto v = static_cast<std::size_t>(i);
+    const int vi = static_cast<int>(i);
+    if (!in.ok[v] || (!in.keep.empty() && in.keep[v]) || fit.residual[i] <= in.exact_residual)
+      continue;
+    if (!polynomial::closed_ring(in.one_ring, in.incidence, vi)) continue;
+    const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
+    Refusal refusal = Refusal::none;
+    std::optional<Eigen::Vector3d> op;
+    // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
+    const bool free_gradient = !in.guessed.empty() && in.guessed[v];
+    const bool free_height = !in.moved.empty() && in.moved[v];
+    const auto operator_over = [&](bool wide, int& spare) FOCAL_LANE_LAMBDA {
+      polynomial::ring_stencil(in.one_ring, vi, wide, in.moved, stencil);
+      return hermite_operator(in.V, in.N, in.ok, stencil, vi, in.guessed, frame, free_height,
+                              free_gradient, refusal, spare);
+    };
+    bool on_one_ring = true;
+    int spare = 0;
+    for (const bool wide : {false, true}) {
+      on_one_ring = !wide;
+      op = operator_over(wide, spare);
+      if (refusal != Refusal::underdetermined) break;
+    }
+    // A 1-ring fit with few rows to spare (a free gradient, guessed neighbours' single rows)
+    // cannot show a spike or a wild normal in its misfit: it stands only where the 2-ring's
+    // agrees.
+    if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
+      const Eigen::Vector3d ring_operator = *op;
+      op = operator_over(true, spare);
+      if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
+        op = ring_operator;
+      }
+    }
+    if (!op) continue;
+    store_vertex(fit, i, frame, principal_from_symmetric((*op)[0], (*op)[1], (*op)[2]),
+                 fit.residual[i], in.tol);
+    written[v] = 1;
+  }
+}
+
+// fit_rows for AVX2 and for baseline x86-64 (polynomial::fit_rows_for).
+FOCAL_TARGET_AVX2 void fit_rows_avx2(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
+                                     CurvatureResult& fit, std::vector<char>& written) {
+  fit_rows(in, begin, end, fit, written);
+}
+void fit_rows_baseline(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
+                       CurvatureResult& fit, std::vector<char>& written) {
+  fit_rows(in, begin, end, fit, written);
+}
+
 }  // namespace
 
 std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
@@ -292,47 +360,13 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const VertexFaces& incidence, const std::vector<char>& keep,
                                      const std::vector<char>& moved,
                                      const std::vector<char>& guessed, double exact_residual,
-                                     const ClassTolerances& tol, CurvatureResult& fit) {
+                                     const ClassTolerances& tol, CurvatureResult& fit,
+                                     SimdIsa isa) {
+  const HermiteInputs in{V, N, ok, keep, moved, guessed, one_ring, incidence, exact_residual, tol};
+  const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);
   std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
   parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {
-    std::vector<int> stencil;
-    for (std::int64_t i = begin; i < end; ++i) {
-      const auto v = static_cast<std::size_t>(i);
-      const int vi = static_cast<int>(i);
-      if (!ok[v] || (!keep.empty() && keep[v]) || fit.residual[i] <= exact_residual) continue;
-      if (!polynomial::closed_ring(one_ring, incidence, vi)) continue;
-      const TangentFrame frame = tangent_frame(N.row(i).transpose());
-      Refusal refusal = Refusal::none;
-      std::optional<Eigen::Vector3d> op;
-      // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
-      const bool free_gradient = !guessed.empty() && guessed[v];
-      const bool free_height = !moved.empty() && moved[v];
-      bool on_one_ring = true;
-      int spare = 0;
-      for (const bool wide : {false, true}) {
-        on_one_ring = !wide;
-        polynomial::ring_stencil(one_ring, vi, wide, moved, stencil);
-        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
-                              refusal, spare);
-        if (refusal != Refusal::underdetermined) break;
-      }
-      // A 1-ring fit with few rows to spare (a free gradient, guessed neighbours' single rows)
-      // cannot show a spike or a wild normal in its misfit: it stands only where the 2-ring's
-      // agrees.
-      if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
-        const Eigen::Vector3d ring_operator = *op;
-        polynomial::ring_stencil(one_ring, vi, true, moved, stencil);
-        op = hermite_operator(V, N, ok, stencil, vi, guessed, frame, free_height, free_gradient,
-                              refusal, spare);
-        if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
-          op = ring_operator;
-        }
-      }
-      if (!op) continue;
-      store_vertex(fit, i, frame, principal_from_symmetric((*op)[0], (*op)[1], (*op)[2]),
-                   fit.residual[i], tol);
-      written[v] = 1;
-    }
+    rows(in, begin, end, fit, written);
   });
   return written;
 }

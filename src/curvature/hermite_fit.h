@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "curvature/vertex_rows.h"
 #include "focal/core/mesh.h"
 #include "focal/curvature/curvature.h"
@@ -70,6 +71,7 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const VertexFaces& incidence, const std::vector<char>& keep,
                                      const std::vector<char>& moved,
                                      const std::vector<char>& guessed, double exact_residual,
-                                     const ClassTolerances& tol, CurvatureResult& fit);
+                                     const ClassTolerances& tol, CurvatureResult& fit,
+                                     SimdIsa isa = SimdIsa::best);
 
 }  // namespace focal::detail

@@ -1,28 +1,33 @@
 #pragma once
 // Internal to curvature/: what the polynomial height fits (hermite_fit.cpp, height_fit.cpp)
 // share: their monomial tables, loops unrolled over the fits' fixed sizes, the Cholesky solve
-// of their normal equations, the shape operator of a fitted graph and the rings they fit.
+// of their normal equations, the shape operator of a fitted graph, the rings they fit and the
+// choice of their blocks' builds.
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "core/simd_lanes.h"
 #include "focal/mesh/neighbourhood.h"
 #include "mesh/topology.h"
 
 namespace focal::detail::polynomial {
 
 /// f(integral_constant<0>), ..., f(integral_constant<N - 1>): loops over the fit's fixed sizes
-/// unrolled, with every index a constant.
+/// unrolled, with every index a constant. Always inlined, as the lambdas passed to it are
+/// (FOCAL_LANE_LAMBDA): the fits' blocks are compiled for two instruction sets
+/// (fit_rows_for), and a call left out of line would run its baseline build.
 template <std::size_t N, class F>
-void unroll(F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
+FOCAL_LANE_INLINE void unroll(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) FOCAL_LANE_LAMBDA {
     (f(std::integral_constant<std::size_t, I>{}), ...);
   }
   (std::make_index_sequence<N>{});
@@ -53,7 +58,8 @@ struct Table {
 
 /// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
 template <class table, class K, std::size_t P>
-double monomial_at(const std::array<double, P>& pu, const std::array<double, P>& pv, K k) {
+FOCAL_LANE_INLINE double monomial_at(const std::array<double, P>& pu,
+                                     const std::array<double, P>& pv, K k) {
   constexpr std::array<int, 2> e = table::value[k];
   return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
 }
@@ -61,7 +67,7 @@ double monomial_at(const std::array<double, P>& pu, const std::array<double, P>&
 /// The powers u^0 .. u^8 and v^0 .. v^8 of a point's scaled offset (the moments' degrees).
 struct Powers {
   std::array<double, 9> u, v;
-  Powers(double x, double y) {
+  FOCAL_LANE_INLINE Powers(double x, double y) {
     u[0] = v[0] = 1.0;
     for (std::size_t k = 1; k < 9; ++k) {
       u[k] = u[k - 1] * x;
@@ -69,6 +75,15 @@ struct Powers {
     }
   }
 };
+
+/// A fit's block of vertices compiled for AVX2 where the CPU runs it and `isa` is not
+/// baseline, else its baseline x86-64 build. The builds differ only in the width of their
+/// registers (the fits' moments take fewer instructions in wider ones): AVX2 without the FMA
+/// extension fuses no product into a sum, so both give the same bits.
+template <class Kernel>
+Kernel fit_rows_for(SimdIsa isa, Kernel avx2, Kernel baseline) {
+  return isa != SimdIsa::baseline && simd_isa_available(SimdIsa::avx2) ? avx2 : baseline;
+}
 
 template <std::size_t N>
 using Vector = std::array<double, N>;
@@ -79,33 +94,34 @@ using Matrix = std::array<Vector<N>, N>;
 /// or nothing where a pivot is not positive or below `min_pivot` times the largest (the
 /// stencil does not fix the polynomial).
 template <std::size_t N>
-std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right, double min_pivot) {
+FOCAL_LANE_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right,
+                                                          double min_pivot) {
   double largest = 0.0, smallest = INFINITY;
   bool positive = true;
-  unroll<N>([&](auto k) {
+  unroll<N>([&](auto k) FOCAL_LANE_LAMBDA {
     double pivot = l[k][k];
-    unroll<k>([&](auto j) { pivot -= l[k][j] * l[k][j]; });
+    unroll<k>([&](auto j) FOCAL_LANE_LAMBDA { pivot -= l[k][j] * l[k][j]; });
     positive = positive && pivot > 0.0;
     largest = std::max(largest, pivot);
     smallest = std::min(smallest, pivot);
     l[k][k] = std::sqrt(pivot);
     const double inverse = 1.0 / l[k][k];
-    unroll<N - k - 1>([&](auto r) {
+    unroll<N - k - 1>([&](auto r) FOCAL_LANE_LAMBDA {
       constexpr std::size_t i = k + 1 + r;
       double v = l[i][k];
-      unroll<k>([&](auto j) { v -= l[i][j] * l[k][j]; });
+      unroll<k>([&](auto j) FOCAL_LANE_LAMBDA { v -= l[i][j] * l[k][j]; });
       l[i][k] = v * inverse;
     });
   });
   if (!positive || !(smallest >= min_pivot * largest)) return std::nullopt;
   Vector<N> c = right;
-  unroll<N>([&](auto i) {  // L y = right
-    unroll<i>([&](auto j) { c[i] -= l[i][j] * c[j]; });
+  unroll<N>([&](auto i) FOCAL_LANE_LAMBDA {  // L y = right
+    unroll<i>([&](auto j) FOCAL_LANE_LAMBDA { c[i] -= l[i][j] * c[j]; });
     c[i] /= l[i][i];
   });
-  unroll<N>([&](auto r) {  // L^T c = y
+  unroll<N>([&](auto r) FOCAL_LANE_LAMBDA {  // L^T c = y
     constexpr std::size_t i = N - 1 - r;
-    unroll<N - 1 - i>([&](auto k) { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
+    unroll<N - 1 - i>([&](auto k) FOCAL_LANE_LAMBDA { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
     c[i] /= l[i][i];
   });
   return c;
@@ -113,7 +129,8 @@ std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right, dou
 
 /// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
 template <std::size_t N>
-double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb, int rows) {
+FOCAL_LANE_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
+                                    int rows) {
   double ctb = 0.0;
   for (std::size_t i = 0; i < N; ++i) ctb += c[i] * atb[i];
   return std::sqrt(std::max(0.0, btb - ctb) / rows);
@@ -137,6 +154,9 @@ inline bool closed_ring(const Neighbourhoods& one_ring, const VertexFaces& incid
   return incidence.size(v) == static_cast<int>(one_ring.end(v) - one_ring.begin(v));
 }
 
+/// 1-rings up to this size gather their 2-ring by searching the entries found (ring_stencil).
+constexpr std::size_t kSearchedRing = 16;
+
 /// The 1-ring of v, or with `wide` its 2-ring (without v), less the `moved` vertices (empty or
 /// #V flags), into `out` (the 1-ring in its order, the 2-ring ascending).
 inline void ring_stencil(const Neighbourhoods& one_ring, int v, bool wide,
@@ -144,13 +164,22 @@ inline void ring_stencil(const Neighbourhoods& one_ring, int v, bool wide,
   out.assign(one_ring.begin(v), one_ring.end(v));
   if (wide) {
     const std::size_t first = out.size();
+    // Each vertex once. About 18 of the 36 entries of a typical 1-ring's rings are new: a
+    // linear search over those found is cheaper than sorting all 36; a wide fan's rings are
+    // sorted instead (the search would be quadratic in its size).
+    const bool search = first <= kSearchedRing;
     for (std::size_t k = 0; k < first; ++k) {
       for (const int* j = one_ring.begin(out[k]); j != one_ring.end(out[k]); ++j) {
-        if (*j != v) out.push_back(*j);
+        if (*j != v && (!search || std::find(out.begin(), out.end(), *j) == out.end()))
+          out.push_back(*j);
       }
     }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (search) {
+      sort_small(out.data(), out.data() + out.size(), std::less<>());
+    } else {
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
   }
   if (!moved.empty()) {
     std::erase_if(out, [&](int j) { return moved[static_cast<std::size_t>(j)] != 0; });
