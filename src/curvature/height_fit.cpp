@@ -39,14 +39,14 @@ struct HeightSystem {
   double btb = 0.0;
   int rows = 0;
 
-  FOCAL_LANE_INLINE void add_point(double u, double v, double z) {
+  FOCAL_FIT_INLINE void add_point(double u, double v, double z) {
     const double g = 1.0 / (u * u + v * v), h = g * g, hz = h * z;
     const polynomial::Powers powers(u, v);
     const std::array<double, 9>&pu = powers.u, &pv = powers.v;
-    unroll<kMoments.size()>([&](auto k) FOCAL_LANE_LAMBDA {
+    unroll<kMoments.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       moments[k] += h * polynomial::monomial_at<Moments>(pu, pv, k);
     });
-    unroll<N>([&](auto k) FOCAL_LANE_LAMBDA {
+    unroll<N>([&](auto k) FOCAL_FIT_LAMBDA {
       right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k);
     });
     btb += hz * z;
@@ -55,8 +55,8 @@ struct HeightSystem {
 
   [[nodiscard]] polynomial::Matrix<N> normal_matrix() const {
     polynomial::Matrix<N> out;
-    unroll<N>([&](auto i) FOCAL_LANE_LAMBDA {
-      unroll<i + 1>([&](auto j) FOCAL_LANE_LAMBDA {
+    unroll<N>([&](auto i) FOCAL_FIT_LAMBDA {
+      unroll<i + 1>([&](auto j) FOCAL_FIT_LAMBDA {
         constexpr auto ei = kTerms[i];
         constexpr auto ej = kTerms[j];
         constexpr int k = monomial_index(2 * lo, ei[0] + ej[0], ei[1] + ej[1]);
@@ -82,7 +82,7 @@ struct HeightFit {
 /// The fit of `stencil` around v in `frame`, or nothing where the stencil does not fix the
 /// quartic (too few points, or not all of them `ok` and within the turn guard of the frame).
 template <int lo>
-FOCAL_LANE_INLINE std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
+FOCAL_FIT_INLINE std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
                                                       const std::vector<char>& ok,
                                                       const std::vector<int>& stencil, int v,
                                                       const TangentFrame& frame) {
@@ -149,7 +149,7 @@ struct HeightInputs {
 };
 
 /// prefer_height_fit on the vertices [begin, end).
-FOCAL_LANE_INLINE void fit_rows(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+FOCAL_FIT_INLINE void fit_rows(const HeightInputs& in, std::int64_t begin, std::int64_t end,
                                 CurvatureResult& fit, std::vector<char>& written) {
   std::vector<int> stencil;
   for (std::int64_t i = begin; i < end; ++i) {

@@ -98,23 +98,23 @@ struct System {
   int rows = 0;
 
   /// A point at scaled offset (u, v), height z, slopes (zu, zv).
-  FOCAL_LANE_INLINE void add_point(double u, double v, double z, double zu, double zv,
+  FOCAL_FIT_INLINE void add_point(double u, double v, double z, double zu, double zv,
                                    bool slopes_known) {
     const double g = 1.0 / (u * u + v * v), h = g * g;
     // A point whose normal is not known to full order gives its height row only.
     const double gs = slopes_known ? g : 0.0;
     const polynomial::Powers powers(u, v);
     const std::array<double, 9>&pu = powers.u, &pv = powers.v;
-    const auto at = [&](auto table, auto k) FOCAL_LANE_LAMBDA {
+    const auto at = [&](auto table, auto k) FOCAL_FIT_LAMBDA {
       return polynomial::monomial_at<decltype(table)>(pu, pv, k);
     };
     const double hz = h * z, gu = gs * zu, gv = gs * zv;
     unroll<kHeightMoments.size()>(
-        [&](auto k) FOCAL_LANE_LAMBDA { heights[k] += h * at(HeightMoments{}, k); });
+        [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * at(HeightMoments{}, k); });
     unroll<kSlopeMoments.size()>(
-        [&](auto k) FOCAL_LANE_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
-    unroll<kTerms>([&](auto k) FOCAL_LANE_LAMBDA { height_right[k] += hz * at(HeightRight{}, k); });
-    unroll<kSlopeRight.size()>([&](auto k) FOCAL_LANE_LAMBDA {
+        [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
+    unroll<kTerms>([&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * at(HeightRight{}, k); });
+    unroll<kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       const double m = at(SlopeRight{}, k);
       u_right[k] += gu * m;
       v_right[k] += gv * m;
@@ -166,7 +166,7 @@ struct System {
   /// A^T A from the moments.
   [[nodiscard]] polynomial::Matrix<kTerms> normal_matrix() const {
     polynomial::Matrix<kTerms> out;
-    unroll<kNormalEntries.size()>([&](auto k) FOCAL_LANE_LAMBDA {
+    unroll<kNormalEntries.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       constexpr NormalEntry e = kNormalEntries[k];
       double x = heights[static_cast<std::size_t>(e.height)];
       if constexpr (e.u_slope >= 0) x += e.u_factor * slopes[static_cast<std::size_t>(e.u_slope)];
@@ -190,7 +190,7 @@ struct System {
   /// times zu, its v-slope row (b u^a v^(b-1)) times zv.
   [[nodiscard]] Terms right_side() const {
     Terms out;
-    unroll<kTerms>([&](auto i) FOCAL_LANE_LAMBDA {
+    unroll<kTerms>([&](auto i) FOCAL_FIT_LAMBDA {
       constexpr int a = kHeightRight[i][0], b = kHeightRight[i][1];
       double x = height_right[i];
       if constexpr (a > 0) x += a * u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
@@ -213,7 +213,7 @@ struct System {
 
   /// The least-squares solution (Cholesky of A^T A), or nothing where a pivot is below
   /// kHermiteMinPivot times the largest.
-  [[nodiscard]] FOCAL_LANE_INLINE std::optional<Solution> solve() const {
+  [[nodiscard]] FOCAL_FIT_INLINE std::optional<Solution> solve() const {
     const Terms atb = right_side();
     const std::optional<Terms> c =
         polynomial::cholesky_solve<kTerms>(normal_matrix(), atb, kHermiteMinPivot);
@@ -230,7 +230,7 @@ enum class Refusal { none, underdetermined, unfit };
 
 /// The shape operator [a b; b c] of the fit over `stencil` in the vertex's frame; `refusal`
 /// says why there is none.
-FOCAL_LANE_INLINE std::optional<Eigen::Vector3d> hermite_operator(
+FOCAL_FIT_INLINE std::optional<Eigen::Vector3d> hermite_operator(
     PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
     const std::vector<int>& stencil, int v, const std::vector<char>& guessed,
     const TangentFrame& frame, bool free_height, bool free_gradient, Refusal& refusal, int& spare) {
@@ -299,7 +299,7 @@ struct HermiteInputs {
 };
 
 /// prefer_hermite_fit on the vertices [begin, end).
-FOCAL_LANE_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
+FOCAL_FIT_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
                                 CurvatureResult& fit, std::vector<char>& written) {
   std::vector<int> stencil;
   for (std::int64_t i = begin; i < end; ++i) {
@@ -314,7 +314,7 @@ FOCAL_LANE_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std
     // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
     const bool free_gradient = !in.guessed.empty() && in.guessed[v];
     const bool free_height = !in.moved.empty() && in.moved[v];
-    const auto operator_over = [&](bool wide, int& spare) FOCAL_LANE_LAMBDA {
+    const auto operator_over = [&](bool wide, int& spare) FOCAL_FIT_LAMBDA {
       polynomial::ring_stencil(in.one_ring, vi, wide, in.moved, stencil);
       return hermite_operator(in.V, in.N, in.ok, stencil, vi, in.guessed, frame, free_height,
                               free_gradient, refusal, spare);

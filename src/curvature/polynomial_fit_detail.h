@@ -19,15 +19,33 @@
 #include "focal/mesh/neighbourhood.h"
 #include "mesh/topology.h"
 
+// The fits' loops and lambdas are always inlined where the library is built for speed, so that
+// a block's AVX2 build (fit_rows_for) holds the whole fit in wide registers. The fits pass no
+// vectors by value, so a call left out of line is as correct, only slower: the sanitizer builds
+// leave inlining to the compiler, whose instrumentation of the fully inlined and unrolled
+// blocks would otherwise take GCC over half an hour a file.
+#if defined(__SANITIZE_ADDRESS__)
+#define FOCAL_FIT_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define FOCAL_FIT_SANITIZED 1
+#endif
+#endif
+#ifdef FOCAL_FIT_SANITIZED
+#define FOCAL_FIT_INLINE inline
+#define FOCAL_FIT_LAMBDA
+#else
+#define FOCAL_FIT_INLINE FOCAL_LANE_INLINE
+#define FOCAL_FIT_LAMBDA FOCAL_LANE_LAMBDA
+#endif
+
 namespace focal::detail::polynomial {
 
 /// f(integral_constant<0>), ..., f(integral_constant<N - 1>): loops over the fit's fixed sizes
-/// unrolled, with every index a constant. Always inlined, as the lambdas passed to it are
-/// (FOCAL_LANE_LAMBDA): the fits' blocks are compiled for two instruction sets
-/// (fit_rows_for), and a call left out of line would run its baseline build.
+/// unrolled, with every index a constant (inlined as FOCAL_FIT_INLINE says).
 template <std::size_t N, class F>
-FOCAL_LANE_INLINE void unroll(F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) FOCAL_LANE_LAMBDA {
+FOCAL_FIT_INLINE void unroll(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) FOCAL_FIT_LAMBDA {
     (f(std::integral_constant<std::size_t, I>{}), ...);
   }
   (std::make_index_sequence<N>{});
@@ -58,7 +76,7 @@ struct Table {
 
 /// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
 template <class table, class K, std::size_t P>
-FOCAL_LANE_INLINE double monomial_at(const std::array<double, P>& pu,
+FOCAL_FIT_INLINE double monomial_at(const std::array<double, P>& pu,
                                      const std::array<double, P>& pv, K k) {
   constexpr std::array<int, 2> e = table::value[k];
   return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
@@ -67,7 +85,7 @@ FOCAL_LANE_INLINE double monomial_at(const std::array<double, P>& pu,
 /// The powers u^0 .. u^8 and v^0 .. v^8 of a point's scaled offset (the moments' degrees).
 struct Powers {
   std::array<double, 9> u, v;
-  FOCAL_LANE_INLINE Powers(double x, double y) {
+  FOCAL_FIT_INLINE Powers(double x, double y) {
     u[0] = v[0] = 1.0;
     for (std::size_t k = 1; k < 9; ++k) {
       u[k] = u[k - 1] * x;
@@ -94,34 +112,34 @@ using Matrix = std::array<Vector<N>, N>;
 /// or nothing where a pivot is not positive or below `min_pivot` times the largest (the
 /// stencil does not fix the polynomial).
 template <std::size_t N>
-FOCAL_LANE_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right,
+FOCAL_FIT_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right,
                                                           double min_pivot) {
   double largest = 0.0, smallest = INFINITY;
   bool positive = true;
-  unroll<N>([&](auto k) FOCAL_LANE_LAMBDA {
+  unroll<N>([&](auto k) FOCAL_FIT_LAMBDA {
     double pivot = l[k][k];
-    unroll<k>([&](auto j) FOCAL_LANE_LAMBDA { pivot -= l[k][j] * l[k][j]; });
+    unroll<k>([&](auto j) FOCAL_FIT_LAMBDA { pivot -= l[k][j] * l[k][j]; });
     positive = positive && pivot > 0.0;
     largest = std::max(largest, pivot);
     smallest = std::min(smallest, pivot);
     l[k][k] = std::sqrt(pivot);
     const double inverse = 1.0 / l[k][k];
-    unroll<N - k - 1>([&](auto r) FOCAL_LANE_LAMBDA {
+    unroll<N - k - 1>([&](auto r) FOCAL_FIT_LAMBDA {
       constexpr std::size_t i = k + 1 + r;
       double v = l[i][k];
-      unroll<k>([&](auto j) FOCAL_LANE_LAMBDA { v -= l[i][j] * l[k][j]; });
+      unroll<k>([&](auto j) FOCAL_FIT_LAMBDA { v -= l[i][j] * l[k][j]; });
       l[i][k] = v * inverse;
     });
   });
   if (!positive || !(smallest >= min_pivot * largest)) return std::nullopt;
   Vector<N> c = right;
-  unroll<N>([&](auto i) FOCAL_LANE_LAMBDA {  // L y = right
-    unroll<i>([&](auto j) FOCAL_LANE_LAMBDA { c[i] -= l[i][j] * c[j]; });
+  unroll<N>([&](auto i) FOCAL_FIT_LAMBDA {  // L y = right
+    unroll<i>([&](auto j) FOCAL_FIT_LAMBDA { c[i] -= l[i][j] * c[j]; });
     c[i] /= l[i][i];
   });
-  unroll<N>([&](auto r) FOCAL_LANE_LAMBDA {  // L^T c = y
+  unroll<N>([&](auto r) FOCAL_FIT_LAMBDA {  // L^T c = y
     constexpr std::size_t i = N - 1 - r;
-    unroll<N - 1 - i>([&](auto k) FOCAL_LANE_LAMBDA { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
+    unroll<N - 1 - i>([&](auto k) FOCAL_FIT_LAMBDA { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
     c[i] /= l[i][i];
   });
   return c;
@@ -129,7 +147,7 @@ FOCAL_LANE_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vec
 
 /// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
 template <std::size_t N>
-FOCAL_LANE_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
+FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
                                     int rows) {
   double ctb = 0.0;
   for (std::size_t i = 0; i < N; ++i) ctb += c[i] * atb[i];
