@@ -46,9 +46,8 @@ struct HeightSystem {
     unroll<kMoments.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       moments[k] += h * polynomial::monomial_at<Moments>(pu, pv, k);
     });
-    unroll<N>([&](auto k) FOCAL_FIT_LAMBDA {
-      right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k);
-    });
+    unroll<N>([&](auto k)
+                  FOCAL_FIT_LAMBDA { right[k] += hz * polynomial::monomial_at<Terms>(pu, pv, k); });
     btb += hz * z;
     ++rows;
   }
@@ -83,9 +82,9 @@ struct HeightFit {
 /// quartic (too few points, or not all of them `ok` and within the turn guard of the frame).
 template <int lo>
 FOCAL_FIT_INLINE std::optional<HeightFit> height_fit(PositionsRef V, const RowMatrixX3d& N,
-                                                      const std::vector<char>& ok,
-                                                      const std::vector<int>& stencil, int v,
-                                                      const TangentFrame& frame) {
+                                                     const std::vector<char>& ok,
+                                                     const std::vector<int>& stencil, int v,
+                                                     const TangentFrame& frame) {
   using System = HeightSystem<lo>;
   if (stencil.size() > kMaxPoints ||
       static_cast<int>(stencil.size()) < static_cast<int>(System::N) + kHeightSpareRows) {
@@ -137,27 +136,16 @@ FOCAL_FIT_INLINE std::optional<HeightFit> height_fit(PositionsRef V, const RowMa
                    cubic ? polynomial::rms_misfit(sys.btb, *cubic, cubic_right, sys.rows) : NAN};
 }
 
-/// What prefer_height_fit reads (its arguments).
-struct HeightInputs {
-  PositionsRef V;
-  const RowMatrixX3d& N;
-  const std::vector<char>&ok, &keep, &moved;
-  const Neighbourhoods& one_ring;
-  const VertexFaces& incidence;
-  double exact_residual;
-  const ClassTolerances& tol;
-};
+using polynomial::FitInputs;
 
 /// prefer_height_fit on the vertices [begin, end).
-FOCAL_FIT_INLINE void fit_rows(const HeightInputs& in, std::int64_t begin, std::int64_t end,
-                                CurvatureResult& fit, std::vector<char>& written) {
+FOCAL_FIT_INLINE void fit_rows(const FitInputs& in, std::int64_t begin, std::int64_t end,
+                               CurvatureResult& fit, std::vector<char>& written) {
   std::vector<int> stencil;
   for (std::int64_t i = begin; i < end; ++i) {
     const auto v = static_cast<std::size_t>(i);
-    if (!in.ok[v] || (!in.keep.empty() && in.keep[v]) || fit.residual[i] <= in.exact_residual)
-      continue;
+    if (!polynomial::takes_vertex(in, fit, i)) continue;
     const int vi = static_cast<int>(i);
-    if (!polynomial::closed_ring(in.one_ring, in.incidence, vi)) continue;
     const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
     polynomial::ring_stencil(in.one_ring, vi, true, in.moved, stencil);
     const std::optional<HeightFit> f = !in.moved.empty() && in.moved[v]
@@ -177,11 +165,11 @@ FOCAL_FIT_INLINE void fit_rows(const HeightInputs& in, std::int64_t begin, std::
 }
 
 // fit_rows for AVX2 and for baseline x86-64 (polynomial::fit_rows_for).
-FOCAL_TARGET_AVX2 void fit_rows_avx2(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+FOCAL_TARGET_AVX2 void fit_rows_avx2(const FitInputs& in, std::int64_t begin, std::int64_t end,
                                      CurvatureResult& fit, std::vector<char>& written) {
   fit_rows(in, begin, end, fit, written);
 }
-void fit_rows_baseline(const HeightInputs& in, std::int64_t begin, std::int64_t end,
+void fit_rows_baseline(const FitInputs& in, std::int64_t begin, std::int64_t end,
                        CurvatureResult& fit, std::vector<char>& written) {
   fit_rows(in, begin, end, fit, written);
 }
@@ -193,7 +181,7 @@ std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
                                     const VertexFaces& incidence, const std::vector<char>& keep,
                                     const std::vector<char>& moved, double exact_residual,
                                     const ClassTolerances& tol, CurvatureResult& fit, SimdIsa isa) {
-  const HeightInputs in{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol};
+  const FitInputs in{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol};
   const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);
   std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
   parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {

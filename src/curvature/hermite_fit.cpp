@@ -99,7 +99,7 @@ struct System {
 
   /// A point at scaled offset (u, v), height z, slopes (zu, zv).
   FOCAL_FIT_INLINE void add_point(double u, double v, double z, double zu, double zv,
-                                   bool slopes_known) {
+                                  bool slopes_known) {
     const double g = 1.0 / (u * u + v * v), h = g * g;
     // A point whose normal is not known to full order gives its height row only.
     const double gs = slopes_known ? g : 0.0;
@@ -111,8 +111,8 @@ struct System {
     const double hz = h * z, gu = gs * zu, gv = gs * zv;
     unroll<kHeightMoments.size()>(
         [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * at(HeightMoments{}, k); });
-    unroll<kSlopeMoments.size()>(
-        [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
+    unroll<kSlopeMoments.size()>([&](auto k)
+                                     FOCAL_FIT_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
     unroll<kTerms>([&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * at(HeightRight{}, k); });
     unroll<kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       const double m = at(SlopeRight{}, k);
@@ -288,26 +288,18 @@ FOCAL_FIT_INLINE std::optional<Eigen::Vector3d> hermite_operator(
 }
 
 /// What prefer_hermite_fit reads (its arguments).
-struct HermiteInputs {
-  PositionsRef V;
-  const RowMatrixX3d& N;
-  const std::vector<char>&ok, &keep, &moved, &guessed;
-  const Neighbourhoods& one_ring;
-  const VertexFaces& incidence;
-  double exact_residual;
-  const ClassTolerances& tol;
+struct HermiteInputs : polynomial::FitInputs {
+  const std::vector<char>& guessed;
 };
 
 /// prefer_hermite_fit on the vertices [begin, end).
 FOCAL_FIT_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
-                                CurvatureResult& fit, std::vector<char>& written) {
+                               CurvatureResult& fit, std::vector<char>& written) {
   std::vector<int> stencil;
   for (std::int64_t i = begin; i < end; ++i) {
     const auto v = static_cast<std::size_t>(i);
     const int vi = static_cast<int>(i);
-    if (!in.ok[v] || (!in.keep.empty() && in.keep[v]) || fit.residual[i] <= in.exact_residual)
-      continue;
-    if (!polynomial::closed_ring(in.one_ring, in.incidence, vi)) continue;
+    if (!polynomial::takes_vertex(in, fit, i)) continue;
     const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
     Refusal refusal = Refusal::none;
     std::optional<Eigen::Vector3d> op;
@@ -362,7 +354,8 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const std::vector<char>& guessed, double exact_residual,
                                      const ClassTolerances& tol, CurvatureResult& fit,
                                      SimdIsa isa) {
-  const HermiteInputs in{V, N, ok, keep, moved, guessed, one_ring, incidence, exact_residual, tol};
+  const HermiteInputs in{{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol},
+                         guessed};
   const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);
   std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
   parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {

@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "core/simd_lanes.h"
+#include "curvature/vertex_rows.h"
+#include "focal/core/mesh.h"
 #include "focal/mesh/neighbourhood.h"
 #include "mesh/topology.h"
 
@@ -77,7 +79,7 @@ struct Table {
 /// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
 template <class table, class K, std::size_t P>
 FOCAL_FIT_INLINE double monomial_at(const std::array<double, P>& pu,
-                                     const std::array<double, P>& pv, K k) {
+                                    const std::array<double, P>& pv, K k) {
   constexpr std::array<int, 2> e = table::value[k];
   return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
 }
@@ -113,7 +115,7 @@ using Matrix = std::array<Vector<N>, N>;
 /// stencil does not fix the polynomial).
 template <std::size_t N>
 FOCAL_FIT_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right,
-                                                          double min_pivot) {
+                                                         double min_pivot) {
   double largest = 0.0, smallest = INFINITY;
   bool positive = true;
   unroll<N>([&](auto k) FOCAL_FIT_LAMBDA {
@@ -147,8 +149,7 @@ FOCAL_FIT_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vect
 
 /// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
 template <std::size_t N>
-FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
-                                    int rows) {
+FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb, int rows) {
   double ctb = 0.0;
   for (std::size_t i = 0; i < N; ++i) ctb += c[i] * atb[i];
   return std::sqrt(std::max(0.0, btb - ctb) / rows);
@@ -170,6 +171,26 @@ inline Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eige
 /// Whether v's 1-ring is closed: as many faces as neighbours in `incidence`.
 inline bool closed_ring(const Neighbourhoods& one_ring, const VertexFaces& incidence, int v) {
   return incidence.size(v) == static_cast<int>(one_ring.end(v) - one_ring.begin(v));
+}
+
+/// What both fits read (prefer_hermite_fit's and prefer_height_fit's arguments).
+struct FitInputs {
+  PositionsRef V;
+  const RowMatrixX3d& N;
+  const std::vector<char>&ok, &keep, &moved;
+  const Neighbourhoods& one_ring;
+  const VertexFaces& incidence;
+  double exact_residual;
+  const ClassTolerances& tol;
+};
+
+/// Whether a fit takes vertex i at all: its normal is `ok`, it is not to be kept (`keep`, empty
+/// or #V flags), its row's residual is not at most `exact_residual` (the two-slit fit is exact
+/// there already; a NaN residual is fitted) and its 1-ring is closed.
+inline bool takes_vertex(const FitInputs& in, const CurvatureResult& fit, std::int64_t i) {
+  const auto v = static_cast<std::size_t>(i);
+  return in.ok[v] && (in.keep.empty() || !in.keep[v]) && !(fit.residual[i] <= in.exact_residual) &&
+         closed_ring(in.one_ring, in.incidence, static_cast<int>(i));
 }
 
 /// 1-rings up to this size gather their 2-ring by searching the entries found (ring_stencil).
