@@ -480,7 +480,8 @@ TEST(SimdKernels, AreaAndMaxNormalsInLanesEqualTheScalarLoopVertexByVertex) {
 }
 
 // The Hermite and height fits' blocks, compiled for AVX2 and for baseline x86-64
-// (polynomial::fit_rows_for): the same rows bit for bit, on an irregular torus where some
+// (polynomial::fit_rows_for), and the Hermite fit's lanes (a vertex a lane) against each vertex
+// fitted alone: the same rows bit for bit, on an irregular torus where some
 // vertices' positions are flagged as moved and some normals as guessed (their free terms).
 TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
   const Mesh m =
@@ -491,12 +492,12 @@ TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
   std::vector<char> moved(n, 0), guessed(n, 0);
   for (std::size_t i = 0; i < n; i += 37) moved[i] = 1;
   for (std::size_t i = 5; i < n; i += 41) guessed[i] = 1;
-  const auto hermite = [&](SimdIsa isa) {
+  const auto hermite = [&](SimdIsa isa, bool in_lanes) {
     CurvatureResult fit = detail::undefined_result(m.V.rows());
     fit.residual.setConstant(1.0);  // no row exact
     const std::vector<char> written =
         detail::prefer_hermite_fit(m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep,
-                                   moved, guessed, 1e-9, {}, fit, isa);
+                                   moved, guessed, 1e-9, {}, fit, isa, in_lanes);
     EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
     return fit;
   };
@@ -508,10 +509,13 @@ TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
     EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
     return fit;
   };
-  const CurvatureResult hermite_reference = hermite(SimdIsa::baseline);
+  // The reference fits each vertex alone; the lanes take most vertices (all but the moved, the
+  // guessed and those whose rows are few), four or two at once.
+  const CurvatureResult hermite_reference = hermite(SimdIsa::baseline, false);
   const CurvatureResult height_reference = height(SimdIsa::baseline);
   for (SimdIsa isa : available_isas()) {
-    EXPECT_TRUE(identical(hermite(isa), hermite_reference)) << static_cast<int>(isa);
+    EXPECT_TRUE(identical(hermite(isa, false), hermite_reference)) << static_cast<int>(isa);
+    EXPECT_TRUE(identical(hermite(isa, true), hermite_reference)) << static_cast<int>(isa);
     EXPECT_TRUE(identical(height(isa), height_reference)) << static_cast<int>(isa);
   }
 }

@@ -18,7 +18,7 @@ namespace {
 
 using polynomial::monomial_index;
 using polynomial::monomials;
-using polynomial::Table;
+using polynomial::each;
 using polynomial::unroll;
 
 /// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4
@@ -40,10 +40,21 @@ constexpr auto kHeightRight = monomials<2, 4>();
 constexpr auto kSlopeRight = monomials<1, 3>();
 static_assert(kHeightRight.size() == kTerms);
 
-using HeightMoments = Table<kHeightMoments>;
-using SlopeMoments = Table<kSlopeMoments>;
-using HeightRight = Table<kHeightRight>;
-using SlopeRight = Table<kSlopeRight>;
+/// Every monomial of degree 0 to 8 in the same order (by degree, u's exponent descending): each
+/// table above is a run of it, from its first entry on.
+constexpr auto kAllMonomials = monomials<0, 8>();
+template <const auto& table>
+constexpr std::size_t run_start() {
+  const std::size_t start = monomial_index(0, table[0][0], table[0][1]);
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    if (table[k] != kAllMonomials[start + k]) throw "not a run of kAllMonomials";
+  }
+  return start;
+}
+constexpr std::size_t kHeightMomentsAt = run_start<kHeightMoments>();
+constexpr std::size_t kSlopeMomentsAt = run_start<kSlopeMoments>();
+constexpr std::size_t kHeightRightAt = run_start<kHeightRight>();
+constexpr std::size_t kSlopeRightAt = run_start<kSlopeRight>();
 
 /// Entry (i, j) of A^T A: heights[kH] + ai aj slopes[kU] + bi bj slopes[kV] (an index of -1:
 /// no such term).
@@ -76,57 +87,107 @@ constexpr auto kNormalEntries = normal_entries();
 /// d = |(u, v)| gives a height row m_i / d^2 (m_i = u^a_i v^b_i) and two slope rows
 /// (dm_i/du) / d, (dm_i/dv) / d, so every entry of A^T A is a moment of degree 4 to 8 weighted
 /// by 1 / d^4 plus moments of degree 2 to 6 weighted by 1 / d^2, and A^T b is made of 30 more:
-/// 90 sums a point instead of three rank-one updates of a 12 x 12 matrix.
-///
-/// Free terms: the height at the vertex (`free_height`: its position is known to third order
-/// only, as a repaired spike's) and the gradient there (`free_gradient`: its normal is, as one
-/// estimated from the positions) become unknowns too, eliminated from the normal equations
-/// (their Schur complement). Their columns are 1 / d^2, u / d^2, v / d^2 in the height row and
-/// 1 / d in the slope rows of the gradient's own component; their blocks are summed from the
-/// rows themselves (few vertices need them).
-struct System {
+/// 90 sums a point instead of three rank-one updates of a 12 x 12 matrix. T: one vertex
+/// (double) or a vertex a lane (polynomial_fit_detail.h).
+template <class T>
+struct Moments {
+  std::array<T, kHeightMoments.size()> heights{};
+  std::array<T, kSlopeMoments.size()> slopes{};
+  std::array<T, kHeightRight.size()> height_right{};
+  std::array<T, kSlopeRight.size()> u_right{}, v_right{};
+  T btb{};
+
+  /// A point at scaled offset (u, v), height z, slopes (zu, zv); none where not `active` (the
+  /// sums take exact zeros: a lane whose ring is shorter than its batch's longest).
+  FOCAL_FIT_INLINE void add_point(const T& u, const T& v, const T& z, const T& zu, const T& zv,
+                                  const MaskOf<T>& slopes_known, const MaskOf<T>& active) {
+    const T zero = polynomial::constant<T>(0.0);
+    const T g = polynomial::pick<T>(active, 1.0 / (u * u + v * v), zero), h = g * g;
+    // A point whose normal is not known to full order gives its height row only.
+    const T gs = polynomial::pick<T>(slopes_known, g, zero);
+    const polynomial::Powers<T> powers(u, v);
+    std::array<T, kAllMonomials.size()> m;  // u^a v^b in kAllMonomials' order
+    for (std::size_t n = 0, k = 0; n <= 8; ++n) {
+      for (std::size_t b = 0; b <= n; ++b) m[k++] = powers.u[n - b] * powers.v[b];
+    }
+    const T hz = h * z, gu = gs * zu, gv = gs * zv;
+    each<T, kHeightMoments.size()>(
+        [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * m[kHeightMomentsAt + k]; });
+    each<T, kSlopeMoments.size()>(
+        [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * m[kSlopeMomentsAt + k]; });
+    each<T, kTerms>(
+        [&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * m[kHeightRightAt + k]; });
+    each<T, kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
+      u_right[k] += gu * m[kSlopeRightAt + k];
+      v_right[k] += gv * m[kSlopeRightAt + k];
+    });
+    btb += hz * z + gs * (zu * zu + zv * zv);
+  }
+
+  /// A^T A from the moments.
+  [[nodiscard]] FOCAL_FIT_INLINE polynomial::Matrix<kTerms, T> normal_matrix() const {
+    polynomial::Matrix<kTerms, T> out;
+    each<T, kNormalEntries.size()>([&](auto k) FOCAL_FIT_LAMBDA {
+      const NormalEntry& e = kNormalEntries[k];
+      T x = heights[static_cast<std::size_t>(e.height)];
+      if (e.u_slope >= 0) x += e.u_factor * slopes[static_cast<std::size_t>(e.u_slope)];
+      if (e.v_slope >= 0) x += e.v_factor * slopes[static_cast<std::size_t>(e.v_slope)];
+      out[static_cast<std::size_t>(e.i)][static_cast<std::size_t>(e.j)] = x;
+      out[static_cast<std::size_t>(e.j)][static_cast<std::size_t>(e.i)] = x;
+    });
+    return out;
+  }
+
+  /// A^T b from the moments: term u^a v^b's height row times z, its u-slope row (a u^(a-1) v^b)
+  /// times zu, its v-slope row (b u^a v^(b-1)) times zv.
+  [[nodiscard]] FOCAL_FIT_INLINE polynomial::Vector<kTerms, T> right_side() const {
+    polynomial::Vector<kTerms, T> out;
+    each<T, kTerms>([&](auto i) FOCAL_FIT_LAMBDA {
+      const int a = kHeightRight[i][0], b = kHeightRight[i][1];
+      T x = height_right[i];
+      if (a > 0) {
+        x += static_cast<double>(a) *
+             u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
+      }
+      if (b > 0) {
+        x += static_cast<double>(b) *
+             v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
+      }
+      out[i] = x;
+    });
+    return out;
+  }
+};
+
+/// The fit of one vertex: its moments, and the free terms where its height at the vertex
+/// (`free_height`: its position is known to third order only, as a repaired spike's) or its
+/// gradient there (`free_gradient`: its normal is, as one estimated from the positions) are
+/// unknowns too, eliminated from the normal equations (their Schur complement). Their columns
+/// are 1 / d^2, u / d^2, v / d^2 in the height row and 1 / d in the slope rows of the
+/// gradient's own component; their blocks are summed from the rows themselves (few vertices
+/// need them).
+struct System : Moments<double> {
   bool free_height = false, free_gradient = false;
   Eigen::Matrix3d free_free = Eigen::Matrix3d::Zero();  ///< F^T F, terms (1, u, v)
   Eigen::Matrix<double, 3, kTerms> free_terms =
       Eigen::Matrix<double, 3, kTerms>::Zero();          ///< F^T A
   Eigen::Vector3d free_right = Eigen::Vector3d::Zero();  ///< F^T b
-  std::array<double, kHeightMoments.size()> heights{};
-  std::array<double, kSlopeMoments.size()> slopes{};
-  std::array<double, kHeightRight.size()> height_right{};
-  std::array<double, kSlopeRight.size()> u_right{}, v_right{};
-  double btb = 0.0;
   int rows = 0;
 
-  /// A point at scaled offset (u, v), height z, slopes (zu, zv).
   FOCAL_FIT_INLINE void add_point(double u, double v, double z, double zu, double zv,
                                   bool slopes_known) {
-    const double g = 1.0 / (u * u + v * v), h = g * g;
-    // A point whose normal is not known to full order gives its height row only.
-    const double gs = slopes_known ? g : 0.0;
-    const polynomial::Powers powers(u, v);
-    const std::array<double, 9>&pu = powers.u, &pv = powers.v;
-    const auto at = [&](auto table, auto k) FOCAL_FIT_LAMBDA {
-      return polynomial::monomial_at<decltype(table)>(pu, pv, k);
-    };
-    const double hz = h * z, gu = gs * zu, gv = gs * zv;
-    unroll<kHeightMoments.size()>(
-        [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * at(HeightMoments{}, k); });
-    unroll<kSlopeMoments.size()>([&](auto k)
-                                     FOCAL_FIT_LAMBDA { slopes[k] += gs * at(SlopeMoments{}, k); });
-    unroll<kTerms>([&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * at(HeightRight{}, k); });
-    unroll<kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
-      const double m = at(SlopeRight{}, k);
-      u_right[k] += gu * m;
-      v_right[k] += gv * m;
-    });
-    if (free_height || free_gradient) add_free(pu, pv, g, slopes_known, z, zu, zv);
-    btb += hz * z + gs * (zu * zu + zv * zv);
+    Moments<double>::add_point(u, v, z, zu, zv, slopes_known, true);
+    if (free_height || free_gradient) {
+      const double g = 1.0 / (u * u + v * v);
+      add_free(polynomial::Powers<double>(u, v), g, slopes_known, z, zu, zv);
+    }
     rows += slopes_known ? 3 : 1;
   }
 
   /// The free terms' blocks of a point's three rows (g = 1 / d^2).
-  void add_free(const std::array<double, 9>& pu, const std::array<double, 9>& pv, double g,
-                bool slopes_known, double z, double zu, double zv) {
+  void add_free(const polynomial::Powers<double>& powers, double g, bool slopes_known, double z,
+                double zu, double zv) {
+    const std::array<double, 9>&pu = powers.u, &pv = powers.v;
     const double w = slopes_known ? std::sqrt(g) : 0.0, on = free_gradient ? 1.0 : 0.0;
     const Eigen::Vector3d height(free_height ? g : 0.0, on * g * pu[1], on * g * pv[1]);
     const Eigen::Vector3d du(0.0, on * w, 0.0), dv(0.0, 0.0, on * w);
@@ -163,17 +224,9 @@ struct System {
     return e.tail<2>();
   }
 
-  /// A^T A from the moments.
-  [[nodiscard]] polynomial::Matrix<kTerms> normal_matrix() const {
-    polynomial::Matrix<kTerms> out;
-    unroll<kNormalEntries.size()>([&](auto k) FOCAL_FIT_LAMBDA {
-      constexpr NormalEntry e = kNormalEntries[k];
-      double x = heights[static_cast<std::size_t>(e.height)];
-      if constexpr (e.u_slope >= 0) x += e.u_factor * slopes[static_cast<std::size_t>(e.u_slope)];
-      if constexpr (e.v_slope >= 0) x += e.v_factor * slopes[static_cast<std::size_t>(e.v_slope)];
-      out[static_cast<std::size_t>(e.i)][static_cast<std::size_t>(e.j)] = x;
-      out[static_cast<std::size_t>(e.j)][static_cast<std::size_t>(e.i)] = x;
-    });
+  /// A^T A of the other terms (less the free terms' part).
+  [[nodiscard]] FOCAL_FIT_INLINE polynomial::Matrix<kTerms> reduced_normal_matrix() const {
+    polynomial::Matrix<kTerms> out = normal_matrix();
     if (any_free()) {
       const Eigen::Matrix<double, kTerms, kTerms> schur =
           free_terms.transpose() * free_inverse() * free_terms;
@@ -186,17 +239,9 @@ struct System {
     return out;
   }
 
-  /// A^T b from the moments: term u^a v^b's height row times z, its u-slope row (a u^(a-1) v^b)
-  /// times zu, its v-slope row (b u^a v^(b-1)) times zv.
-  [[nodiscard]] Terms right_side() const {
-    Terms out;
-    unroll<kTerms>([&](auto i) FOCAL_FIT_LAMBDA {
-      constexpr int a = kHeightRight[i][0], b = kHeightRight[i][1];
-      double x = height_right[i];
-      if constexpr (a > 0) x += a * u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
-      if constexpr (b > 0) x += b * v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
-      out[i] = x;
-    });
+  /// A^T b of the other terms (less the free terms' part).
+  [[nodiscard]] FOCAL_FIT_INLINE Terms reduced_right_side() const {
+    Terms out = right_side();
     if (any_free()) {
       const Eigen::Matrix<double, kTerms, 1> schur =
           free_terms.transpose() * (free_inverse() * free_right);
@@ -214,9 +259,9 @@ struct System {
   /// The least-squares solution (Cholesky of A^T A), or nothing where a pivot is below
   /// kHermiteMinPivot times the largest.
   [[nodiscard]] FOCAL_FIT_INLINE std::optional<Solution> solve() const {
-    const Terms atb = right_side();
+    const Terms atb = reduced_right_side();
     const std::optional<Terms> c =
-        polynomial::cholesky_solve<kTerms>(normal_matrix(), atb, kHermiteMinPivot);
+        polynomial::cholesky_solve<kTerms>(reduced_normal_matrix(), atb, kHermiteMinPivot);
     if (!c) return std::nullopt;
     // Less the free terms' part of b^T b.
     const double bb = any_free() ? btb - free_right.dot(free_inverse() * free_right) : btb;
@@ -228,63 +273,103 @@ struct System {
 /// rows it does not fit (a wider one would not help).
 enum class Refusal { none, underdetermined, unfit };
 
-/// The shape operator [a b; b c] of the fit over `stencil` in the vertex's frame; `refusal`
-/// says why there is none.
-FOCAL_FIT_INLINE std::optional<Eigen::Vector3d> hermite_operator(
-    PositionsRef V, const RowMatrixX3d& N, const std::vector<char>& ok,
-    const std::vector<int>& stencil, int v, const std::vector<char>& guessed,
-    const TangentFrame& frame, bool free_height, bool free_gradient, Refusal& refusal, int& spare) {
+/// A stencil's points in the vertex's frame, scaled by `scale` (their RMS tangential length) so
+/// that the offsets are O(1): the fit's rows before their weights.
+struct ScaledPoints {
+  std::size_t size = 0;
+  double scale = 0.0;
+  int rows = 0;  ///< 3 a point whose slopes are known (its normal not guessed), else 1
+  std::array<double, kMaxPoints> u, v, z, zu, zv;
+  std::array<bool, kMaxPoints> known;
+};
+
+/// The points of `stencil` for the fit at v, or false with `refusal`: underdetermined (fewer than
+/// 5 points, or more than kMaxPoints) or unfit (a normal not `ok` or turned past
+/// kHermiteMaxTurnCosine from the vertex's, offsets that vanish).
+FOCAL_FIT_INLINE bool scaled_points(PositionsRef V, const RowMatrixX3d& N,
+                                    const std::vector<char>& ok, const std::vector<int>& stencil,
+                                    int v, const std::vector<char>& guessed,
+                                    const TangentFrame& frame, ScaledPoints& out,
+                                    Refusal& refusal) {
   refusal = Refusal::underdetermined;
-  if (stencil.size() < 5 || stencil.size() > kMaxPoints) return std::nullopt;
+  if (stencil.size() < 5 || stencil.size() > kMaxPoints) return false;
   refusal = Refusal::unfit;
   const Eigen::Vector3d p = V.row(v).transpose();
-  // Offsets (x, y, z) and slopes in the frame, and the scale that makes the offsets O(1) (their
-  // RMS tangential length).
-  std::array<Eigen::Vector3d, kMaxPoints> local;
-  std::array<Eigen::Vector2d, kMaxPoints> slope;
   double spread = 0.0;
   for (std::size_t k = 0; k < stencil.size(); ++k) {
     const int j = stencil[k];
-    if (!ok[static_cast<std::size_t>(j)]) return std::nullopt;
+    if (!ok[static_cast<std::size_t>(j)]) return false;
     const Eigen::Vector3d m = N.row(j).transpose();
     const double mz = m.dot(frame.n);
-    if (!(mz >= kHermiteMaxTurnCosine)) return std::nullopt;
+    if (!(mz >= kHermiteMaxTurnCosine)) return false;
     const Eigen::Vector3d e = V.row(j).transpose() - p;
-    local[k] = {e.dot(frame.x), e.dot(frame.y), e.dot(frame.n)};
-    slope[k] = {-m.dot(frame.x) / mz, -m.dot(frame.y) / mz};
-    spread += local[k].head<2>().squaredNorm();
+    const Eigen::Vector3d local(e.dot(frame.x), e.dot(frame.y), e.dot(frame.n));
+    out.u[k] = local.x();
+    out.v[k] = local.y();
+    out.z[k] = local.z();
+    out.zu[k] = -m.dot(frame.x) / mz;
+    out.zv[k] = -m.dot(frame.y) / mz;
+    spread += local.head<2>().squaredNorm();
   }
-  const double s = std::sqrt(spread / static_cast<double>(stencil.size()));
-  if (!(s > 0.0)) return std::nullopt;
+  out.size = stencil.size();
+  out.scale = std::sqrt(spread / static_cast<double>(stencil.size()));
+  const double s = out.scale;
+  if (!(s > 0.0)) return false;
+  out.rows = 0;
+  for (std::size_t k = 0; k < out.size; ++k) {
+    out.u[k] /= s;
+    out.v[k] /= s;
+    out.z[k] /= s;
+    if (!(out.u[k] * out.u[k] + out.v[k] * out.v[k] > 0.0)) return false;
+    out.known[k] = guessed.empty() || !guessed[static_cast<std::size_t>(stencil[k])];
+    out.rows += out.known[k] ? 3 : 1;
+  }
+  return true;
+}
+
+/// Whether a fit's coefficients stand: finite curvature terms, rows met within
+/// kHermiteMaxMisfit.
+inline bool fit_stands(double k0, double k1, double k2, double misfit) {
+  return std::isfinite(k0 + k1 + k2) && misfit <= kHermiteMaxMisfit;
+}
+
+/// The Hessian of the height at the vertex from the fit of the scaled points: h(x, y) =
+/// s h~(x / s, y / s), so second derivatives are h~'s over s.
+inline Eigen::Matrix2d hessian_of(double k0, double k1, double k2, double s) {
+  return (Eigen::Matrix2d() << 2.0 * k0, k1, k1, 2.0 * k2).finished() / s;
+}
+
+/// The shape operator [a b; b c] of a graph whose gradient vanishes at the vertex.
+inline Eigen::Vector3d minus_hessian(const Eigen::Matrix2d& hessian) {
+  return {-hessian(0, 0), -hessian(0, 1), -hessian(1, 1)};
+}
+
+/// The shape operator [a b; b c] of the fit over `points` in the vertex's frame; `refusal` says
+/// why there is none (underdetermined where the rows do not fix the quartic, unfit where it does
+/// not meet them); `spare`: the rows beyond the unknowns.
+FOCAL_FIT_INLINE std::optional<Eigen::Vector3d> hermite_operator(const ScaledPoints& points,
+                                                                 bool free_height,
+                                                                 bool free_gradient,
+                                                                 Refusal& refusal, int& spare) {
   System sys;
   sys.free_height = free_height;
   sys.free_gradient = free_gradient;
-  for (std::size_t j = 0; j < stencil.size(); ++j) {
-    const double u = local[j].x() / s, w = local[j].y() / s;
-    if (!(u * u + w * w > 0.0)) return std::nullopt;
-    sys.add_point(u, w, local[j].z() / s, slope[j].x(), slope[j].y(),
-                  guessed.empty() || !guessed[static_cast<std::size_t>(stencil[j])]);
+  for (std::size_t k = 0; k < points.size; ++k) {
+    sys.add_point(points.u[k], points.v[k], points.z[k], points.zu[k], points.zv[k],
+                  points.known[k]);
   }
   spare = sys.rows - (kTerms + (free_height ? 1 : 0) + (free_gradient ? 2 : 0));
-  if (spare < 1) {
-    refusal = Refusal::underdetermined;
-    return std::nullopt;
-  }
+  refusal = Refusal::underdetermined;
+  if (spare < 1) return std::nullopt;
   const std::optional<System::Solution> solution = sys.solve();
-  if (!solution) {
-    refusal = Refusal::underdetermined;
-    return std::nullopt;
-  }
+  if (!solution) return std::nullopt;
+  refusal = Refusal::unfit;
   const Terms& k = solution->c;
-  if (!std::isfinite(k[0] + k[1] + k[2]) || !(solution->misfit <= kHermiteMaxMisfit)) {
-    return std::nullopt;
-  }
+  if (!fit_stands(k[0], k[1], k[2], solution->misfit)) return std::nullopt;
   refusal = Refusal::none;
-  // h(x, y) = s h~(x / s, y / s): second derivatives are h~'s over s, first ones h~'s.
-  const Eigen::Matrix2d hessian =
-      (Eigen::Matrix2d() << 2.0 * k[0], k[1], k[1], 2.0 * k[2]).finished() / s;
+  const Eigen::Matrix2d hessian = hessian_of(k[0], k[1], k[2], points.scale);
   return free_gradient ? polynomial::graph_operator(hessian, sys.free_gradient_at(k))
-                       : Eigen::Vector3d(-hessian(0, 0), -hessian(0, 1), -hessian(1, 1));
+                       : minus_hessian(hessian);
 }
 
 /// What prefer_hermite_fit reads (its arguments).
@@ -292,57 +377,216 @@ struct HermiteInputs : polynomial::FitInputs {
   const std::vector<char>& guessed;
 };
 
-/// prefer_hermite_fit on the vertices [begin, end).
-FOCAL_FIT_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
-                               CurvatureResult& fit, std::vector<char>& written) {
-  std::vector<int> stencil;
-  for (std::int64_t i = begin; i < end; ++i) {
-    const auto v = static_cast<std::size_t>(i);
-    const int vi = static_cast<int>(i);
-    if (!polynomial::takes_vertex(in, fit, i)) continue;
-    const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
-    Refusal refusal = Refusal::none;
-    std::optional<Eigen::Vector3d> op;
-    // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
-    const bool free_gradient = !in.guessed.empty() && in.guessed[v];
-    const bool free_height = !in.moved.empty() && in.moved[v];
-    const auto operator_over = [&](bool wide, int& spare) FOCAL_FIT_LAMBDA {
-      polynomial::ring_stencil(in.one_ring, vi, wide, in.moved, stencil);
-      return hermite_operator(in.V, in.N, in.ok, stencil, vi, in.guessed, frame, free_height,
-                              free_gradient, refusal, spare);
-    };
-    bool on_one_ring = true;
-    int spare = 0;
-    for (const bool wide : {false, true}) {
-      on_one_ring = !wide;
-      op = operator_over(wide, spare);
-      if (refusal != Refusal::underdetermined) break;
+/// Row i of `fit` from the operator `op` in `frame`.
+inline void store_operator(const HermiteInputs& in, std::int64_t i, const TangentFrame& frame,
+                           const Eigen::Vector3d& op, CurvatureResult& fit,
+                           std::vector<char>& written) {
+  store_vertex(fit, i, frame, principal_from_symmetric(op[0], op[1], op[2]), fit.residual[i],
+               in.tol);
+  written[static_cast<std::size_t>(i)] = 1;
+}
+
+/// prefer_hermite_fit at vertex i alone (`stencil` and `points`: scratch).
+FOCAL_FIT_INLINE void fit_vertex(const HermiteInputs& in, std::int64_t i, std::vector<int>& stencil,
+                                 ScaledPoints& points, CurvatureResult& fit,
+                                 std::vector<char>& written) {
+  const auto v = static_cast<std::size_t>(i);
+  const int vi = static_cast<int>(i);
+  const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
+  Refusal refusal = Refusal::none;
+  std::optional<Eigen::Vector3d> op;
+  // The 1-ring first; the 2-ring where the 1-ring is too small to fix the quartic.
+  const bool free_gradient = !in.guessed.empty() && in.guessed[v];
+  const bool free_height = !in.moved.empty() && in.moved[v];
+  const auto operator_over = [&](bool wide, int& spare) FOCAL_FIT_LAMBDA {
+    polynomial::ring_stencil(in.one_ring, vi, wide, in.moved, stencil);
+    if (!scaled_points(in.V, in.N, in.ok, stencil, vi, in.guessed, frame, points, refusal)) {
+      return std::optional<Eigen::Vector3d>();
     }
-    // A 1-ring fit with few rows to spare (a free gradient, guessed neighbours' single rows)
-    // cannot show a spike or a wild normal in its misfit: it stands only where the 2-ring's
-    // agrees.
-    if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
-      const Eigen::Vector3d ring_operator = *op;
-      op = operator_over(true, spare);
-      if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
-        op = ring_operator;
+    return hermite_operator(points, free_height, free_gradient, refusal, spare);
+  };
+  bool on_one_ring = true;
+  int spare = 0;
+  for (const bool wide : {false, true}) {
+    on_one_ring = !wide;
+    op = operator_over(wide, spare);
+    if (refusal != Refusal::underdetermined) break;
+  }
+  // A 1-ring fit with few rows to spare (a free gradient, guessed neighbours' single rows)
+  // cannot show a spike or a wild normal in its misfit: it stands only where the 2-ring's
+  // agrees.
+  if (op.has_value() && on_one_ring && (free_gradient || spare < kHermiteSpareRows)) {
+    const Eigen::Vector3d ring_operator = *op;
+    op = operator_over(true, spare);
+    if (op.has_value() && (ring_operator - *op).norm() <= kHermiteAgreement * op->norm()) {
+      op = ring_operator;
+    }
+  }
+  if (op) store_operator(in, i, frame, *op, fit, written);
+}
+
+template <class L>
+constexpr auto lanes_in = static_cast<std::size_t>(lane_count<L>);
+
+/// Points a lane's fit takes at most (the 1-rings whose 2-ring is searched, not sorted).
+constexpr std::size_t kLanePoints = polynomial::kSearchedRing;
+
+/// Vertices fitted a vertex a lane: those whose operator is their 1-ring's fit alone (no free
+/// terms, at least kHermiteSpareRows rows to spare, at most kLanePoints points). Each lane
+/// sums its own points in its stencil's order, then exact zeros up to the batch's longest ring,
+/// so that it has the bits of fit_vertex.
+// (Arrays of the language, not std::array: GCC folds identical element accessors of arrays of
+// different lengths into one and then reports the lanes' accesses against the other's bounds.)
+template <std::size_t width>
+struct LaneBatch {
+  static constexpr std::size_t kWidth = width;
+  std::size_t size = 0;  ///< lanes filled, below kWidth between flushes
+  /// size, shown to the compiler to be at most kWidth.
+  [[nodiscard]] std::size_t filled() const { return std::min(size, kWidth); }
+  std::int64_t row[width] = {};
+  TangentFrame frame[width];
+  ScaledPoints points[width];
+};
+
+/// Whether vertex i goes to a lane of `batch` (added there), else to fit_vertex.
+template <std::size_t width>
+FOCAL_FIT_INLINE bool add_to_lanes(const HermiteInputs& in, std::int64_t i,
+                                   std::vector<int>& stencil, LaneBatch<width>& batch) {
+  const auto v = static_cast<std::size_t>(i);
+  if ((!in.guessed.empty() && in.guessed[v]) || (!in.moved.empty() && in.moved[v]) ||
+      batch.size >= width) {
+    return false;
+  }
+  polynomial::ring_stencil(in.one_ring, static_cast<int>(i), false, in.moved, stencil);
+  if (stencil.size() > kLanePoints) return false;
+  const TangentFrame frame = tangent_frame(in.N.row(i).transpose());
+  ScaledPoints& points = batch.points[batch.size];
+  Refusal refusal = Refusal::none;
+  if (!scaled_points(in.V, in.N, in.ok, stencil, static_cast<int>(i), in.guessed, frame, points,
+                     refusal) ||
+      points.rows - kTerms < kHermiteSpareRows) {
+    return false;
+  }
+  batch.row[batch.size] = i;
+  batch.frame[batch.size] = frame;
+  ++batch.size;
+  return true;
+}
+
+/// A lane's fit: the curvature terms, the misfit and whether the system was solved.
+struct LaneFit {
+  double k0, k1, k2, misfit;
+  bool solved;
+};
+template <std::size_t width>
+struct LaneFits {
+  LaneFit lane[width] = {};
+};
+
+/// Pads each lane's points up to the batch's longest ring with points that add exact zeros
+/// (fit_lanes makes them inactive), the lanes not filled with such points alone; returns that
+/// length.
+template <std::size_t width>
+FOCAL_FIT_INLINE std::size_t pad_lanes(LaneBatch<width>& batch) {
+  std::size_t longest = 0;
+  for (std::size_t l = 0; l < batch.filled(); ++l) {
+    longest = std::max(longest, batch.points[l].size);
+  }
+  for (std::size_t l = 0; l < width; ++l) {
+    ScaledPoints& p = batch.points[l];
+    if (l >= batch.filled()) p.size = 0, p.rows = 1;
+    for (std::size_t k = p.size; k < longest; ++k) {
+      p.u[k] = p.v[k] = 1.0;
+      p.z[k] = p.zu[k] = p.zv[k] = 0.0;
+      p.known[k] = false;
+    }
+  }
+  return longest;
+}
+
+template <class L>
+FOCAL_FIT_INLINE LaneFits<lanes_in<L>> fit_lanes(LaneBatch<lanes_in<L>>& batch) {
+  const std::size_t longest = pad_lanes(batch);
+  const auto lanes = [&](auto value) FOCAL_LANE_LAMBDA {
+    return lanes_of<L>([&](int l) FOCAL_FIT_LAMBDA {
+      return value(batch.points[static_cast<std::size_t>(l)]);
+    });
+  };
+  const L size = lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
+    return static_cast<double>(p.size);
+  });
+  const L rows = lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
+    return static_cast<double>(p.rows);
+  });
+  const L zero = polynomial::constant<L>(0.0);
+  Moments<L> sums;
+  for (std::size_t k = 0; k < longest; ++k) {
+    const auto at = [&](const std::array<double, kMaxPoints> ScaledPoints::*field)
+                        FOCAL_LANE_LAMBDA {
+      return lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return (p.*field)[k]; });
+    };
+    const L known = lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
+      return p.known[k] ? 1.0 : 0.0;
+    });
+    sums.add_point(at(&ScaledPoints::u), at(&ScaledPoints::v), at(&ScaledPoints::z),
+                   at(&ScaledPoints::zu), at(&ScaledPoints::zv), known != zero,
+                   polynomial::constant<L>(static_cast<double>(k)) < size);
+  }
+  const polynomial::Vector<kTerms, L> atb = sums.right_side();
+  MaskOf<L> solved;
+  polynomial::Matrix<kTerms, L> normal = sums.normal_matrix();
+  const polynomial::Vector<kTerms, L> c =
+      polynomial::cholesky_solve<kTerms, L>(normal, atb, kHermiteMinPivot, solved);
+  const L misfit = polynomial::rms_misfit<kTerms, L>(sums.btb, c, atb, rows);
+  LaneFits<lanes_in<L>> out;
+  for (std::size_t l = 0; l < batch.filled(); ++l) {
+    out.lane[l] = {c[0][l], c[1][l], c[2][l], misfit[l], solved[l] != 0};
+  }
+  return out;
+}
+
+/// prefer_hermite_fit on the vertices [begin, end), those that a lane takes (add_to_lanes) in
+/// lanes of L where `in_lanes`.
+template <class L>
+FOCAL_FIT_INLINE void fit_rows(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
+                               CurvatureResult& fit, std::vector<char>& written, bool in_lanes) {
+  std::vector<int> stencil;
+  ScaledPoints points;
+  LaneBatch<lanes_in<L>> batch;
+  const auto flush = [&]() FOCAL_FIT_LAMBDA {
+    const LaneFits<lanes_in<L>> fits = fit_lanes<L>(batch);
+    for (std::size_t l = 0; l < batch.filled(); ++l) {
+      const LaneFit& f = fits.lane[l];
+      const std::int64_t i = batch.row[l];
+      if (!f.solved) {  // the 1-ring does not fix the quartic: the 2-ring may
+        fit_vertex(in, i, stencil, points, fit, written);
+      } else if (fit_stands(f.k0, f.k1, f.k2, f.misfit)) {
+        const Eigen::Matrix2d hessian = hessian_of(f.k0, f.k1, f.k2, batch.points[l].scale);
+        store_operator(in, i, batch.frame[l], minus_hessian(hessian), fit, written);
       }
     }
-    if (!op) continue;
-    store_vertex(fit, i, frame, principal_from_symmetric((*op)[0], (*op)[1], (*op)[2]),
-                 fit.residual[i], in.tol);
-    written[v] = 1;
+    batch.size = 0;
+  };
+  for (std::int64_t i = begin; i < end; ++i) {
+    if (!polynomial::takes_vertex(in, fit, i)) continue;
+    if (in_lanes && add_to_lanes(in, i, stencil, batch)) {
+      if (batch.size == lanes_in<L>) flush();
+    } else {
+      fit_vertex(in, i, stencil, points, fit, written);
+    }
   }
+  if (batch.size > 0) flush();
 }
 
 // fit_rows for AVX2 and for baseline x86-64 (polynomial::fit_rows_for).
 FOCAL_TARGET_AVX2 void fit_rows_avx2(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
-                                     CurvatureResult& fit, std::vector<char>& written) {
-  fit_rows(in, begin, end, fit, written);
+                                     CurvatureResult& fit, std::vector<char>& written,
+                                     bool in_lanes) {
+  fit_rows<Lanes4>(in, begin, end, fit, written, in_lanes);
 }
 void fit_rows_baseline(const HermiteInputs& in, std::int64_t begin, std::int64_t end,
-                       CurvatureResult& fit, std::vector<char>& written) {
-  fit_rows(in, begin, end, fit, written);
+                       CurvatureResult& fit, std::vector<char>& written, bool in_lanes) {
+  fit_rows<Lanes2>(in, begin, end, fit, written, in_lanes);
 }
 
 }  // namespace
@@ -353,13 +597,13 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const std::vector<char>& moved,
                                      const std::vector<char>& guessed, double exact_residual,
                                      const ClassTolerances& tol, CurvatureResult& fit,
-                                     SimdIsa isa) {
+                                     SimdIsa isa, bool in_lanes) {
   const HermiteInputs in{{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol},
                          guessed};
   const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);
   std::vector<char> written(static_cast<std::size_t>(V.rows()), 0);
   parallel_for_blocks(V.rows(), 256, 0, [&](std::int64_t begin, std::int64_t end) {
-    rows(in, begin, end, fit, written);
+    rows(in, begin, end, fit, written, in_lanes);
   });
   return written;
 }

@@ -65,13 +65,15 @@ constexpr double kHermiteAgreement = 0.1;
 /// and their own fits take the height at the vertex as one more unknown; `guessed` normals are
 /// estimated from the positions (file normals replaced as outliers): they give their height
 /// rows only, and their own fits take the gradient at the vertex as two more unknowns. The row
-/// keeps its residual. Returns, per vertex, whether its row was written.
+/// keeps its residual. Returns, per vertex, whether its row was written. `in_lanes`: the
+/// vertices whose fit is their 1-ring's alone are fitted several at once, a vertex a SIMD lane,
+/// with the same bits (false: each alone, for the tests of that).
 std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const std::vector<char>& ok, const Neighbourhoods& one_ring,
                                      const VertexFaces& incidence, const std::vector<char>& keep,
                                      const std::vector<char>& moved,
                                      const std::vector<char>& guessed, double exact_residual,
                                      const ClassTolerances& tol, CurvatureResult& fit,
-                                     SimdIsa isa = SimdIsa::best);
+                                     SimdIsa isa = SimdIsa::best, bool in_lanes = true);
 
 }  // namespace focal::detail

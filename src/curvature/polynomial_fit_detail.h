@@ -76,19 +76,96 @@ struct Table {
   static constexpr const auto& value = table;
 };
 
+/// The fits' arithmetic is written once for T = double (one vertex) and for T = a lane vector
+/// of core/simd_lanes.h (a vertex a lane): the same IEEE operations in the same order, so each
+/// lane has the bits of its vertex fitted alone. These helpers are the parts that differ. A
+/// function that takes or returns a T by value is always inlined, also in the sanitizer builds:
+/// left out of line it would be a baseline x86-64 function called from AVX2 code with another
+/// ABI for its vectors.
+template <class T>
+constexpr bool kOneVertex = std::is_same_v<T, double>;
+
+/// x in every lane.
+template <class T>
+FOCAL_LANE_INLINE T constant(double x) {
+  if constexpr (kOneVertex<T>) {
+    return x;
+  } else {
+    return broadcast<T>(x);
+  }
+}
+
+/// c ? a : b per lane.
+template <class T>
+FOCAL_LANE_INLINE T pick(MaskOf<T> c, T a, T b) {
+  return c ? a : b;
+}
+
+template <class T>
+FOCAL_LANE_INLINE T square_root(T x) {
+  if constexpr (kOneVertex<T>) {
+    return std::sqrt(x);
+  } else {
+    return lane_sqrt(x);
+  }
+}
+
+/// f(k) for k < N: unrolled with every k a constant for one vertex; a loop for lanes, whose wide
+/// sums do not fit in registers anyway (and unrolled would cost GCC minutes a file).
+template <class T, std::size_t N, class F>
+FOCAL_FIT_INLINE void each(F&& f) {
+  if constexpr (kOneVertex<T>) {
+    unroll<N>(f);
+  } else {
+    for (std::size_t k = 0; k < N; ++k) f(k);
+  }
+}
+
+/// f(j) for j < k, k an index of each().
+template <class T, class K, class F>
+FOCAL_FIT_INLINE void each_below(K k, F&& f) {
+  if constexpr (kOneVertex<T>) {
+    unroll<K::value>(f);
+  } else {
+    for (std::size_t j = 0; j < k; ++j) f(j);
+  }
+}
+
+/// f(i) for k < i < N, ascending, k an index of each().
+template <class T, std::size_t N, class K, class F>
+FOCAL_FIT_INLINE void each_above(K k, F&& f) {
+  if constexpr (kOneVertex<T>) {
+    unroll<N - K::value - 1>([&](auto r) FOCAL_FIT_LAMBDA {
+      f(std::integral_constant<std::size_t, K::value + 1 + decltype(r)::value>{});
+    });
+  } else {
+    for (std::size_t i = k + 1; i < N; ++i) f(i);
+  }
+}
+
+/// N - 1 - r for an index r of each().
+template <class T, std::size_t N, class R>
+FOCAL_FIT_INLINE auto reversed(R r) {
+  if constexpr (kOneVertex<T>) {
+    return std::integral_constant<std::size_t, N - 1 - R::value>{};
+  } else {
+    return N - 1 - r;
+  }
+}
+
 /// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
-template <class table, class K, std::size_t P>
-FOCAL_FIT_INLINE double monomial_at(const std::array<double, P>& pu,
-                                    const std::array<double, P>& pv, K k) {
-  constexpr std::array<int, 2> e = table::value[k];
+template <class table, class K, std::size_t P, class T>
+FOCAL_LANE_INLINE T monomial_at(const std::array<T, P>& pu, const std::array<T, P>& pv, K k) {
+  const std::array<int, 2>& e = table::value[k];
   return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
 }
 
 /// The powers u^0 .. u^8 and v^0 .. v^8 of a point's scaled offset (the moments' degrees).
+template <class T = double>
 struct Powers {
-  std::array<double, 9> u, v;
-  FOCAL_FIT_INLINE Powers(double x, double y) {
-    u[0] = v[0] = 1.0;
+  std::array<T, 9> u, v;
+  FOCAL_FIT_INLINE Powers(const T& x, const T& y) {
+    u[0] = v[0] = constant<T>(1.0);
     for (std::size_t k = 1; k < 9; ++k) {
       u[k] = u[k - 1] * x;
       v[k] = v[k - 1] * y;
@@ -105,54 +182,72 @@ Kernel fit_rows_for(SimdIsa isa, Kernel avx2, Kernel baseline) {
   return isa != SimdIsa::baseline && simd_isa_available(SimdIsa::avx2) ? avx2 : baseline;
 }
 
-template <std::size_t N>
-using Vector = std::array<double, N>;
-template <std::size_t N>
-using Matrix = std::array<Vector<N>, N>;
+template <std::size_t N, class T = double>
+using Vector = std::array<T, N>;
+template <std::size_t N, class T = double>
+using Matrix = std::array<Vector<N, T>, N>;
 
-/// The solution of `normal` c = `right` (symmetric, only the lower triangle read) by Cholesky,
-/// or nothing where a pivot is not positive or below `min_pivot` times the largest (the
-/// stencil does not fix the polynomial).
-template <std::size_t N>
-FOCAL_FIT_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> l, const Vector<N>& right,
-                                                         double min_pivot) {
-  double largest = 0.0, smallest = INFINITY;
-  bool positive = true;
-  unroll<N>([&](auto k) FOCAL_FIT_LAMBDA {
-    double pivot = l[k][k];
-    unroll<k>([&](auto j) FOCAL_FIT_LAMBDA { pivot -= l[k][j] * l[k][j]; });
-    positive = positive && pivot > 0.0;
-    largest = std::max(largest, pivot);
-    smallest = std::min(smallest, pivot);
-    l[k][k] = std::sqrt(pivot);
-    const double inverse = 1.0 / l[k][k];
-    unroll<N - k - 1>([&](auto r) FOCAL_FIT_LAMBDA {
-      constexpr std::size_t i = k + 1 + r;
-      double v = l[i][k];
-      unroll<k>([&](auto j) FOCAL_FIT_LAMBDA { v -= l[i][j] * l[k][j]; });
+/// The solution of `l` c = `right` (symmetric, only the lower triangle read) by Cholesky, `l`
+/// overwritten by its factor; `solved` is false where a pivot is not positive or below
+/// `min_pivot` times the largest (the stencil does not fix the polynomial), and the solution is
+/// then meaningless.
+template <std::size_t N, class T>
+FOCAL_FIT_INLINE Vector<N, T> cholesky_solve(Matrix<N, T>& l, const Vector<N, T>& right,
+                                             double min_pivot, MaskOf<T>& solved) {
+  T largest = constant<T>(0.0), smallest = constant<T>(INFINITY);
+  MaskOf<T> positive = largest == largest;
+  each<T, N>([&](auto k) FOCAL_FIT_LAMBDA {
+    T pivot = l[k][k];
+    each_below<T>(k, [&](auto j) FOCAL_FIT_LAMBDA { pivot -= l[k][j] * l[k][j]; });
+    positive = positive & (pivot > constant<T>(0.0));
+    largest = pick<T>(largest < pivot, pivot, largest);     // std::max(largest, pivot)
+    smallest = pick<T>(pivot < smallest, pivot, smallest);  // std::min(smallest, pivot)
+    l[k][k] = square_root(pivot);
+    const T inverse = 1.0 / l[k][k];
+    each_above<T, N>(k, [&](auto i) FOCAL_FIT_LAMBDA {
+      T v = l[i][k];
+      each_below<T>(k, [&](auto j) FOCAL_FIT_LAMBDA { v -= l[i][j] * l[k][j]; });
       l[i][k] = v * inverse;
     });
   });
-  if (!positive || !(smallest >= min_pivot * largest)) return std::nullopt;
-  Vector<N> c = right;
-  unroll<N>([&](auto i) FOCAL_FIT_LAMBDA {  // L y = right
-    unroll<i>([&](auto j) FOCAL_FIT_LAMBDA { c[i] -= l[i][j] * c[j]; });
+  solved = positive & (smallest >= min_pivot * largest);
+  Vector<N, T> c = right;
+  each<T, N>([&](auto i) FOCAL_FIT_LAMBDA {  // L y = right
+    each_below<T>(i, [&](auto j) FOCAL_FIT_LAMBDA { c[i] -= l[i][j] * c[j]; });
     c[i] /= l[i][i];
   });
-  unroll<N>([&](auto r) FOCAL_FIT_LAMBDA {  // L^T c = y
-    constexpr std::size_t i = N - 1 - r;
-    unroll<N - 1 - i>([&](auto k) FOCAL_FIT_LAMBDA { c[i] -= l[i + 1 + k][i] * c[i + 1 + k]; });
+  each<T, N>([&](auto r) FOCAL_FIT_LAMBDA {  // L^T c = y
+    const auto i = reversed<T, N>(r);
+    each_above<T, N>(i, [&](auto k) FOCAL_FIT_LAMBDA { c[i] -= l[k][i] * c[k]; });
     c[i] /= l[i][i];
   });
   return c;
 }
 
-/// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
+/// cholesky_solve of one vertex, or nothing where it is not solved.
 template <std::size_t N>
-FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb, int rows) {
-  double ctb = 0.0;
+FOCAL_FIT_INLINE std::optional<Vector<N>> cholesky_solve(Matrix<N> normal, const Vector<N>& right,
+                                                         double min_pivot) {
+  bool solved = false;
+  const Vector<N> c = cholesky_solve<N, double>(normal, right, min_pivot, solved);
+  if (!solved) return std::nullopt;
+  return c;
+}
+
+/// The rows' RMS misfit at the least-squares solution c of A c = b: r^T r = b^T b - c^T A^T b.
+template <std::size_t N, class T>
+FOCAL_LANE_INLINE T rms_misfit(const T& btb, const Vector<N, T>& c, const Vector<N, T>& atb,
+                               const T& rows) {
+  T ctb = constant<T>(0.0);
   for (std::size_t i = 0; i < N; ++i) ctb += c[i] * atb[i];
-  return std::sqrt(std::max(0.0, btb - ctb) / rows);
+  const T spread = btb - ctb;
+  const T zero = constant<T>(0.0);
+  return square_root(pick<T>(zero < spread, spread, zero) / rows);  // std::max(0, spread)
+}
+template <std::size_t N>
+FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
+                                   int rows) {
+  return rms_misfit<N, double>(btb, c, atb, static_cast<double>(rows));
 }
 
 /// The shape operator [a b; b c] of a graph with Hessian `hessian` and gradient p at the
