@@ -480,8 +480,8 @@ TEST(SimdKernels, AreaAndMaxNormalsInLanesEqualTheScalarLoopVertexByVertex) {
 }
 
 // The Hermite and height fits' blocks, compiled for AVX2 and for baseline x86-64
-// (polynomial::fit_rows_for), and the Hermite fit's lanes (a vertex a lane) against each vertex
-// fitted alone: the same rows bit for bit, on an irregular torus where some
+// (polynomial::fit_rows_for), and their lanes (a vertex a lane) against each vertex fitted
+// alone: the same rows bit for bit, on an irregular torus where some
 // vertices' positions are flagged as moved and some normals as guessed (their free terms).
 TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
   const Mesh m =
@@ -501,22 +501,24 @@ TEST(SimdKernels, PolynomialFitsAreBitIdenticalForEveryInstructionSet) {
     EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
     return fit;
   };
-  const auto height = [&](SimdIsa isa) {
+  const auto height = [&](SimdIsa isa, bool in_lanes) {
     CurvatureResult fit = detail::undefined_result(m.V.rows());
     fit.residual.setConstant(1.0);
-    const std::vector<char> written = detail::prefer_height_fit(
-        m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep, moved, 1e-9, {}, fit, isa);
+    const std::vector<char> written =
+        detail::prefer_height_fit(m.V, m.N, ok, mesh.one_ring(), *detail::incidence(mesh), keep,
+                                  moved, 1e-9, {}, fit, isa, in_lanes);
     EXPECT_GT(std::count(written.begin(), written.end(), 1), static_cast<long>(n / 2));
     return fit;
   };
-  // The reference fits each vertex alone; the lanes take most vertices (all but the moved, the
-  // guessed and those whose rows are few), four or two at once.
+  // The references fit each vertex alone; the lanes take most vertices (all but the moved, and
+  // for the Hermite fit the guessed and those whose rows are few), four or two at once.
   const CurvatureResult hermite_reference = hermite(SimdIsa::baseline, false);
-  const CurvatureResult height_reference = height(SimdIsa::baseline);
+  const CurvatureResult height_reference = height(SimdIsa::baseline, false);
   for (SimdIsa isa : available_isas()) {
     EXPECT_TRUE(identical(hermite(isa, false), hermite_reference)) << static_cast<int>(isa);
     EXPECT_TRUE(identical(hermite(isa, true), hermite_reference)) << static_cast<int>(isa);
-    EXPECT_TRUE(identical(height(isa), height_reference)) << static_cast<int>(isa);
+    EXPECT_TRUE(identical(height(isa, false), height_reference)) << static_cast<int>(isa);
+    EXPECT_TRUE(identical(height(isa, true), height_reference)) << static_cast<int>(isa);
   }
 }
 

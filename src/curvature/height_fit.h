@@ -55,13 +55,15 @@ constexpr double kHeightMaxMedianShare = 0.15;
 /// kHeightSpareRows rows to spare and a quartic that meets its rows (kHeightMaxMisfit). `moved`
 /// (empty or #V flags): positions known to third order only (repaired spikes); they are in no
 /// other stencil, and their own fits take the height at the vertex as one more unknown. The row
-/// keeps its residual. Returns, per vertex, whether its row was written.
+/// keeps its residual. Returns, per vertex, whether its row was written. `in_lanes`: the
+/// vertices whose height is not free are fitted several at once, a vertex a SIMD lane, with the
+/// same bits (false: each alone, for the tests of that).
 std::vector<char> prefer_height_fit(PositionsRef V, const RowMatrixX3d& N,
                                     const std::vector<char>& ok, const Neighbourhoods& one_ring,
                                     const VertexFaces& incidence, const std::vector<char>& keep,
                                     const std::vector<char>& moved, double exact_residual,
                                     const ClassTolerances& tol, CurvatureResult& fit,
-                                    SimdIsa isa = SimdIsa::best);
+                                    SimdIsa isa = SimdIsa::best, bool in_lanes = true);
 
 /// The share at v of its quartic fit's misfit in the cubic's (both of its 2-ring's heights in
 /// the frame of the unit normal `n`, the turn guard on the `ok` rows of N): the sample's values

@@ -40,17 +40,7 @@ constexpr auto kHeightRight = monomials<2, 4>();
 constexpr auto kSlopeRight = monomials<1, 3>();
 static_assert(kHeightRight.size() == kTerms);
 
-/// Every monomial of degree 0 to 8 in the same order (by degree, u's exponent descending): each
-/// table above is a run of it, from its first entry on.
-constexpr auto kAllMonomials = monomials<0, 8>();
-template <const auto& table>
-constexpr std::size_t run_start() {
-  const std::size_t start = monomial_index(0, table[0][0], table[0][1]);
-  for (std::size_t k = 0; k < table.size(); ++k) {
-    if (table[k] != kAllMonomials[start + k]) throw "not a run of kAllMonomials";
-  }
-  return start;
-}
+using polynomial::run_start;
 constexpr std::size_t kHeightMomentsAt = run_start<kHeightMoments>();
 constexpr std::size_t kSlopeMomentsAt = run_start<kSlopeMoments>();
 constexpr std::size_t kHeightRightAt = run_start<kHeightRight>();
@@ -105,21 +95,17 @@ struct Moments {
     const T g = polynomial::pick<T>(active, 1.0 / (u * u + v * v), zero), h = g * g;
     // A point whose normal is not known to full order gives its height row only.
     const T gs = polynomial::pick<T>(slopes_known, g, zero);
-    const polynomial::Powers<T> powers(u, v);
-    std::array<T, kAllMonomials.size()> m;  // u^a v^b in kAllMonomials' order
-    for (std::size_t n = 0, k = 0; n <= 8; ++n) {
-      for (std::size_t b = 0; b <= n; ++b) m[k++] = powers.u[n - b] * powers.v[b];
-    }
+    const polynomial::AllMonomials<T> m(u, v);
     const T hz = h * z, gu = gs * zu, gv = gs * zv;
     each<T, kHeightMoments.size()>(
-        [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * m[kHeightMomentsAt + k]; });
+        [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * m.value[kHeightMomentsAt + k]; });
     each<T, kSlopeMoments.size()>(
-        [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * m[kSlopeMomentsAt + k]; });
+        [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * m.value[kSlopeMomentsAt + k]; });
     each<T, kTerms>(
-        [&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * m[kHeightRightAt + k]; });
+        [&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * m.value[kHeightRightAt + k]; });
     each<T, kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
-      u_right[k] += gu * m[kSlopeRightAt + k];
-      v_right[k] += gv * m[kSlopeRightAt + k];
+      u_right[k] += gu * m.value[kSlopeRightAt + k];
+      v_right[k] += gv * m.value[kSlopeRightAt + k];
     });
     btb += hz * z + gs * (zu * zu + zv * zv);
   }

@@ -173,6 +173,32 @@ struct Powers {
   }
 };
 
+/// Every monomial of degree 0 to 8, by degree, u's exponent descending (monomials<0, 8>()): the
+/// fits' tables of monomials are runs of it.
+constexpr auto kAllMonomials = monomials<0, 8>();
+
+/// Where `table` starts in kAllMonomials (a compile-time error where it is not a run of it).
+template <const auto& table>
+constexpr std::size_t run_start() {
+  const std::size_t start = static_cast<std::size_t>(monomial_index(0, table[0][0], table[0][1]));
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    if (table[k] != kAllMonomials[start + k]) throw "not a run of kAllMonomials";
+  }
+  return start;
+}
+
+/// u^a v^b of a point's scaled offset (u, v) for every entry of kAllMonomials.
+template <class T>
+struct AllMonomials {
+  std::array<T, kAllMonomials.size()> value;
+  FOCAL_FIT_INLINE AllMonomials(const T& u, const T& v) {
+    const Powers<T> powers(u, v);
+    for (std::size_t n = 0, k = 0; n <= 8; ++n) {
+      for (std::size_t b = 0; b <= n; ++b) value[k++] = powers.u[n - b] * powers.v[b];
+    }
+  }
+};
+
 /// A fit's block of vertices compiled for AVX2 where the CPU runs it and `isa` is not
 /// baseline, else its baseline x86-64 build. The builds differ only in the width of their
 /// registers (the fits' moments take fewer instructions in wider ones): AVX2 without the FMA
