@@ -12,6 +12,7 @@
 #include <string>
 
 #include "focal/core/error.h"
+#include "focal/io/mesh_io.h"
 #include "focal/normals/cloud_normals.h"
 #include "focal/points/neighbours.h"
 #include "normals/cloud_jets.h"
@@ -399,5 +400,68 @@ TEST(GlobalOrientation, DISABLED_Wnnc) {
     }
   }
 }
+
+// What a cloud's flipped count needs (docs/notes/points-log.md, "What the remaining counts
+// need"): on the cloud FOCAL_WO_CLOUD (a file with normals, e.g. CGAL's oni.pwn), the global
+// orientation from the file's own lines with random signs and from PCA's, with the field's
+// verdict and forced through it; then the winding number of the file's oriented points at each
+// sample (direct sums) against the points the forced orientation from the file's lines gets
+// wrong.
+TEST(GlobalOrientation, DISABLED_WhatTheCountsNeed) {
+  const char* path = std::getenv("FOCAL_WO_CLOUD");
+  ASSERT_NE(path, nullptr) << "set FOCAL_WO_CLOUD to a cloud with normals";
+  const Mesh m = read_mesh(path);
+  RowMatrixX3d truth = m.N;
+  truth.rowwise().normalize();
+  std::mt19937_64 rng(1);
+  RowMatrixX3d random_signs = truth;
+  for (Eigen::Index i = 0; i < truth.rows(); ++i) {
+    if ((rng() & 1U) != 0) random_signs.row(i) *= -1.0;
+  }
+  const auto orient = [&](const Neighbourhoods& nb, RowMatrixX3d N, bool force) {
+    orient_normals_mst(m.V, nb, N);
+    const int mst = test::flipped_against(N, truth);
+    detail::WindingOrientationOptions o;
+    if (force) o.closed_residual = o.closed_gain = 10.0;
+    const auto r =
+        detail::orient_by_winding(m.V, nb, nullptr, detail::patch_areas(m.V, nb, N, 0), N, 0, o);
+    std::printf("  mst %5d  global %5d  decided %d  residual %.3f -> %.3f\n", mst,
+                test::flipped_against(N, truth), static_cast<int>(r.decided), r.residual_before,
+                r.residual_after);
+    return N;
+  };
+  for (const int k : {8, 12, 16, 24}) {
+    const Neighbourhoods nb = nearest_neighbours(m.V, k);
+    const RowMatrixX3d pca = pca_normals(m.V, nb);
+    int off = 0;
+    for (Eigen::Index i = 0; i < pca.rows(); ++i)
+      off += !(std::abs(pca.row(i).dot(truth.row(i))) >= 0.5);
+    for (const bool force : {false, true}) {
+      std::printf("k %d, the file's lines%s:\n", k, force ? ", forced" : "");
+      orient(nb, random_signs, force);
+      std::printf("k %d, PCA's lines (%d more than 60 deg off)%s:\n", k, off,
+                  force ? ", forced" : "");
+      orient(nb, pca, force);
+    }
+  }
+  const Neighbourhoods nb = nearest_neighbours(m.V, 16);
+  const Eigen::VectorXd area = detail::patch_areas(m.V, nb, truth, 0);
+  const detail::WindingTree direct(m.V, 0.5 * area.cwiseSqrt(), 1e9);
+  const Eigen::VectorXd w =
+      direct.winding(truth.array().colwise() * area.array(), Eigen::VectorXd::Ones(m.V.rows()), 0);
+  std::printf("the file's lines, k 16, forced:\n");
+  const RowMatrixX3d N = orient(nb, random_signs, true);
+  const double bands[] = {-INFINITY, 0.3, 0.7, 1.1, INFINITY};
+  for (int b = 0; b < 4; ++b) {
+    int right = 0, wrong = 0;
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+      if (!(w[i] >= bands[b] && w[i] < bands[b + 1])) continue;
+      (N.row(i).dot(truth.row(i)) > 0.0 ? right : wrong) += 1;
+    }
+    std::printf("  the file's w in [%.1f, %.1f): right %5d wrong %5d\n", bands[b], bands[b + 1],
+                right, wrong);
+  }
+}
+
 }  // namespace
 }  // namespace focal

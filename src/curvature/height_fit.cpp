@@ -45,8 +45,8 @@ struct HeightSystem {
     const T zero = polynomial::constant<T>(0.0);
     const T g = polynomial::pick<T>(active, 1.0 / (u * u + v * v), zero), h = g * g, hz = h * z;
     const polynomial::AllMonomials<T> m(u, v);
-    each<T, kMoments.size()>(
-        [&](auto k) FOCAL_FIT_LAMBDA { moments[k] += h * m.value[kMomentsAt + k]; });
+    each<T, kMoments.size()>([&](auto k)
+                                 FOCAL_FIT_LAMBDA { moments[k] += h * m.value[kMomentsAt + k]; });
     each<T, N>([&](auto k) FOCAL_FIT_LAMBDA { right[k] += hz * m.value[kTermsAt + k]; });
     btb += hz * z;
     rows += polynomial::pick<T>(active, polynomial::constant<T>(1.0), zero);
@@ -200,8 +200,7 @@ using polynomial::FitInputs;
 inline void store_fit(const FitInputs& in, std::int64_t i, const TangentFrame& frame,
                       const std::optional<HeightFit>& f, CurvatureResult& fit,
                       std::vector<char>& written) {
-  if (!f || !(f->misfit <= kHeightMaxMisfit) ||
-      !(f->misfit <= kHeightMaxShare * f->cubic_misfit)) {
+  if (!f || !(f->misfit <= kHeightMaxMisfit) || !(f->misfit <= kHeightMaxShare * f->cubic_misfit)) {
     return;
   }
   const Eigen::Vector3d& op = f->op;
@@ -243,18 +242,17 @@ FOCAL_FIT_INLINE void fit_lanes(const FitInputs& in, LaneBatch<lanes_in<L>>& bat
     for (std::size_t k = p.size; k < longest; ++k) p.u[k] = p.v[k] = 1.0, p.z[k] = 0.0;
   }
   const auto lanes = [&](auto value) FOCAL_LANE_LAMBDA {
-    return lanes_of<L>([&](int l) FOCAL_FIT_LAMBDA {
-      return value(batch.points[static_cast<std::size_t>(l)]);
-    });
+    return lanes_of<L>(
+        [&](int l) FOCAL_FIT_LAMBDA { return value(batch.points[static_cast<std::size_t>(l)]); });
   };
   const L size =
       lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return static_cast<double>(p.size); });
   System sys;
   for (std::size_t k = 0; k < longest; ++k) {
-    const auto at = [&](const std::array<double, kMaxPoints> ScaledPoints::*field)
-                        FOCAL_LANE_LAMBDA {
-      return lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return (p.*field)[k]; });
-    };
+    const auto at =
+        [&](const std::array<double, kMaxPoints> ScaledPoints::*field) FOCAL_LANE_LAMBDA {
+          return lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return (p.*field)[k]; });
+        };
     sys.add_point(at(&ScaledPoints::u), at(&ScaledPoints::v), at(&ScaledPoints::z),
                   polynomial::constant<L>(static_cast<double>(k)) < size);
   }
@@ -263,8 +261,8 @@ FOCAL_FIT_INLINE void fit_lanes(const FitInputs& in, LaneBatch<lanes_in<L>>& bat
   for (std::size_t l = 0; l < batch.filled(); ++l) {
     store_fit(in, batch.row[l], batch.frame[l],
               height_fit_of(f.solved[l] != 0, at(2, 0, l), at(1, 1, l), at(0, 2, l), at(1, 0, l),
-                            at(0, 1, l), batch.points[l].scale, f.misfit[l],
-                            f.cubic_solved[l] != 0, f.cubic_misfit[l]),
+                            at(0, 1, l), batch.points[l].scale, f.misfit[l], f.cubic_solved[l] != 0,
+                            f.cubic_misfit[l]),
               fit, written);
   }
   batch.size = 0;
@@ -336,8 +334,7 @@ double height_truncation_share(PositionsRef V, const RowMatrixX3d& N, const std:
   std::vector<int> stencil;
   polynomial::ring_stencil(one_ring, v, true, {}, stencil);
   ScaledPoints points;
-  const std::optional<HeightFit> f =
-      height_fit<1>(V, N, ok, stencil, v, tangent_frame(n), points);
+  const std::optional<HeightFit> f = height_fit<1>(V, N, ok, stencil, v, tangent_frame(n), points);
   return f ? f->misfit / f->cubic_misfit : NAN;
 }
 

@@ -16,9 +16,9 @@
 namespace focal::detail {
 namespace {
 
+using polynomial::each;
 using polynomial::monomial_index;
 using polynomial::monomials;
-using polynomial::each;
 using polynomial::unroll;
 
 /// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4
@@ -101,8 +101,8 @@ struct Moments {
         [&](auto k) FOCAL_FIT_LAMBDA { heights[k] += h * m.value[kHeightMomentsAt + k]; });
     each<T, kSlopeMoments.size()>(
         [&](auto k) FOCAL_FIT_LAMBDA { slopes[k] += gs * m.value[kSlopeMomentsAt + k]; });
-    each<T, kTerms>(
-        [&](auto k) FOCAL_FIT_LAMBDA { height_right[k] += hz * m.value[kHeightRightAt + k]; });
+    each<T, kTerms>([&](auto k)
+                        FOCAL_FIT_LAMBDA { height_right[k] += hz * m.value[kHeightRightAt + k]; });
     each<T, kSlopeRight.size()>([&](auto k) FOCAL_FIT_LAMBDA {
       u_right[k] += gu * m.value[kSlopeRightAt + k];
       v_right[k] += gv * m.value[kSlopeRightAt + k];
@@ -132,12 +132,12 @@ struct Moments {
       const int a = kHeightRight[i][0], b = kHeightRight[i][1];
       T x = height_right[i];
       if (a > 0) {
-        x += static_cast<double>(a) *
-             u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
+        x +=
+            static_cast<double>(a) * u_right[static_cast<std::size_t>(monomial_index(1, a - 1, b))];
       }
       if (b > 0) {
-        x += static_cast<double>(b) *
-             v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
+        x +=
+            static_cast<double>(b) * v_right[static_cast<std::size_t>(monomial_index(1, a, b - 1))];
       }
       out[i] = x;
     });
@@ -494,26 +494,22 @@ template <class L>
 FOCAL_FIT_INLINE LaneFits<lanes_in<L>> fit_lanes(LaneBatch<lanes_in<L>>& batch) {
   const std::size_t longest = pad_lanes(batch);
   const auto lanes = [&](auto value) FOCAL_LANE_LAMBDA {
-    return lanes_of<L>([&](int l) FOCAL_FIT_LAMBDA {
-      return value(batch.points[static_cast<std::size_t>(l)]);
-    });
+    return lanes_of<L>(
+        [&](int l) FOCAL_FIT_LAMBDA { return value(batch.points[static_cast<std::size_t>(l)]); });
   };
-  const L size = lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
-    return static_cast<double>(p.size);
-  });
-  const L rows = lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
-    return static_cast<double>(p.rows);
-  });
+  const L size =
+      lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return static_cast<double>(p.size); });
+  const L rows =
+      lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return static_cast<double>(p.rows); });
   const L zero = polynomial::constant<L>(0.0);
   Moments<L> sums;
   for (std::size_t k = 0; k < longest; ++k) {
-    const auto at = [&](const std::array<double, kMaxPoints> ScaledPoints::*field)
-                        FOCAL_LANE_LAMBDA {
-      return lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return (p.*field)[k]; });
-    };
-    const L known = lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA {
-      return p.known[k] ? 1.0 : 0.0;
-    });
+    const auto at =
+        [&](const std::array<double, kMaxPoints> ScaledPoints::*field) FOCAL_LANE_LAMBDA {
+          return lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return (p.*field)[k]; });
+        };
+    const L known =
+        lanes([&](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return p.known[k] ? 1.0 : 0.0; });
     sums.add_point(at(&ScaledPoints::u), at(&ScaledPoints::v), at(&ScaledPoints::z),
                    at(&ScaledPoints::zu), at(&ScaledPoints::zv), known != zero,
                    polynomial::constant<L>(static_cast<double>(k)) < size);
@@ -582,8 +578,8 @@ std::vector<char> prefer_hermite_fit(PositionsRef V, const RowMatrixX3d& N,
                                      const VertexFaces& incidence, const std::vector<char>& keep,
                                      const std::vector<char>& moved,
                                      const std::vector<char>& guessed, double exact_residual,
-                                     const ClassTolerances& tol, CurvatureResult& fit,
-                                     SimdIsa isa, bool in_lanes) {
+                                     const ClassTolerances& tol, CurvatureResult& fit, SimdIsa isa,
+                                     bool in_lanes) {
   const HermiteInputs in{{V, N, ok, keep, moved, one_ring, incidence, exact_residual, tol},
                          guessed};
   const auto rows = polynomial::fit_rows_for(isa, fit_rows_avx2, fit_rows_baseline);

@@ -271,8 +271,7 @@ FOCAL_LANE_INLINE T rms_misfit(const T& btb, const Vector<N, T>& c, const Vector
   return square_root(pick<T>(zero < spread, spread, zero) / rows);  // std::max(0, spread)
 }
 template <std::size_t N>
-FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb,
-                                   int rows) {
+FOCAL_FIT_INLINE double rms_misfit(double btb, const Vector<N>& c, const Vector<N>& atb, int rows) {
   return rms_misfit<N, double>(btb, c, atb, static_cast<double>(rows));
 }
 
