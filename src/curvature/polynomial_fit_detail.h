@@ -70,12 +70,6 @@ constexpr int monomial_index(int lo, int a, int b) {
   return (n * (n + 1) - lo * (lo + 1)) / 2 + (n - a);
 }
 
-/// A table as a type, for unroll's constant indices.
-template <const auto& table>
-struct Table {
-  static constexpr const auto& value = table;
-};
-
 /// The fits' arithmetic is written once for T = double (one vertex) and for T = a lane vector
 /// of core/simd_lanes.h (a vertex a lane): the same IEEE operations in the same order, so each
 /// lane has the bits of its vertex fitted alone. These helpers are the parts that differ. A
@@ -151,13 +145,6 @@ FOCAL_FIT_INLINE auto reversed(R r) {
   } else {
     return N - 1 - r;
   }
-}
-
-/// u^a v^b for the exponents of entry k of `table`, from the powers pu[i] = u^i, pv[i] = v^i.
-template <class table, class K, std::size_t P, class T>
-FOCAL_LANE_INLINE T monomial_at(const std::array<T, P>& pu, const std::array<T, P>& pv, K k) {
-  const std::array<int, 2>& e = table::value[k];
-  return pu[static_cast<std::size_t>(e[0])] * pv[static_cast<std::size_t>(e[1])];
 }
 
 /// The powers u^0 .. u^8 and v^0 .. v^8 of a point's scaled offset (the moments' degrees).
