@@ -209,42 +209,24 @@ inline void store_fit(const FitInputs& in, std::int64_t i, const TangentFrame& f
   written[static_cast<std::size_t>(i)] = 1;
 }
 
-template <class L>
-constexpr auto lanes_in = static_cast<std::size_t>(lane_count<L>);
+using polynomial::lanes_in;
 
-/// Vertices fitted a vertex a lane (those whose height at the vertex is not free: lo = 1). Each
-/// lane sums its own points in its stencil's order, then exact zeros up to the batch's longest
-/// stencil, so that it has the bits of the vertex fitted alone. (Arrays of the language, not
-/// std::array: GCC folds identical element accessors of arrays of different lengths into one
-/// and then reports the lanes' accesses against the other's bounds.)
+/// The vertices fitted a vertex a lane: those whose height at the vertex is not free (lo = 1).
 template <std::size_t width>
-struct LaneBatch {
-  std::size_t size = 0;  ///< lanes filled, below width between flushes
-  [[nodiscard]] std::size_t filled() const { return std::min(size, width); }
-  std::int64_t row[width] = {};
-  TangentFrame frame[width];
-  ScaledPoints points[width];
-};
+using LaneBatch = polynomial::LaneBatch<ScaledPoints, width>;
 
 /// The lanes' fits (height_fit<1> of each lane's points).
 template <class L>
 FOCAL_FIT_INLINE void fit_lanes(const FitInputs& in, LaneBatch<lanes_in<L>>& batch,
                                 CurvatureResult& fit, std::vector<char>& written) {
-  constexpr std::size_t width = lanes_in<L>;
   using System = HeightSystem<1, L>;
-  std::size_t longest = 0;
-  for (std::size_t l = 0; l < batch.filled(); ++l) {
-    longest = std::max(longest, batch.points[l].size);
-  }
-  for (std::size_t l = 0; l < width; ++l) {  // the padding points: exact zeros (inactive)
-    ScaledPoints& p = batch.points[l];
-    if (l >= batch.filled()) p.size = 0;
-    for (std::size_t k = p.size; k < longest; ++k) p.u[k] = p.v[k] = 1.0, p.z[k] = 0.0;
-  }
-  const auto lanes = [&](auto value) FOCAL_LANE_LAMBDA {
-    return lanes_of<L>(
-        [&](int l) FOCAL_FIT_LAMBDA { return value(batch.points[static_cast<std::size_t>(l)]); });
-  };
+  const std::size_t longest =
+      batch.pad_to_longest([](ScaledPoints& p, std::size_t k) FOCAL_FIT_LAMBDA {
+        p.u[k] = p.v[k] = 1.0;
+        p.z[k] = 0.0;
+      });
+  const auto lanes = [&](auto value)
+                         FOCAL_LANE_LAMBDA { return polynomial::lane_values<L>(batch, value); };
   const L size =
       lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return static_cast<double>(p.size); });
   System sys;

@@ -19,7 +19,6 @@ namespace {
 using polynomial::each;
 using polynomial::monomial_index;
 using polynomial::monomials;
-using polynomial::unroll;
 
 /// The quartic's unknowns: the coefficients of the monomials x^a y^b of degree 2 to 4
 /// (kHeightRight below lists them).
@@ -411,28 +410,15 @@ FOCAL_FIT_INLINE void fit_vertex(const HermiteInputs& in, std::int64_t i, std::v
   if (op) store_operator(in, i, frame, *op, fit, written);
 }
 
-template <class L>
-constexpr auto lanes_in = static_cast<std::size_t>(lane_count<L>);
+using polynomial::lanes_in;
 
 /// Points a lane's fit takes at most (the 1-rings whose 2-ring is searched, not sorted).
 constexpr std::size_t kLanePoints = polynomial::kSearchedRing;
 
-/// Vertices fitted a vertex a lane: those whose operator is their 1-ring's fit alone (no free
-/// terms, at least kHermiteSpareRows rows to spare, at most kLanePoints points). Each lane
-/// sums its own points in its stencil's order, then exact zeros up to the batch's longest ring,
-/// so that it has the bits of fit_vertex.
-// (Arrays of the language, not std::array: GCC folds identical element accessors of arrays of
-// different lengths into one and then reports the lanes' accesses against the other's bounds.)
+/// The vertices fitted a vertex a lane: those whose operator is their 1-ring's fit alone (no
+/// free terms, at least kHermiteSpareRows rows to spare, at most kLanePoints points).
 template <std::size_t width>
-struct LaneBatch {
-  static constexpr std::size_t kWidth = width;
-  std::size_t size = 0;  ///< lanes filled, below kWidth between flushes
-  /// size, shown to the compiler to be at most kWidth.
-  [[nodiscard]] std::size_t filled() const { return std::min(size, kWidth); }
-  std::int64_t row[width] = {};
-  TangentFrame frame[width];
-  ScaledPoints points[width];
-};
+using LaneBatch = polynomial::LaneBatch<ScaledPoints, width>;
 
 /// Whether vertex i goes to a lane of `batch` (added there), else to fit_vertex.
 template <std::size_t width>
@@ -469,34 +455,16 @@ struct LaneFits {
   LaneFit lane[width] = {};
 };
 
-/// Pads each lane's points up to the batch's longest ring with points that add exact zeros
-/// (fit_lanes makes them inactive), the lanes not filled with such points alone; returns that
-/// length.
-template <std::size_t width>
-FOCAL_FIT_INLINE std::size_t pad_lanes(LaneBatch<width>& batch) {
-  std::size_t longest = 0;
-  for (std::size_t l = 0; l < batch.filled(); ++l) {
-    longest = std::max(longest, batch.points[l].size);
-  }
-  for (std::size_t l = 0; l < width; ++l) {
-    ScaledPoints& p = batch.points[l];
-    if (l >= batch.filled()) p.size = 0, p.rows = 1;
-    for (std::size_t k = p.size; k < longest; ++k) {
-      p.u[k] = p.v[k] = 1.0;
-      p.z[k] = p.zu[k] = p.zv[k] = 0.0;
-      p.known[k] = false;
-    }
-  }
-  return longest;
-}
-
 template <class L>
 FOCAL_FIT_INLINE LaneFits<lanes_in<L>> fit_lanes(LaneBatch<lanes_in<L>>& batch) {
-  const std::size_t longest = pad_lanes(batch);
-  const auto lanes = [&](auto value) FOCAL_LANE_LAMBDA {
-    return lanes_of<L>(
-        [&](int l) FOCAL_FIT_LAMBDA { return value(batch.points[static_cast<std::size_t>(l)]); });
-  };
+  const std::size_t longest =
+      batch.pad_to_longest([](ScaledPoints& p, std::size_t k) FOCAL_FIT_LAMBDA {
+        p.u[k] = p.v[k] = 1.0;
+        p.z[k] = p.zu[k] = p.zv[k] = 0.0;
+        p.known[k] = false;
+      });
+  const auto lanes = [&](auto value)
+                         FOCAL_LANE_LAMBDA { return polynomial::lane_values<L>(batch, value); };
   const L size =
       lanes([](const ScaledPoints& p) FOCAL_FIT_LAMBDA { return static_cast<double>(p.size); });
   const L rows =

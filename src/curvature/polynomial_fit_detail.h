@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <type_traits>
@@ -18,6 +19,7 @@
 #include "core/simd_lanes.h"
 #include "curvature/vertex_rows.h"
 #include "focal/core/mesh.h"
+#include "focal/curvature/normal_rays.h"
 #include "focal/mesh/neighbourhood.h"
 #include "mesh/topology.h"
 
@@ -273,6 +275,46 @@ inline Eigen::Vector3d graph_operator(const Eigen::Matrix2d& hessian, const Eige
   if (q > 0.0) half += (1.0 / root - 1.0) * p * p.transpose() / q;
   const Eigen::Matrix2d S = half * (-hessian / root) * half;
   return {S(0, 0), 0.5 * (S(0, 1) + S(1, 0)), S(1, 1)};
+}
+
+/// The lanes of a lane type L.
+template <class L>
+constexpr auto lanes_in = static_cast<std::size_t>(lane_count<L>);
+
+/// Vertices fitted a vertex a lane, with their `Points` (a fit's points in the vertex's frame,
+/// `size` of them). Each lane sums its own points in its stencil's order, then points that add
+/// exact zeros up to the batch's longest stencil, so that it has the bits of its vertex fitted
+/// alone. (Arrays of the language, not std::array: GCC folds identical element accessors of
+/// arrays of different lengths into one and then reports the lanes' accesses against the
+/// other's bounds.)
+template <class Points, std::size_t width>
+struct LaneBatch {
+  std::size_t size = 0;  ///< lanes filled, below width between flushes
+  /// size, shown to the compiler to be at most width.
+  [[nodiscard]] std::size_t filled() const { return std::min(size, width); }
+  std::int64_t row[width] = {};
+  TangentFrame frame[width];
+  Points points[width];
+
+  /// Each lane's points from its own end up to the longest stencil set by pad(points, k) (to
+  /// points that add exact zeros), the lanes not filled from the first; returns that length.
+  template <class Pad>
+  FOCAL_FIT_INLINE std::size_t pad_to_longest(Pad&& pad) {
+    std::size_t longest = 0;
+    for (std::size_t l = 0; l < filled(); ++l) longest = std::max(longest, points[l].size);
+    for (std::size_t l = 0; l < width; ++l) {
+      if (l >= filled()) points[l].size = 0;
+      for (std::size_t k = points[l].size; k < longest; ++k) pad(points[l], k);
+    }
+    return longest;
+  }
+};
+
+/// value(points) of each lane of `batch`, as a vector.
+template <class L, class Points, class Value>
+FOCAL_LANE_INLINE L lane_values(const LaneBatch<Points, lanes_in<L>>& batch, Value&& value) {
+  return lanes_of<L>(
+      [&](int l) FOCAL_FIT_LAMBDA { return value(batch.points[static_cast<std::size_t>(l)]); });
 }
 
 /// Whether v's 1-ring is closed: as many faces as neighbours in `incidence`.
